@@ -1,0 +1,30 @@
+#!/bin/sh
+# Runs every test program and prints the combined "N passed, N failed" line.
+# Usage: tests/run.sh BUILD_DIR
+set -u
+build=${1:-build}
+total_pass=0
+total_fail=0
+run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed"
+    name=$1; shift
+    echo "== $name" >&2
+    out=$("$@")
+    status=$?
+    line=$(printf '%s\n' "$out" | tail -n 1)
+    p=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed.*/\1/p')
+    f=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed.*/\2/p')
+    if [ -z "$p" ]; then
+        echo "$name: no result line (exit $status)" >&2
+        p=0; f=1
+    elif [ "$status" != 0 ] && [ "$f" = 0 ]; then
+        echo "$name: exit status $status" >&2
+        f=1
+    fi
+    echo "$name: $line" >&2
+    total_pass=$((total_pass + p))
+    total_fail=$((total_fail + f))
+}
+run unit "$build/test"
+run cli sh tests/cli.sh "$build/vdag"
+echo "$total_pass passed, $total_fail failed"
+[ "$total_fail" = 0 ]

@@ -1,0 +1,56 @@
+/* Minimal test harness shared by all suites: explicit registry, one line per
+   failure, a closing "N passed, N failed" line. */
+#ifndef VOXDAG_TEST_H
+#define VOXDAG_TEST_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+typedef struct test_case {
+    const char *name;
+    void (*fn)(void);
+} test_case;
+
+/* Set by CHECK when the running test case fails. */
+extern int test_current_failed;
+
+#define CHECK(cond)                                                            \
+    do {                                                                       \
+        if (!(cond)) {                                                         \
+            if (test_current_failed < 8)                                       \
+                fprintf(stderr, "  %s:%d: CHECK failed: %s\n", __FILE__,       \
+                        __LINE__, #cond);                                      \
+            test_current_failed++;                                             \
+        }                                                                      \
+    } while (0)
+
+#define CHECK_MSG(cond, ...)                                                   \
+    do {                                                                       \
+        if (!(cond)) {                                                         \
+            if (test_current_failed < 8) {                                     \
+                fprintf(stderr, "  %s:%d: CHECK failed: %s: ", __FILE__,       \
+                        __LINE__, #cond);                                      \
+                fprintf(stderr, __VA_ARGS__);                                  \
+                fputc('\n', stderr);                                           \
+            }                                                                  \
+            test_current_failed++;                                             \
+        }                                                                      \
+    } while (0)
+
+/* Deterministic generator for test data (splitmix64). */
+static inline uint64_t test_rand(uint64_t *state) {
+    uint64_t z = (*state += 0x9E3779B97F4A7C15ull);
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+static inline uint32_t test_rand_below(uint64_t *state, uint32_t n) {
+    return (uint32_t)(test_rand(state) % n);
+}
+
+/* Path of the test data folder (tests/data), overridable by VOXDAG_TEST_DATA. */
+const char *test_data_dir(void);
+
+#endif

@@ -1,0 +1,39 @@
+/* The test runner: every suite registers its cases here. Usage:
+   test [FILTER]  runs the cases whose name contains FILTER. */
+#include "test.h"
+
+int test_current_failed;
+
+extern const test_case test_core_cases[];
+
+static const test_case *const suites[] = {
+    test_core_cases,
+};
+
+const char *test_data_dir(void) {
+    const char *d = getenv("VOXDAG_TEST_DATA");
+    return d ? d : "tests/data";
+}
+
+int main(int argc, char **argv) {
+    const char *filter = argc > 1 ? argv[1] : NULL;
+    int passed = 0, failed = 0;
+    size_t s;
+    for (s = 0; s < sizeof suites / sizeof suites[0]; s++) {
+        const test_case *t;
+        for (t = suites[s]; t->name; t++) {
+            if (filter && !strstr(t->name, filter)) continue;
+            test_current_failed = 0;
+            fprintf(stderr, "[ RUN ] %s\n", t->name);
+            t->fn();
+            if (test_current_failed) {
+                fprintf(stderr, "[FAIL ] %s (%d checks failed)\n", t->name, test_current_failed);
+                failed++;
+            } else {
+                passed++;
+            }
+        }
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
