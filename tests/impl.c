@@ -1,0 +1,3 @@
+/* The one translation unit holding the implementations used by the tests. */
+#define VOXDAG_IMPLEMENTATION
+#include "voxdag.h"
