@@ -7,10 +7,17 @@
 #include <stddef.h>
 #include <stdint.h>
 
-typedef struct vdag_image {
-    uint32_t width, height;
-    uint8_t *rgb; /* width*height*3 bytes, rows top to bottom */
-} vdag_image;
+#include "image.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Most voxels a .vox scene may expand to (its scene graph can instance one
+   model many times); a larger scene is an error, not an allocation. */
+#ifndef VDAG_IMPORT_MAX_POINTS
+#define VDAG_IMPORT_MAX_POINTS ((uint64_t)1 << 28)
+#endif
 
 typedef struct vdag_material {
     uint8_t rgb[3]; /* diffuse colour (Kd), 8-bit sRGB */
@@ -49,5 +56,9 @@ int vdag_import_memory(const char *ext, const void *data, size_t size,
                        size_t err_size);
 
 void vdag_scene_free(vdag_scene *scene);
+
+#ifdef __cplusplus
+}
+#endif
 
 #endif

@@ -1,0 +1,19 @@
+/* Texture decoding left out of the build (OpenImageIO was not found). */
+#include "image.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+
+int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size) {
+    out->width = out->height = 0;
+    out->rgb = NULL;
+    if (err_size) snprintf(err, err_size, "%s: texture decoding not built in", path);
+    return 0;
+}
+
+void vdag_image_free(vdag_image *image) {
+    if (!image) return;
+    free(image->rgb);
+    image->rgb = NULL;
+    image->width = image->height = 0;
+}
