@@ -15,7 +15,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h
 
 VDAG_SRC := examples/vdag.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c
 
 .PHONY: all test deps demo bench clean
 

@@ -1,5 +1,993 @@
-/* voxcolor.h (work in progress) */
+/* voxcolor.h - variable-bitrate block colour codec in one header.  version 0.1.0
+
+   Compresses an array of RGB8 colours (the colours of a voxel DAG in
+   voxel-index order, or any 1D colour array with spatial coherence) with a
+   guaranteed maximum error per colour, and decodes any colour by index in
+   near-constant time, in place, without allocation.
+
+   The array is cut into blocks of any length (Dolonius et al. 2017, §4.2).
+   Each block is one of: a single colour, two endpoints with a 1..4-bit weight
+   per colour interpolating between them, or raw colours. Endpoints are RGB565
+   or RGB888, chosen per block. Blocks never cross a page (2^page_shift
+   colours), and a page table gives each page's first block, so a lookup reads
+   one table entry and walks a few block headers of one page.
+
+   QUICK START
+       #define VOXCOLOR_IMPLEMENTATION   // in exactly one C or C++ file
+       #include "voxcolor.h"
+
+       voxcolor_encode_opts opts = {0};
+       opts.max_error = 0.02;            // |decoded - original| / 255 <= 0.02
+       size_t cap = voxcolor_encode_bound(count);
+       uint8_t *buf = malloc(cap);
+       size_t size = voxcolor_encode(buf, cap, rgb, count, &opts);
+
+       voxcolor_view view;               // validates untrusted bytes once
+       if (voxcolor_view_init(&view, buf, size) == VOXCOLOR_OK) {
+           uint8_t c[3];
+           voxcolor_view_get(&view, 12345, c);
+       }
+
+   ERROR GUARANTEE
+   Every colour c' returned by the decoder for an original colour c satisfies
+   |c' - c|_2 / 255 <= max_error (Euclidean RGB distance, 8-bit units), or,
+   with VOXCOLOR_METRIC_CIELAB, CIE76 delta E(c', c) <= max_error. The encoder
+   checks each colour against what the decoder will return. max_error 0 is
+   lossless.
+
+   CONFIGURATION (define before including the implementation)
+     VOXCOLOR_ASSERT(x)   caller-contract checks (default: assert)
+     VOXCOLOR_STATIC      give every function internal linkage
+   The codec never allocates: the caller owns every buffer.
+
+   THREADS: no global state. A view is immutable after voxcolor_view_init: any
+   number of threads may query one view at the same time. Encoding reads its
+   input and writes only the caller's buffer.
+
+   STREAM FORMAT: FORMAT.md, section "Colour section (voxcolor)", documents
+   every byte; the VOXCOLOR_OFF_* macros mirror it.
+*/
 #ifndef VOXCOLOR_H
 #define VOXCOLOR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
 #define VOXCOLOR_VERSION_MAJOR 0
+#define VOXCOLOR_VERSION_MINOR 1
+#define VOXCOLOR_VERSION_PATCH 0
+#define VOXCOLOR_VERSION \
+    (VOXCOLOR_VERSION_MAJOR * 10000 + VOXCOLOR_VERSION_MINOR * 100 + VOXCOLOR_VERSION_PATCH)
+
+/* Stream layout version, stored in every stream (FORMAT.md). */
+#define VOXCOLOR_FORMAT_VERSION 1
+
+/* Byte offsets of the stream header fields (FORMAT.md). */
+#define VOXCOLOR_OFF_MAGIC 0      /* 4 bytes "VXC1" */
+#define VOXCOLOR_OFF_VERSION 4    /* u16 format version */
+#define VOXCOLOR_OFF_PAGE_SHIFT 6 /* u8 log2 of colours per page */
+#define VOXCOLOR_OFF_FLAGS 7      /* u8, bit 0: 8-byte page table entries */
+#define VOXCOLOR_OFF_COUNT 8      /* u64 colour count */
+#define VOXCOLOR_OFF_DATA_SIZE 16 /* u64 block data bytes */
+#define VOXCOLOR_HEADER_SIZE 24   /* then the page table, then the block data */
+
+#define VOXCOLOR_MIN_PAGE_SHIFT 4
+#define VOXCOLOR_MAX_PAGE_SHIFT 12
+#define VOXCOLOR_DEFAULT_PAGE_SHIFT 8
+
+#ifndef VOXCOLOR_API
+#ifdef VOXCOLOR_STATIC
+#define VOXCOLOR_API static
+#else
+#define VOXCOLOR_API extern
 #endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// -- Status
+
+typedef enum voxcolor_status {
+    VOXCOLOR_OK = 0,
+    VOXCOLOR_ERR_TRUNCATED, /* the stream ends before a part it declares */
+    VOXCOLOR_ERR_BAD_MAGIC, /* not a voxcolor stream */
+    VOXCOLOR_ERR_VERSION,   /* a format version this reader does not know */
+    VOXCOLOR_ERR_CORRUPT,   /* a field is out of range or inconsistent */
+    VOXCOLOR_ERR_TRAILING,  /* bytes follow the end of the stream */
+    VOXCOLOR_STATUS_COUNT,
+    VOXCOLOR_STATUS_FORCE_32BIT = 0x7fffffff
+} voxcolor_status;
+
+/* Returns a static, human-readable name of a status. Thread-safe. */
+VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status);
+
+/* Returns VOXCOLOR_VERSION of the implementation that was compiled. */
+VOXCOLOR_API uint32_t voxcolor_version(void);
+
+// -- Encoding
+
+typedef enum voxcolor_metric {
+    VOXCOLOR_METRIC_RGB = 0,    /* Euclidean distance of RGB8 values / 255 */
+    VOXCOLOR_METRIC_CIELAB = 1, /* CIE76 delta E, colours taken as sRGB (D65) */
+    VOXCOLOR_METRIC_COUNT,
+    VOXCOLOR_METRIC_FORCE_32BIT = 0x7fffffff
+} voxcolor_metric;
+
+/* Encoder options. A NULL pointer or an all-zero struct means: lossless,
+   RGB metric, weight width chosen per block, pages of 256 colours. */
+typedef struct voxcolor_encode_opts {
+    double max_error;        /* error bound e_t in units of the metric; >= 0 */
+    voxcolor_metric metric;
+    uint32_t weight_bits;    /* 0: 0..4 bits per block (best fit); 1..4: blocks
+                                with weights all use this width (as in the
+                                paper's fixed-width format) */
+    uint32_t page_shift;     /* 0: 8; else 4..12. Larger: smaller stream,
+                                slower random lookup */
+} voxcolor_encode_opts;
+
+/* Returns the largest stream voxcolor_encode can produce for COUNT colours,
+   whatever the options (about 3.7 bytes per colour), or 0 when that does not
+   fit in a size_t. Thread-safe. */
+VOXCOLOR_API size_t voxcolor_encode_bound(size_t count);
+
+/* Encodes COUNT colours (RGB8, 3 bytes each) into DST. OPTS may be NULL.
+   Returns the stream size in bytes, or 0 when DST_SIZE is too small (a buffer
+   of voxcolor_encode_bound(count) bytes is always large enough). The caller
+   owns both buffers; no memory is allocated. Deterministic: the same input and
+   options give the same bytes. Invalid options trip VOXCOLOR_ASSERT. */
+VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
+                                    size_t count, const voxcolor_encode_opts *opts);
+
+// -- Decoding
+
+/* A validated, read-only window on a stream. The stream bytes are not copied:
+   they must stay valid and unchanged while the view is used. */
+typedef struct voxcolor_view {
+    const uint8_t *table; /* page table */
+    const uint8_t *data;  /* block data */
+    uint64_t count;       /* number of colours */
+    uint32_t page_shift;
+    uint32_t wide;        /* 1: 8-byte page table entries, 0: 4-byte */
+} voxcolor_view;
+
+/* Validates SIZE bytes at SRC completely (header, version, page table, every
+   block header, padding, no trailing bytes) and sets up VIEW. Returns
+   VOXCOLOR_OK, or an error and leaves VIEW zeroed. Never reads outside
+   [SRC, SRC + SIZE); runs in time linear in SIZE. Thread-safe. */
+VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src,
+                                                size_t size);
+
+/* Writes the colour at INDEX (< view->count) to RGB_OUT[0..2]. Reads one page
+   table entry and walks the headers of one page. Thread-safe. */
+VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
+                                    uint8_t rgb_out[3]);
+
+/* Writes N colours starting at FIRST (FIRST + N <= view->count) to RGB_OUT
+   (3 * N bytes), decoding sequentially. Same result as N calls of
+   voxcolor_view_get, faster. Thread-safe. */
+VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t first,
+                                          size_t n, uint8_t *rgb_out);
+
+// -- 2D mapping (Dolonius §4.1)
+
+/* Pixel of array element INDEX along a 2D Morton curve: the bits of INDEX
+   alternate x (bit 0), y (bit 1), x, y, ... Thread-safe. */
+VOXCOLOR_API void voxcolor_morton2d_decode(uint64_t index, uint32_t *x, uint32_t *y);
+
+/* Inverse of voxcolor_morton2d_decode. */
+VOXCOLOR_API uint64_t voxcolor_morton2d_encode(uint32_t x, uint32_t y);
+
+/* Smallest image whose Morton curve holds COUNT elements: WIDTH a power of
+   two, WIDTH >= HEIGHT, HEIGHT the number of rows the curve actually visits.
+   COUNT must be at most 2^62. */
+VOXCOLOR_API void voxcolor_image_size(uint64_t count, uint32_t *width, uint32_t *height);
+
+/* Writes COUNT colours into IMAGE (WIDTH x HEIGHT RGB8 pixels, rows top to
+   bottom, sizes from voxcolor_image_size) along the Morton curve. Pixels the
+   curve does not reach get the colour of the element before them on the
+   curve, which image codecs compress to almost nothing. */
+VOXCOLOR_API void voxcolor_to_image(uint8_t *image, uint32_t width, uint32_t height,
+                                    const uint8_t *rgb8, size_t count);
+
+/* Reads COUNT colours back from an image written by voxcolor_to_image. */
+VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t *image,
+                                      uint32_t width, uint32_t height);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VOXCOLOR_H */
+
+/* ==========================================================================
+   Implementation
+   ========================================================================== */
+#ifdef VOXCOLOR_IMPLEMENTATION
+#ifndef VOXCOLOR_IMPLEMENTATION_DONE
+#define VOXCOLOR_IMPLEMENTATION_DONE
+
+#include <string.h>
+
+#ifndef VOXCOLOR_ASSERT
+#include <assert.h>
+#define VOXCOLOR_ASSERT(x) assert(x)
+#endif
+
+// -- Block modes
+/* A block header is MODE (3 bits), PRECISION (1 bit: 0 RGB565, 1 RGB888
+   endpoints) and LENGTH - 1 (page_shift bits), followed by the endpoints and
+   the per-colour payload. Modes 0..4: weight width in bits (0 = one colour);
+   mode 5: raw RGB888 colours. */
+#define VOXCOLORI_MODE_RAW 5u
+#define VOXCOLORI_MAX_WEIGHT_BITS 4u
+
+/* Interpolation weights in 64ths for weight k of width w: round(64 k / (2^w - 1)).
+   A channel decodes as (e0 * (64 - t) + e1 * t + 32) >> 6 (as in BC7). */
+static const uint8_t voxcolori_weights[5][16] = {
+    {0},
+    {0, 64},
+    {0, 21, 43, 64},
+    {0, 9, 18, 27, 37, 46, 55, 64},
+    {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64},
+};
+
+/* Bits per colour of the payload of each mode. */
+static unsigned voxcolori_payload_bits(unsigned mode) {
+    return mode == VOXCOLORI_MODE_RAW ? 24u : mode;
+}
+
+/* Endpoint bits of a block: none for raw, one colour for mode 0, two else. */
+static unsigned voxcolori_endpoint_bits(unsigned mode, unsigned precision) {
+    unsigned one = precision ? 24u : 16u;
+    if (mode == VOXCOLORI_MODE_RAW) return 0;
+    return mode == 0 ? one : 2 * one;
+}
+
+/* 8-bit value of a quantized channel with BITS bits (bit replication). */
+static unsigned voxcolori_expand(unsigned q, unsigned bits) {
+    if (bits == 8) return q;
+    return (q << (8 - bits)) | (q >> (2 * bits - 8));
+}
+
+/* Channel bit widths of an endpoint: 5/6/5 or 8/8/8. */
+static unsigned voxcolori_channel_bits(unsigned channel, unsigned precision) {
+    if (precision) return 8;
+    return channel == 1 ? 6u : 5u;
+}
+
+// -- Little-endian bytes
+
+static uint64_t voxcolori_load_le(const uint8_t *p, unsigned n) {
+    uint64_t v = 0;
+    while (n--) v = v << 8 | p[n];
+    return v;
+}
+
+static void voxcolori_store_le(uint8_t *p, uint64_t v, unsigned n) {
+    unsigned i;
+    for (i = 0; i < n; i++) p[i] = (uint8_t)(v >> (8 * i));
+}
+
+/* Written out so that compilers turn it into one load. */
+static uint64_t voxcolori_load64(const uint8_t *p) {
+    return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24 |
+           (uint64_t)p[4] << 32 | (uint64_t)p[5] << 40 | (uint64_t)p[6] << 48 |
+           (uint64_t)p[7] << 56;
+}
+
+/* N (<= 56) bits at bit position POS of DATA, least significant bit first.
+   The stream ends with 8 zero bytes, so the 8-byte load stays inside it. */
+static uint64_t voxcolori_bits(const uint8_t *data, uint64_t pos, unsigned n) {
+    uint64_t w = voxcolori_load64(data + (size_t)(pos >> 3)) >> (pos & 7);
+    return w & ((1ull << n) - 1);
+}
+
+// -- Decoding one block
+
+/* Reads an endpoint colour of PRECISION at bit POS into E (8-bit channels). */
+static void voxcolori_read_endpoint(const uint8_t *data, uint64_t pos, unsigned precision,
+                                    unsigned e[3]) {
+    uint64_t v = voxcolori_bits(data, pos, precision ? 24u : 16u);
+    unsigned c, shift = 0;
+    for (c = 0; c < 3; c++) {
+        unsigned b = voxcolori_channel_bits(c, precision);
+        e[c] = voxcolori_expand((unsigned)(v >> shift) & ((1u << b) - 1), b);
+        shift += b;
+    }
+}
+
+/* Interpolated colour for weight index K of a width-W block. */
+static void voxcolori_mix(const unsigned e0[3], const unsigned e1[3], unsigned w, unsigned k,
+                          uint8_t out[3]) {
+    unsigned t = voxcolori_weights[w][k], c;
+    for (c = 0; c < 3; c++) out[c] = (uint8_t)((e0[c] * (64 - t) + e1[c] * t + 32) >> 6);
+}
+
+typedef struct voxcolori_block {
+    unsigned mode, precision;
+    uint64_t length;
+    uint64_t payload; /* bit position after the header */
+} voxcolori_block;
+
+static void voxcolori_read_header(const uint8_t *data, uint64_t pos, unsigned page_shift,
+                                  voxcolori_block *b) {
+    uint64_t h = voxcolori_bits(data, pos, 4 + page_shift);
+    b->mode = (unsigned)(h & 7);
+    b->precision = (unsigned)(h >> 3) & 1;
+    b->length = (h >> 4) + 1;
+    b->payload = pos + 4 + page_shift;
+}
+
+/* Bit position just after block B. */
+static uint64_t voxcolori_block_end(const voxcolori_block *b) {
+    return b->payload + voxcolori_endpoint_bits(b->mode, b->precision) +
+           b->length * voxcolori_payload_bits(b->mode);
+}
+
+/* Colour number I (< length) of block B. */
+static void voxcolori_block_color(const uint8_t *data, const voxcolori_block *b, uint64_t i,
+                                  uint8_t out[3]) {
+    unsigned e0[3], e1[3];
+    if (b->mode == VOXCOLORI_MODE_RAW) {
+        uint64_t v = voxcolori_bits(data, b->payload + 24 * i, 24);
+        out[0] = (uint8_t)v;
+        out[1] = (uint8_t)(v >> 8);
+        out[2] = (uint8_t)(v >> 16);
+        return;
+    }
+    voxcolori_read_endpoint(data, b->payload, b->precision, e0);
+    if (b->mode == 0) {
+        out[0] = (uint8_t)e0[0];
+        out[1] = (uint8_t)e0[1];
+        out[2] = (uint8_t)e0[2];
+        return;
+    }
+    {
+        unsigned one = b->precision ? 24u : 16u;
+        uint64_t k = voxcolori_bits(data, b->payload + 2 * one + b->mode * i, b->mode);
+        voxcolori_read_endpoint(data, b->payload + one, b->precision, e1);
+        voxcolori_mix(e0, e1, b->mode, (unsigned)k, out);
+    }
+}
+
+// -- Views
+
+VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status) {
+    switch (status) {
+    case VOXCOLOR_OK: return "ok";
+    case VOXCOLOR_ERR_TRUNCATED: return "stream truncated";
+    case VOXCOLOR_ERR_BAD_MAGIC: return "not a voxcolor stream";
+    case VOXCOLOR_ERR_VERSION: return "unsupported voxcolor format version";
+    case VOXCOLOR_ERR_CORRUPT: return "corrupt voxcolor stream";
+    case VOXCOLOR_ERR_TRAILING: return "bytes after the end of the voxcolor stream";
+    default: return "unknown status";
+    }
+}
+
+VOXCOLOR_API uint32_t voxcolor_version(void) { return VOXCOLOR_VERSION; }
+
+static uint64_t voxcolori_page_offset(const voxcolor_view *v, uint64_t page) {
+    unsigned n = v->wide ? 8u : 4u;
+    return voxcolori_load_le(v->table + (size_t)(page * n), n);
+}
+
+/* Checks the blocks of every page: they must tile each page exactly, follow
+   each other without gaps, start where the page table says, and end before
+   the 8 zero bytes that close the data. DATA_SIZE >= 8. */
+static voxcolor_status voxcolori_check_blocks(const voxcolor_view *v, uint64_t data_size) {
+    uint64_t limit = (data_size - 8) * 8, pos = 0, page, pages;
+    uint64_t page_size = 1ull << v->page_shift;
+    size_t i;
+    pages = v->count ? ((v->count - 1) >> v->page_shift) + 1 : 0;
+    for (page = 0; page < pages; page++) {
+        uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size;
+        if (voxcolori_page_offset(v, page) != pos / 8) return VOXCOLOR_ERR_CORRUPT;
+        while (left) {
+            voxcolori_block b;
+            if (limit - pos < 4 + v->page_shift) return VOXCOLOR_ERR_CORRUPT;
+            voxcolori_read_header(v->data, pos, v->page_shift, &b);
+            if (b.mode > VOXCOLORI_MODE_RAW || (b.mode == VOXCOLORI_MODE_RAW && b.precision) ||
+                b.length > left)
+                return VOXCOLOR_ERR_CORRUPT;
+            /* length <= 4096 and payload <= limit: no overflow below. */
+            if (voxcolori_block_end(&b) > limit) return VOXCOLOR_ERR_CORRUPT;
+            pos = voxcolori_block_end(&b);
+            left -= b.length;
+        }
+        /* Pages start on a byte; the bits up to it must be zero. */
+        if (pos & 7) {
+            if (voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7))) return VOXCOLOR_ERR_CORRUPT;
+            pos += 8 - (pos & 7);
+        }
+    }
+    if (pos / 8 + 8 != data_size) return VOXCOLOR_ERR_CORRUPT;
+    for (i = 0; i < 8; i++)
+        if (v->data[pos / 8 + i]) return VOXCOLOR_ERR_CORRUPT;
+    return VOXCOLOR_OK;
+}
+
+VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src,
+                                                size_t size) {
+    const uint8_t *p = (const uint8_t *)src;
+    voxcolor_view v;
+    uint64_t pages, entry, rest, data_size;
+    unsigned flags;
+    voxcolor_status st;
+    VOXCOLOR_ASSERT(view && (src || !size));
+    memset(view, 0, sizeof *view);
+    if (size < VOXCOLOR_HEADER_SIZE) return VOXCOLOR_ERR_TRUNCATED;
+    if (memcmp(p + VOXCOLOR_OFF_MAGIC, "VXC1", 4) != 0) return VOXCOLOR_ERR_BAD_MAGIC;
+    if (voxcolori_load_le(p + VOXCOLOR_OFF_VERSION, 2) != VOXCOLOR_FORMAT_VERSION)
+        return VOXCOLOR_ERR_VERSION;
+    v.page_shift = p[VOXCOLOR_OFF_PAGE_SHIFT];
+    flags = p[VOXCOLOR_OFF_FLAGS];
+    if (v.page_shift < VOXCOLOR_MIN_PAGE_SHIFT || v.page_shift > VOXCOLOR_MAX_PAGE_SHIFT ||
+        flags > 1)
+        return VOXCOLOR_ERR_CORRUPT;
+    v.wide = flags;
+    v.count = voxcolori_load_le(p + VOXCOLOR_OFF_COUNT, 8);
+    data_size = voxcolori_load_le(p + VOXCOLOR_OFF_DATA_SIZE, 8);
+    pages = v.count ? ((v.count - 1) >> v.page_shift) + 1 : 0;
+    entry = v.wide ? 8 : 4;
+    rest = (uint64_t)size - VOXCOLOR_HEADER_SIZE;
+    if (pages > rest / entry) return VOXCOLOR_ERR_TRUNCATED;
+    rest -= pages * entry;
+    if (data_size > rest) return VOXCOLOR_ERR_TRUNCATED;
+    if (data_size < rest) return VOXCOLOR_ERR_TRAILING;
+    if (data_size < 8 || data_size > UINT64_MAX / 8) return VOXCOLOR_ERR_CORRUPT;
+    v.table = p + VOXCOLOR_HEADER_SIZE;
+    v.data = v.table + (size_t)(pages * entry);
+    st = voxcolori_check_blocks(&v, data_size);
+    if (st == VOXCOLOR_OK) *view = v;
+    return st;
+}
+
+/* Finds the block holding colour INDEX; *LOCAL receives its place in it. */
+static void voxcolori_find(const voxcolor_view *v, uint64_t index, voxcolori_block *b,
+                           uint64_t *local) {
+    uint64_t page = index >> v->page_shift;
+    uint64_t i = index & ((1ull << v->page_shift) - 1);
+    uint64_t pos = voxcolori_page_offset(v, page) * 8;
+    for (;;) {
+        voxcolori_read_header(v->data, pos, v->page_shift, b);
+        if (i < b->length) break;
+        i -= b->length;
+        pos = voxcolori_block_end(b);
+    }
+    *local = i;
+}
+
+VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
+                                    uint8_t rgb_out[3]) {
+    voxcolori_block b;
+    uint64_t i;
+    VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
+    voxcolori_find(view, index, &b, &i);
+    voxcolori_block_color(view->data, &b, i, rgb_out);
+}
+
+VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t first,
+                                          size_t n, uint8_t *rgb_out) {
+    voxcolori_block b;
+    uint64_t i, start;
+    VOXCOLOR_ASSERT(view && (rgb_out || !n) && first <= view->count &&
+                    n <= view->count - first);
+    if (!n) return;
+    voxcolori_find(view, first, &b, &i);
+    start = first - i;
+    for (;;) {
+        uint64_t end;
+        for (; i < b.length && n; i++, n--, rgb_out += 3)
+            voxcolori_block_color(view->data, &b, i, rgb_out);
+        if (!n) return;
+        /* Blocks follow each other; a new page starts on the next byte. */
+        end = voxcolori_block_end(&b);
+        start += b.length;
+        if ((start & ((1ull << view->page_shift) - 1)) == 0) end = (end + 7) & ~7ull;
+        voxcolori_read_header(view->data, end, view->page_shift, &b);
+        i = 0;
+    }
+}
+
+// -- Encoding: error metric
+
+typedef struct voxcolori_enc {
+    uint32_t thr2;          /* RGB: largest squared distance allowed */
+    int lab;                /* 1: CIELAB metric */
+    double lab_thr2;        /* CIELAB: largest squared delta E allowed */
+    double linear[256];     /* CIELAB: sRGB channel value to linear light */
+    unsigned page_shift;
+    unsigned modes[VOXCOLORI_MAX_WEIGHT_BITS + 1], mode_count;
+    unsigned precisions[2], precision_count;
+} voxcolori_enc;
+
+/* X^(1/N) for X in [0, 2] by Newton's method from above (no libm needed). */
+static double voxcolori_root(double x, unsigned n) {
+    double y = x > 1 ? x : 1;
+    unsigned i;
+    if (x <= 0) return 0;
+    for (i = 0; i < 64; i++) {
+        double p = 1, next;
+        unsigned k;
+        for (k = 1; k < n; k++) p *= y;
+        next = ((n - 1) * y + x / p) / n;
+        if (next >= y) break;
+        y = next;
+    }
+    return y;
+}
+
+static double voxcolori_lab_f(double t) {
+    const double d = 6.0 / 29.0;
+    return t > d * d * d ? voxcolori_root(t, 3) : t / (3 * d * d) + 4.0 / 29.0;
+}
+
+/* CIELAB (D65 white) of an sRGB colour. */
+static void voxcolori_lab(const voxcolori_enc *e, const uint8_t c[3], double lab[3]) {
+    double r = e->linear[c[0]], g = e->linear[c[1]], b = e->linear[c[2]];
+    double fx = voxcolori_lab_f((0.4124564 * r + 0.3575761 * g + 0.1804375 * b) / 0.95047);
+    double fy = voxcolori_lab_f(0.2126729 * r + 0.7151522 * g + 0.0721750 * b);
+    double fz = voxcolori_lab_f((0.0193339 * r + 0.1191920 * g + 0.9503041 * b) / 1.08883);
+    lab[0] = 116 * fy - 16;
+    lab[1] = 500 * (fx - fy);
+    lab[2] = 200 * (fy - fz);
+}
+
+static uint32_t voxcolori_dist2(const uint8_t a[3], const uint8_t b[3]) {
+    int d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    return (uint32_t)(d0 * d0 + d1 * d1 + d2 * d2);
+}
+
+/* 1 when decoded colour D is within the bound of original colour C. */
+static int voxcolori_close(const voxcolori_enc *e, const uint8_t c[3], const uint8_t d[3]) {
+    double a[3], b[3], s = 0;
+    unsigned i;
+    if (!e->lab) return voxcolori_dist2(c, d) <= e->thr2;
+    voxcolori_lab(e, c, a);
+    voxcolori_lab(e, d, b);
+    for (i = 0; i < 3; i++) s += (a[i] - b[i]) * (a[i] - b[i]);
+    return s <= e->lab_thr2;
+}
+
+/* Sets up the metric and the modes to try from the options. */
+static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) {
+    double x = o->max_error * 255.0;
+    unsigned i;
+    memset(e, 0, sizeof *e);
+    e->page_shift = o->page_shift ? o->page_shift : VOXCOLOR_DEFAULT_PAGE_SHIFT;
+    e->lab = o->metric == VOXCOLOR_METRIC_CIELAB && o->max_error > 0;
+    e->lab_thr2 = o->max_error * o->max_error;
+    /* Largest integer d2 with sqrt(d2) <= x; 3 * 255^2 covers every colour. */
+    if (x >= 442.0) {
+        e->thr2 = 3 * 255 * 255;
+    } else {
+        e->thr2 = (uint32_t)(x * x);
+        while ((double)(e->thr2 + 1) <= x * x) e->thr2++;
+        while (e->thr2 && (double)e->thr2 > x * x) e->thr2--;
+    }
+    if (e->lab)
+        for (i = 0; i < 256; i++) {
+            double c = i / 255.0, s = (c + 0.055) / 1.055;
+            e->linear[i] = c <= 0.04045 ? c / 12.92 : s * s * voxcolori_root(s * s, 5);
+        }
+    e->modes[e->mode_count++] = 0;
+    for (i = 1; i <= VOXCOLORI_MAX_WEIGHT_BITS; i++)
+        if (o->weight_bits ? i == o->weight_bits : 1) e->modes[e->mode_count++] = i;
+    /* RGB565 endpoints cannot meet small bounds (rounding alone errs by up to
+       6 units); RGB888 endpoints rarely pay off at large ones. */
+    if (e->lab || e->thr2 >= 9) e->precisions[e->precision_count++] = 0;
+    if (e->lab || e->thr2 < 100) e->precisions[e->precision_count++] = 1;
+}
+
+// -- Encoding: fitting one block
+
+typedef struct voxcolori_fit {
+    unsigned mode, precision;
+    unsigned q0[3], q1[3]; /* quantized endpoints as stored */
+    unsigned e0[3], e1[3]; /* the same, expanded to 8 bits */
+} voxcolori_fit;
+
+/* Rounds V (any real) to the nearest endpoint of PRECISION. */
+static void voxcolori_quantize(const double v[3], unsigned precision, unsigned q[3],
+                               unsigned e[3]) {
+    unsigned c;
+    for (c = 0; c < 3; c++) {
+        unsigned b = voxcolori_channel_bits(c, precision), top = (1u << b) - 1;
+        double x = v[c] < 0 ? 0 : v[c] > 255 ? 255 : v[c];
+        unsigned k = (unsigned)(x * top / 255.0 + 0.5);
+        /* Bit replication is not uniform: the next code may be nearer. */
+        if (k < top && voxcolori_expand(k + 1, b) - x < x - voxcolori_expand(k, b)) k++;
+        else if (k && x - voxcolori_expand(k - 1, b) < voxcolori_expand(k, b) - x) k--;
+        q[c] = k;
+        e[c] = voxcolori_expand(k, b);
+    }
+}
+
+/* The weight index decoding closest (in RGB) to C, and that decoded colour. */
+static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8_t out[3]) {
+    unsigned top = (1u << f->mode) - 1, k, lo, hi, best = 0, i;
+    int d[3], dd = 0, dot = 0;
+    uint32_t best_err = UINT32_MAX;
+    for (i = 0; i < 3; i++) {
+        d[i] = (int)f->e1[i] - (int)f->e0[i];
+        dd += d[i] * d[i];
+        dot += ((int)c[i] - (int)f->e0[i]) * d[i];
+    }
+    if (dd == 0 || dot <= 0) k = 0;
+    else if (dot >= dd) k = top;
+    else k = (unsigned)((2 * dot * (int)top + dd) / (2 * dd));
+    lo = k ? k - 1 : 0;
+    hi = k < top ? k + 1 : top;
+    for (k = lo; k <= hi; k++) {
+        uint8_t m[3];
+        uint32_t err;
+        voxcolori_mix(f->e0, f->e1, f->mode, k, m);
+        err = voxcolori_dist2(c, m);
+        if (err < best_err) best_err = err, best = k, memcpy(out, m, 3);
+    }
+    return best;
+}
+
+/* 1 when colour C decodes within the bound under fit F. */
+static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const uint8_t c[3]) {
+    uint8_t d[3];
+    if (f->mode == 0) {
+        d[0] = (uint8_t)f->e0[0];
+        d[1] = (uint8_t)f->e0[1];
+        d[2] = (uint8_t)f->e0[2];
+    } else {
+        voxcolori_pick(f, c, d);
+    }
+    return voxcolori_close(e, c, d);
+}
+
+/* Chooses endpoints for the N colours RGB (one colour: the bounding box
+   centre; two: the extremes along the principal axis, found by power
+   iteration on the covariance) and checks every colour. Returns 1 when all
+   fit. */
+static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                               voxcolori_fit *f) {
+    double mean[3], cov[3][3], v[3] = {1, 1, 1}, lo[3], hi[3], tmin = 0, tmax = 0, vv;
+    uint64_t s[3] = {0, 0, 0}, ss[3][3];
+    unsigned a, b, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
+    size_t i;
+    memset(ss, 0, sizeof ss);
+    for (i = 0; i < n; i++) {
+        const uint8_t *c = rgb + 3 * i;
+        for (a = 0; a < 3; a++) {
+            s[a] += c[a];
+            if (c[a] < mn[a]) mn[a] = c[a];
+            if (c[a] > mx[a]) mx[a] = c[a];
+            for (b = a; b < 3; b++) ss[a][b] += (uint64_t)c[a] * c[b];
+        }
+    }
+    if (f->mode == 0) {
+        for (a = 0; a < 3; a++) lo[a] = (mn[a] + mx[a]) * 0.5;
+        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
+    } else if (n <= 2) {
+        /* The principal axis of two colours runs through both. */
+        for (a = 0; a < 3; a++) {
+            lo[a] = rgb[a];
+            hi[a] = rgb[3 * (n - 1) + a];
+        }
+        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
+        voxcolori_quantize(hi, f->precision, f->q1, f->e1);
+    } else {
+        for (a = 0; a < 3; a++) mean[a] = (double)s[a] / (double)n;
+        for (a = 0; a < 3; a++)
+            for (b = a; b < 3; b++)
+                cov[a][b] = cov[b][a] = (double)ss[a][b] / (double)n - mean[a] * mean[b];
+        /* Start from the widest channel's column; scale by the largest
+           component (the direction is all that matters). */
+        it = cov[1][1] > cov[0][0] ? 1u : 0u;
+        if (cov[2][2] > cov[it][it]) it = 2;
+        for (a = 0; a < 3; a++) v[a] = cov[a][it] + (a == it ? 1e-9 : 0);
+        for (it = 0; it < 4; it++) {
+            double w[3], m = 0;
+            for (a = 0; a < 3; a++) w[a] = cov[a][0] * v[0] + cov[a][1] * v[1] + cov[a][2] * v[2];
+            for (a = 0; a < 3; a++) m = w[a] > m ? w[a] : -w[a] > m ? -w[a] : m;
+            if (m < 1e-12) break;
+            for (a = 0; a < 3; a++) v[a] = w[a] / m;
+        }
+        vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        for (i = 0; i < n; i++) {
+            const uint8_t *c = rgb + 3 * i;
+            double t = ((c[0] - mean[0]) * v[0] + (c[1] - mean[1]) * v[1] +
+                        (c[2] - mean[2]) * v[2]) / vv;
+            if (t < tmin) tmin = t;
+            if (t > tmax) tmax = t;
+        }
+        for (a = 0; a < 3; a++) {
+            lo[a] = mean[a] + tmin * v[a];
+            hi[a] = mean[a] + tmax * v[a];
+        }
+        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
+        voxcolori_quantize(hi, f->precision, f->q1, f->e1);
+    }
+    for (i = 0; i < n; i++)
+        if (!voxcolori_fits(e, f, rgb + 3 * i)) return 0;
+    return 1;
+}
+
+/* Length of the longest prefix of RGB[0..n) that one block of F's mode and
+   precision encodes within the bound (0 if not even the first colour), with
+   its endpoints in F. Colours that fit the current endpoints are accepted as
+   they are; one that does not triggers a refit including it, and repeated
+   refits a refit over twice the length (so gradients cost O(n log n)). */
+static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                               voxcolori_fit *f) {
+    voxcolori_fit t = *f;
+    size_t len = 1, streak = 0;
+    if (!voxcolori_fit_block(e, rgb, 1, f)) return 0;
+    while (len < n) {
+        size_t guess = 2 * len + 1 < n ? 2 * len + 1 : n;
+        if (voxcolori_fits(e, f, rgb + 3 * len)) {
+            len++;
+            continue;
+        }
+        if (!voxcolori_fit_block(e, rgb, len + 1, &t)) break;
+        *f = t;
+        len++;
+        /* Colours drifting out of every fit (a gradient): refit ahead. */
+        if (++streak >= 2 && guess > len && voxcolori_fit_block(e, rgb, guess, &t)) {
+            *f = t;
+            len = guess;
+            streak = 0;
+        }
+    }
+    return len;
+}
+
+// -- Encoding: bit writer and pages
+
+typedef struct voxcolori_writer {
+    uint8_t *p;
+    uint64_t acc;
+    unsigned n;
+} voxcolori_writer;
+
+static void voxcolori_put(voxcolori_writer *w, uint64_t v, unsigned bits) {
+    w->acc |= v << w->n;
+    w->n += bits;
+    while (w->n >= 8) {
+        *w->p++ = (uint8_t)w->acc;
+        w->acc >>= 8;
+        w->n -= 8;
+    }
+}
+
+static void voxcolori_put_endpoint(voxcolori_writer *w, const unsigned q[3], unsigned precision) {
+    if (precision) voxcolori_put(w, q[0] | q[1] << 8 | q[2] << 16, 24);
+    else voxcolori_put(w, q[0] | q[1] << 5 | q[2] << 11, 16);
+}
+
+static void voxcolori_put_header(voxcolori_writer *w, unsigned mode, unsigned precision,
+                                 size_t length, unsigned page_shift) {
+    voxcolori_put(w, mode | precision << 3 | (uint64_t)(length - 1) << 4, 4 + page_shift);
+}
+
+static void voxcolori_put_raw(voxcolori_writer *w, const uint8_t *rgb, size_t n,
+                              unsigned page_shift) {
+    size_t i;
+    voxcolori_put_header(w, VOXCOLORI_MODE_RAW, 0, n, page_shift);
+    for (i = 0; i < n; i++)
+        voxcolori_put(w, rgb[3 * i] | (unsigned)rgb[3 * i + 1] << 8 | (unsigned)rgb[3 * i + 2] << 16, 24);
+}
+
+static void voxcolori_put_block(voxcolori_writer *w, const voxcolori_fit *f, const uint8_t *rgb,
+                                size_t n, unsigned page_shift) {
+    size_t i;
+    voxcolori_put_header(w, f->mode, f->precision, n, page_shift);
+    voxcolori_put_endpoint(w, f->q0, f->precision);
+    if (f->mode == 0) return;
+    voxcolori_put_endpoint(w, f->q1, f->precision);
+    for (i = 0; i < n; i++) {
+        uint8_t d[3];
+        voxcolori_put(w, voxcolori_pick(f, rgb + 3 * i, d), f->mode);
+    }
+}
+
+/* Encodes the N colours of one page greedily: at each position, the block
+   (of every mode and precision tried, as long as it fits) with the fewest
+   bits per colour; colours that no block stores in fewer than 24 bits go
+   into raw blocks. Takes at most 4 + page_shift + 24 N bits. */
+static void voxcolori_encode_page(const voxcolori_enc *e, voxcolori_writer *w,
+                                  const uint8_t *rgb, size_t n) {
+    size_t pos = 0, raw_start = 0, header = 4 + e->page_shift;
+    while (pos < n) {
+        voxcolori_fit best, f;
+        size_t best_len = 0, best_bits = 0, len;
+        unsigned m, p;
+        memset(&best, 0, sizeof best);
+        for (m = 0; m < e->mode_count; m++) {
+            f.mode = e->modes[m];
+            /* A wider mode costs more than f.mode bits per colour. */
+            if (best_len && best_bits <= f.mode * best_len) break;
+            for (p = 0; p < e->precision_count; p++) {
+                size_t bits;
+                f.precision = e->precisions[p];
+                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, &f);
+                if (!len) continue;
+                bits = header + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
+                if (!best_len || bits * best_len < best_bits * len ||
+                    (bits * best_len == best_bits * len && len > best_len))
+                    best = f, best_len = len, best_bits = bits;
+            }
+            /* No wider block can be longer than one reaching the page end. */
+            if (best_len == n - pos) break;
+        }
+        /* Worth it only if it also pays for closing a raw run before it:
+           then no page exceeds one raw block. */
+        if (!best_len || best_bits + header > 24 * best_len) {
+            pos++;
+            continue;
+        }
+        if (raw_start < pos) voxcolori_put_raw(w, rgb + 3 * raw_start, pos - raw_start, e->page_shift);
+        voxcolori_put_block(w, &best, rgb + 3 * pos, best_len, e->page_shift);
+        pos += best_len;
+        raw_start = pos;
+    }
+    if (raw_start < n) voxcolori_put_raw(w, rgb + 3 * raw_start, n - raw_start, e->page_shift);
+}
+
+VOXCOLOR_API size_t voxcolor_encode_bound(size_t count) {
+    size_t pages = count / 16 + 1;
+    /* Header, 8-byte page entries, a raw block per page (at most 16 header
+       bits and one padding byte), 8 closing bytes. */
+    if (count > ((size_t)-1 - 64) / 4) return 0;
+    return VOXCOLOR_HEADER_SIZE + 8 + pages * 11 + 3 * count;
+}
+
+VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
+                                    size_t count, const voxcolor_encode_opts *opts) {
+    voxcolor_encode_opts defaults;
+    voxcolori_enc e;
+    voxcolori_writer w;
+    uint8_t *data;
+    size_t pages, entry, table, page, used, cap;
+    memset(&defaults, 0, sizeof defaults);
+    if (!opts) opts = &defaults;
+    VOXCOLOR_ASSERT(dst || !dst_size);
+    VOXCOLOR_ASSERT(rgb8 || !count);
+    VOXCOLOR_ASSERT(opts->max_error >= 0); /* also rejects NaN */
+    VOXCOLOR_ASSERT(opts->metric == VOXCOLOR_METRIC_RGB || opts->metric == VOXCOLOR_METRIC_CIELAB);
+    VOXCOLOR_ASSERT(opts->weight_bits <= VOXCOLORI_MAX_WEIGHT_BITS);
+    VOXCOLOR_ASSERT(!opts->page_shift || (opts->page_shift >= VOXCOLOR_MIN_PAGE_SHIFT &&
+                                          opts->page_shift <= VOXCOLOR_MAX_PAGE_SHIFT));
+    voxcolori_enc_init(&e, opts);
+    pages = count ? ((count - 1) >> e.page_shift) + 1 : 0;
+    /* 4-byte entries address 4 GiB of data: always enough below 2^30 colours. */
+    entry = (uint64_t)count > (1ull << 30) ? 8 : 4;
+    table = VOXCOLOR_HEADER_SIZE + pages * entry;
+    if (dst_size < table + 8) return 0;
+    data = dst + table;
+    cap = dst_size - table - 8;
+    w.p = data;
+    w.acc = 0;
+    w.n = 0;
+    for (page = 0; page < pages; page++) {
+        size_t first = page << e.page_shift;
+        size_t n = count - first < ((size_t)1 << e.page_shift) ? count - first
+                                                                : (size_t)1 << e.page_shift;
+        used = (size_t)(w.p - data);
+        /* A page never takes more than one raw block would. */
+        if (cap - used < (4 + e.page_shift + 24 * n + 7) / 8) return 0;
+        voxcolori_store_le(dst + VOXCOLOR_HEADER_SIZE + page * entry, used, (unsigned)entry);
+        voxcolori_encode_page(&e, &w, rgb8 + 3 * first, n);
+        if (w.n) voxcolori_put(&w, 0, 8 - w.n);
+    }
+    used = (size_t)(w.p - data);
+    memset(data + used, 0, 8);
+    memcpy(dst + VOXCOLOR_OFF_MAGIC, "VXC1", 4);
+    voxcolori_store_le(dst + VOXCOLOR_OFF_VERSION, VOXCOLOR_FORMAT_VERSION, 2);
+    dst[VOXCOLOR_OFF_PAGE_SHIFT] = (uint8_t)e.page_shift;
+    dst[VOXCOLOR_OFF_FLAGS] = entry == 8 ? 1 : 0;
+    voxcolori_store_le(dst + VOXCOLOR_OFF_COUNT, count, 8);
+    voxcolori_store_le(dst + VOXCOLOR_OFF_DATA_SIZE, used + 8, 8);
+    return table + used + 8;
+}
+
+// -- 2D mapping
+
+/* Gathers the even bits of V into the low 32 bits. */
+static uint32_t voxcolori_even_bits(uint64_t v) {
+    v &= 0x5555555555555555ull;
+    v = (v | v >> 1) & 0x3333333333333333ull;
+    v = (v | v >> 2) & 0x0f0f0f0f0f0f0f0full;
+    v = (v | v >> 4) & 0x00ff00ff00ff00ffull;
+    v = (v | v >> 8) & 0x0000ffff0000ffffull;
+    v = (v | v >> 16) & 0x00000000ffffffffull;
+    return (uint32_t)v;
+}
+
+/* Spreads the bits of X to the even bit positions. */
+static uint64_t voxcolori_spread(uint32_t x) {
+    uint64_t v = x;
+    v = (v | v << 16) & 0x0000ffff0000ffffull;
+    v = (v | v << 8) & 0x00ff00ff00ff00ffull;
+    v = (v | v << 4) & 0x0f0f0f0f0f0f0f0full;
+    v = (v | v << 2) & 0x3333333333333333ull;
+    v = (v | v << 1) & 0x5555555555555555ull;
+    return v;
+}
+
+VOXCOLOR_API void voxcolor_morton2d_decode(uint64_t index, uint32_t *x, uint32_t *y) {
+    VOXCOLOR_ASSERT(x && y);
+    *x = voxcolori_even_bits(index);
+    *y = voxcolori_even_bits(index >> 1);
+}
+
+VOXCOLOR_API uint64_t voxcolor_morton2d_encode(uint32_t x, uint32_t y) {
+    return voxcolori_spread(x) | voxcolori_spread(y) << 1;
+}
+
+VOXCOLOR_API void voxcolor_image_size(uint64_t count, uint32_t *width, uint32_t *height) {
+    uint64_t m = count ? count - 1 : 0, even = m & 0x5555555555555555ull;
+    unsigned bits = 0;
+    VOXCOLOR_ASSERT(width && height && count <= (1ull << 62));
+    while (bits < 64 && (m >> bits)) bits++;
+    *width = (uint32_t)1 << ((bits + 1) / 2);
+    /* The largest y among indices <= m: clear m's highest even (x) bit and
+       set every bit below it; without an even bit, m itself. */
+    if (even) {
+        unsigned e = 62;
+        while (!(even >> e)) e -= 2;
+        m = (m & ~((2ull << e) - 1)) | ((1ull << e) - 1);
+    }
+    *height = voxcolori_even_bits(m >> 1) + 1;
+}
+
+VOXCOLOR_API void voxcolor_to_image(uint8_t *image, uint32_t width, uint32_t height,
+                                    const uint8_t *rgb8, size_t count) {
+    uint32_t x, y;
+    VOXCOLOR_ASSERT(image && (rgb8 || !count));
+    if (!count) return;
+    for (y = 0; y < height; y++)
+        for (x = 0; x < width; x++) {
+            uint64_t i = voxcolor_morton2d_encode(x, y);
+            if (i >= count) i = count - 1;
+            memcpy(image + 3 * ((size_t)y * width + x), rgb8 + 3 * (size_t)i, 3);
+        }
+}
+
+VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t *image,
+                                      uint32_t width, uint32_t height) {
+    size_t i;
+    VOXCOLOR_ASSERT((rgb8 && image) || !count);
+    for (i = 0; i < count; i++) {
+        uint32_t x, y;
+        voxcolor_morton2d_decode(i, &x, &y);
+        VOXCOLOR_ASSERT(x < width && y < height);
+        memcpy(rgb8 + 3 * i, image + 3 * ((size_t)y * width + x), 3);
+    }
+    (void)height;
+}
+
+#endif /* VOXCOLOR_IMPLEMENTATION_DONE */
+#endif /* VOXCOLOR_IMPLEMENTATION */
+
+/*
+MIT License
+
+Copyright (c) 2026 The voxdag authors
+
+Permission is hereby granted, free of charge, to any person obtaining a copy
+of this software and associated documentation files (the "Software"), to deal
+in the Software without restriction, including without limitation the rights
+to use, copy, modify, merge, publish, distribute, sublicense, and/or sell
+copies of the Software, and to permit persons to whom the Software is
+furnished to do so, subject to the following conditions:
+
+The above copyright notice and this permission notice shall be included in all
+copies or substantial portions of the Software.
+
+THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND, EXPRESS OR
+IMPLIED, INCLUDING BUT NOT LIMITED TO THE WARRANTIES OF MERCHANTABILITY,
+FITNESS FOR A PARTICULAR PURPOSE AND NONINFRINGEMENT. IN NO EVENT SHALL THE
+AUTHORS OR COPYRIGHT HOLDERS BE LIABLE FOR ANY CLAIM, DAMAGES OR OTHER
+LIABILITY, WHETHER IN AN ACTION OF CONTRACT, TORT OR OTHERWISE, ARISING FROM,
+OUT OF OR IN CONNECTION WITH THE SOFTWARE OR THE USE OR OTHER DEALINGS IN THE
+SOFTWARE.
+*/

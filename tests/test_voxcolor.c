@@ -1,0 +1,638 @@
+/* Tests of voxcolor.h. Expected values come from brute force or from a small
+   reference reader written from FORMAT.md, never from the codec itself. */
+#include "test.h"
+#include "voxcolor.h"
+
+#include <math.h>
+
+// -- Test data
+
+enum { KIND_RANDOM, KIND_SMOOTH, KIND_NOISY, KIND_TEXTURE, KIND_FLAT, KIND_COUNT };
+static const char *const kind_names[KIND_COUNT] = {"random", "smooth", "noisy", "texture", "flat"};
+
+static uint8_t clamp8(double v) { return (uint8_t)(v < 0 ? 0 : v > 255 ? 255 : v + 0.5); }
+
+/* Colour arrays of N colours: uniform noise; gradients; gradients with noise;
+   a texture-like image (patches of shaded colour with grain and edges, read
+   along a 2D Morton curve like a voxelized surface); runs of flat colours. */
+static uint8_t *make_colors(int kind, size_t n, uint64_t seed) {
+    uint8_t *c = (uint8_t *)malloc(3 * n + 1);
+    uint64_t s = seed;
+    size_t i;
+    for (i = 0; i < n; i++) {
+        uint8_t *p = c + 3 * i;
+        double t = (double)i, g = (double)test_rand_below(&s, 17) - 8;
+        uint32_t x = 0, y = 0, k;
+        switch (kind) {
+        case KIND_RANDOM:
+            for (k = 0; k < 3; k++) p[k] = (uint8_t)test_rand(&s);
+            break;
+        case KIND_SMOOTH:
+            p[0] = clamp8(128 + 120 * sin(t * 0.002));
+            p[1] = clamp8(128 + 100 * sin(t * 0.0031 + 1));
+            p[2] = clamp8(128 + 90 * cos(t * 0.0017));
+            break;
+        case KIND_NOISY:
+            p[0] = clamp8(128 + 100 * sin(t * 0.01) + g);
+            p[1] = clamp8(100 + 60 * sin(t * 0.013) + g * 0.5);
+            p[2] = clamp8(90 + 50 * cos(t * 0.007) - g);
+            break;
+        case KIND_TEXTURE: {
+            double patch, shade;
+            for (k = 0; k < 20; k++) { /* 2D Morton position of i */
+                x |= (uint32_t)((i >> (2 * k)) & 1) << k;
+                y |= (uint32_t)((i >> (2 * k + 1)) & 1) << k;
+            }
+            patch = (double)(((x / 24) * 7 + (y / 16) * 13) % 5);
+            shade = 0.6 + 0.4 * sin(x * 0.05) * cos(y * 0.07);
+            p[0] = clamp8((60 + 40 * patch) * shade + g);
+            p[1] = clamp8((90 + 25 * patch) * shade + g * 0.7);
+            p[2] = clamp8((40 + 30 * (4 - patch)) * shade + g * 0.4);
+            break;
+        }
+        default:
+            p[0] = (uint8_t)(i / 300 * 37);
+            p[1] = (uint8_t)(i / 300 * 91);
+            p[2] = (uint8_t)(i / 700 * 53);
+            break;
+        }
+    }
+    return c;
+}
+
+static size_t encode_new(const uint8_t *rgb, size_t n, const voxcolor_encode_opts *o,
+                         uint8_t **out) {
+    size_t cap = voxcolor_encode_bound(n), size;
+    *out = (uint8_t *)malloc(cap);
+    size = voxcolor_encode(*out, cap, rgb, n, o);
+    return size;
+}
+
+static double rgb_error(const uint8_t *a, const uint8_t *b) {
+    double s = 0;
+    int k;
+    for (k = 0; k < 3; k++) s += ((double)a[k] - b[k]) * ((double)a[k] - b[k]);
+    return sqrt(s) / 255.0;
+}
+
+// -- Reference reader (written from FORMAT.md)
+
+static uint64_t ref_le(const uint8_t *p, int n) {
+    uint64_t v = 0;
+    while (n--) v = v << 8 | p[n];
+    return v;
+}
+
+static uint32_t ref_bits(const uint8_t *data, uint64_t *pos, int n) {
+    uint32_t v = 0;
+    int k;
+    for (k = 0; k < n; k++, (*pos)++) v |= (uint32_t)((data[*pos / 8] >> (*pos % 8)) & 1) << k;
+    return v;
+}
+
+static void ref_endpoint(const uint8_t *data, uint64_t *pos, int prec, int out[3]) {
+    if (prec) {
+        int k;
+        for (k = 0; k < 3; k++) out[k] = (int)ref_bits(data, pos, 8);
+    } else {
+        int r = (int)ref_bits(data, pos, 5), g = (int)ref_bits(data, pos, 6);
+        int b = (int)ref_bits(data, pos, 5);
+        out[0] = r << 3 | r >> 2;
+        out[1] = g << 2 | g >> 4;
+        out[2] = b << 3 | b >> 2;
+    }
+}
+
+/* Decodes a whole valid stream block by block into OUT; returns the number
+   of blocks per mode in MODES[0..5] (may be NULL). */
+static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6]) {
+    int ps = s[6], wide = s[7] & 1;
+    uint64_t count = ref_le(s + 8, 8), pages = count ? ((count - 1) >> ps) + 1 : 0;
+    const uint8_t *data = s + 24 + pages * (wide ? 8 : 4);
+    uint64_t page, i = 0;
+    for (page = 0; page < pages; page++) {
+        uint64_t pos = 8 * ref_le(s + 24 + page * (wide ? 8 : 4), wide ? 8 : 4);
+        uint64_t end = (page + 1) << ps;
+        if (end > count) end = count;
+        while (i < end) {
+            int mode = (int)ref_bits(data, &pos, 3), prec = (int)ref_bits(data, &pos, 1);
+            uint32_t len = ref_bits(data, &pos, ps) + 1, j;
+            int e0[3], e1[3], k;
+            if (modes) modes[mode]++;
+            if (mode == 5) {
+                for (j = 0; j < len; j++, i++)
+                    for (k = 0; k < 3; k++) out[3 * i + k] = (uint8_t)ref_bits(data, &pos, 8);
+                continue;
+            }
+            ref_endpoint(data, &pos, prec, e0);
+            if (mode) ref_endpoint(data, &pos, prec, e1);
+            for (j = 0; j < len; j++, i++) {
+                int w = 0, steps = (1 << mode) - 1;
+                if (mode) {
+                    double q = ref_bits(data, &pos, mode);
+                    w = (int)floor(64.0 * q / steps + 0.5);
+                }
+                for (k = 0; k < 3; k++)
+                    out[3 * i + k] = (uint8_t)(mode ? (e0[k] * (64 - w) + e1[k] * w + 32) >> 6 : e0[k]);
+            }
+        }
+    }
+}
+
+// -- Round trips and the error bound
+
+/* Encodes, validates, decodes with get, get_range and the reference reader,
+   and checks all agree and every colour is within MAX_ERROR. */
+static void check_roundtrip(const uint8_t *rgb, size_t n, const voxcolor_encode_opts *o,
+                            const char *what) {
+    uint8_t *s, *a = (uint8_t *)malloc(3 * n + 3), *b = (uint8_t *)malloc(3 * n + 3);
+    uint8_t *r = (uint8_t *)malloc(3 * n + 3);
+    size_t size = encode_new(rgb, n, o, &s), i, bad = 0, differ = 0;
+    voxcolor_view v;
+    double worst = 0, bound = o ? o->max_error : 0;
+    CHECK_MSG(size > 0, "%s", what);
+    CHECK_MSG(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK, "%s", what);
+    CHECK(v.count == n);
+    voxcolor_view_get_range(&v, 0, n, a);
+    ref_decode(s, r, NULL);
+    for (i = 0; i < n; i++) {
+        double e = rgb_error(rgb + 3 * i, a + 3 * i);
+        voxcolor_view_get(&v, i, b + 3 * i);
+        if (memcmp(a + 3 * i, b + 3 * i, 3) || memcmp(a + 3 * i, r + 3 * i, 3)) differ++;
+        if (e > worst) worst = e;
+        if (o && o->metric == VOXCOLOR_METRIC_CIELAB) continue;
+        if (e > bound + 1e-12) bad++;
+    }
+    CHECK_MSG(bad == 0, "%s: %zu colours over %g (worst %g)", what, bad, bound, worst);
+    CHECK_MSG(differ == 0, "%s: get, get_range and reference reader differ at %zu", what, differ);
+    /* Ranges starting and ending anywhere equal single lookups. */
+    for (i = 0; i < 40 && n; i++) {
+        size_t first = (i * 7919) % n, len = (i * 104729) % (n - first) + 1;
+        voxcolor_view_get_range(&v, first, len, a);
+        CHECK_MSG(memcmp(a, b + 3 * first, 3 * len) == 0, "%s: range %zu+%zu", what, first, len);
+    }
+    free(s);
+    free(a);
+    free(b);
+    free(r);
+}
+
+static void test_error_bound(void) {
+    static const double bounds[] = {0, 0.005, 0.01, 0.025, 0.05, 0.1, 0.3, 2};
+    int kind;
+    size_t k;
+    for (kind = 0; kind < KIND_COUNT; kind++) {
+        uint8_t *c = make_colors(kind, 20000, 42 + (uint64_t)kind);
+        for (k = 0; k < sizeof bounds / sizeof bounds[0]; k++) {
+            voxcolor_encode_opts o;
+            char what[64];
+            memset(&o, 0, sizeof o);
+            o.max_error = bounds[k];
+            snprintf(what, sizeof what, "%s e_t=%g", kind_names[kind], bounds[k]);
+            check_roundtrip(c, 20000, &o, what);
+        }
+        free(c);
+    }
+}
+
+/* Weight widths and page sizes change the stream, never the guarantee. */
+static void test_options(void) {
+    uint8_t *c = make_colors(KIND_TEXTURE, 9000, 7);
+    uint32_t bits, shift;
+    for (bits = 0; bits <= 4; bits++)
+        for (shift = 4; shift <= 12; shift += 4) {
+            voxcolor_encode_opts o;
+            uint8_t *s;
+            size_t modes[6] = {0}, size, m;
+            uint8_t *d = (uint8_t *)malloc(3 * 9000);
+            char what[64];
+            memset(&o, 0, sizeof o);
+            o.max_error = 0.03;
+            o.weight_bits = bits;
+            o.page_shift = shift;
+            snprintf(what, sizeof what, "bits=%u shift=%u", bits, shift);
+            check_roundtrip(c, 9000, &o, what);
+            size = encode_new(c, 9000, &o, &s);
+            CHECK(size > 0 && s[6] == shift);
+            ref_decode(s, d, modes);
+            for (m = 1; m <= 4; m++)
+                if (bits && m != bits) CHECK_MSG(modes[m] == 0, "%s: mode %zu used", what, m);
+            free(s);
+            free(d);
+        }
+    free(c);
+}
+
+static void test_lossless(void) {
+    int kind;
+    for (kind = 0; kind < KIND_COUNT; kind++) {
+        uint8_t *c = make_colors(kind, 5000, 3), *s, *d = (uint8_t *)malloc(3 * 5000);
+        size_t size = encode_new(c, 5000, NULL, &s);
+        voxcolor_view v;
+        CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+        voxcolor_view_get_range(&v, 0, 5000, d);
+        CHECK_MSG(memcmp(c, d, 3 * 5000) == 0, "%s not exact", kind_names[kind]);
+        free(c);
+        free(s);
+        free(d);
+    }
+}
+
+/* CIE76 delta E with libm, as the CIELAB metric defines it. */
+static void lab_of(const uint8_t c[3], double lab[3]) {
+    double l[3], X, Y, Z, fx, fy, fz;
+    int k;
+    for (k = 0; k < 3; k++) {
+        double v = c[k] / 255.0;
+        l[k] = v <= 0.04045 ? v / 12.92 : pow((v + 0.055) / 1.055, 2.4);
+    }
+    X = (0.4124564 * l[0] + 0.3575761 * l[1] + 0.1804375 * l[2]) / 0.95047;
+    Y = 0.2126729 * l[0] + 0.7151522 * l[1] + 0.0721750 * l[2];
+    Z = (0.0193339 * l[0] + 0.1191920 * l[1] + 0.9503041 * l[2]) / 1.08883;
+#define LABF(t) ((t) > 216.0 / 24389.0 ? cbrt(t) : (t) * 841.0 / 108.0 + 4.0 / 29.0)
+    fx = LABF(X);
+    fy = LABF(Y);
+    fz = LABF(Z);
+#undef LABF
+    lab[0] = 116 * fy - 16;
+    lab[1] = 500 * (fx - fy);
+    lab[2] = 200 * (fy - fz);
+}
+
+static void test_cielab(void) {
+    static const double bounds[] = {0.5, 2, 5};
+    uint8_t *c = make_colors(KIND_NOISY, 6000, 11), *d = (uint8_t *)malloc(3 * 6000), *s;
+    size_t k, i;
+    for (k = 0; k < 3; k++) {
+        voxcolor_encode_opts o;
+        voxcolor_view v;
+        size_t size, bad = 0;
+        memset(&o, 0, sizeof o);
+        o.max_error = bounds[k];
+        o.metric = VOXCOLOR_METRIC_CIELAB;
+        size = encode_new(c, 6000, &o, &s);
+        CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+        voxcolor_view_get_range(&v, 0, 6000, d);
+        for (i = 0; i < 6000; i++) {
+            double a[3], b[3];
+            lab_of(c + 3 * i, a);
+            lab_of(d + 3 * i, b);
+            if (sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                     (a[2] - b[2]) * (a[2] - b[2])) > bounds[k] + 1e-9)
+                bad++;
+        }
+        CHECK_MSG(bad == 0, "%zu colours over delta E %g", bad, bounds[k]);
+        free(s);
+    }
+    free(c);
+    free(d);
+}
+
+// -- Sizes and buffers
+
+static void test_bound_and_small_buffers(void) {
+    size_t n, cap, size, need;
+    uint8_t *c = make_colors(KIND_RANDOM, 3000, 5), *s;
+    /* Random colours at every count up to 600: worst case for the bound. */
+    for (n = 0; n <= 600; n += 1 + n / 16) {
+        uint32_t shift;
+        for (shift = 4; shift <= 12; shift += 8) {
+            voxcolor_encode_opts o;
+            memset(&o, 0, sizeof o);
+            o.page_shift = shift;
+            cap = voxcolor_encode_bound(n);
+            s = (uint8_t *)malloc(cap);
+            size = voxcolor_encode(s, cap, c, n, &o);
+            CHECK_MSG(size > 0 && size <= cap, "n=%zu size=%zu cap=%zu", n, size, cap);
+            free(s);
+        }
+    }
+    CHECK(voxcolor_encode_bound((size_t)-1) == 0);
+    /* Exact-size buffers: each too small size returns 0 without writing past
+       it (AddressSanitizer watches the allocation). */
+    need = encode_new(c, 200, NULL, &s);
+    free(s);
+    for (cap = 0; cap < need; cap += 1 + cap / 8) {
+        uint8_t *b = (uint8_t *)malloc(cap ? cap : 1);
+        CHECK(voxcolor_encode(cap ? b : NULL, cap, c, 200, NULL) == 0);
+        free(b);
+    }
+    free(c);
+}
+
+static void test_deterministic(void) {
+    uint8_t *c = make_colors(KIND_TEXTURE, 7000, 9), *a, *b;
+    voxcolor_encode_opts o;
+    size_t sa, sb;
+    memset(&o, 0, sizeof o);
+    o.max_error = 0.04;
+    sa = encode_new(c, 7000, &o, &a);
+    sb = encode_new(c, 7000, &o, &b);
+    CHECK(sa == sb && memcmp(a, b, sa) == 0);
+    free(a);
+    free(b);
+    free(c);
+}
+
+// -- The format, byte by byte
+
+/* Three equal colours, lossless: one single-colour block with RGB888
+   endpoint. Every byte follows from FORMAT.md. */
+static void test_golden(void) {
+    static const uint8_t rgb[9] = {0x12, 0x34, 0x56, 0x12, 0x34, 0x56, 0x12, 0x34, 0x56};
+    static const uint8_t expect[] = {
+        'V', 'X', 'C', '1', 1, 0, 8, 0,   /* magic, version 1, page shift 8, flags */
+        3, 0, 0, 0, 0, 0, 0, 0,           /* 3 colours */
+        13, 0, 0, 0, 0, 0, 0, 0,          /* 13 bytes of block data */
+        0, 0, 0, 0,                       /* page 0 starts at byte 0 */
+        /* mode 0 (3 bits), RGB888 (1), length-1 = 2 (8 bits), then R G B:
+           bits 0x028 | 0x12 << 12 | 0x34 << 20 | 0x56 << 28 */
+        0x28, 0x20, 0x41, 0x63, 0x05,
+        0, 0, 0, 0, 0, 0, 0, 0, /* closing zero bytes */
+    };
+    uint8_t buf[128];
+    size_t size = voxcolor_encode(buf, sizeof buf, rgb, 3, NULL);
+    CHECK(size == sizeof expect);
+    CHECK(size == sizeof expect && memcmp(buf, expect, size) == 0);
+    CHECK(VOXCOLOR_OFF_COUNT == 8 && VOXCOLOR_OFF_DATA_SIZE == 16 && VOXCOLOR_HEADER_SIZE == 24);
+}
+
+/* Appends the low N bits of V at bit *POS of BUF (zeroed), LSB first. */
+static void put_bits(uint8_t *buf, unsigned *pos, uint64_t v, unsigned n) {
+    unsigned k;
+    for (k = 0; k < n; k++, (*pos)++) buf[*pos / 8] |= (uint8_t)(((v >> k) & 1) << (*pos % 8));
+}
+
+/* A stream of 5 colours in one page of 16 assembled by hand from FORMAT.md:
+   an interpolated RGB565 block of 3 colours and a raw block of 2. The
+   arguments break it in one place. Returns the stream size. */
+static size_t handmade(uint8_t *s, unsigned mode1, unsigned raw_precision, unsigned length1,
+                       unsigned extra_bytes, unsigned table_entry) {
+    uint8_t *data = s + 28;
+    unsigned pos = 0, k;
+    memset(s, 0, 64);
+    memcpy(s, "VXC1", 4);
+    s[4] = 1;                             /* format version */
+    s[6] = 4;                             /* pages of 16 colours */
+    s[8] = 5;                             /* 5 colours */
+    s[24] = (uint8_t)table_entry;         /* page 0 starts at data byte 0 */
+    /* mode 2, RGB565, 3 colours; e0 = (31,0,0), e1 = (0,63,31); weights 0 2 3 */
+    put_bits(data, &pos, mode1 | 0 << 3 | (length1 - 1) << 4, 3 + 1 + 4);
+    put_bits(data, &pos, 31 | 0 << 5 | 0 << 11, 16);
+    put_bits(data, &pos, 0 | 63 << 5 | 31 << 11, 16);
+    for (k = 0; k < 3; k++) put_bits(data, &pos, k ? k + 1 : 0, mode1); /* 2 bits if valid */
+    /* mode 5 (raw), 2 colours: (3,2,1) and (0xfd,0xfe,0xff) */
+    put_bits(data, &pos, 5 | raw_precision << 3 | 1 << 4, 3 + 1 + 4);
+    put_bits(data, &pos, 0x010203, 24);
+    put_bits(data, &pos, 0xfffefd, 24);
+    if (mode1 == 2) CHECK(pos == 102); /* 13 bytes */
+    s[16] = (uint8_t)((pos + 7) / 8 + 8 + extra_bytes); /* then 8 zero bytes */
+    return 28 + s[16];
+}
+
+static void test_handmade_stream(void) {
+    uint8_t s[64], out[3 * 5];
+    voxcolor_view v;
+    size_t size = handmade(s, 2, 0, 3, 0, 0);
+    unsigned m;
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+    voxcolor_view_get_range(&v, 0, 5, out);
+    CHECK(out[0] == 255 && out[1] == 0 && out[2] == 0);
+    /* weight 2 of 2 bits = round(64 * 2 / 3) = 43: (e0 * 21 + e1 * 43 + 32) >> 6 */
+    CHECK(out[3] == 84 && out[4] == 171 && out[5] == 171);
+    CHECK(out[6] == 0 && out[7] == 255 && out[8] == 255);
+    CHECK(out[9] == 3 && out[10] == 2 && out[11] == 1);
+    CHECK(out[12] == 0xfd && out[13] == 0xfe && out[14] == 0xff);
+    /* Each defect alone is rejected. */
+    for (m = 6; m < 8; m++) {
+        size = handmade(s, m, 0, 3, 0, 0);
+        CHECK_MSG(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT, "mode %u", m);
+    }
+    size = handmade(s, 2, 1, 3, 0, 0);
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 4, 0, 0); /* blocks would cover 6 colours */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 3, 1, 0); /* 9 closing bytes */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 3, 0, 1); /* page table points past the start */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 3, 0, 0);
+    s[28 + 12] |= 0x80; /* a padding bit */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 3, 0, 0);
+    s[size - 1] = 1; /* a closing byte */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+}
+
+// -- Untrusted input
+
+static void decode_all(const voxcolor_view *v) {
+    uint8_t *a = (uint8_t *)malloc(3 * (size_t)v->count + 3), b[3];
+    size_t i;
+    voxcolor_view_get_range(v, 0, (size_t)v->count, a);
+    for (i = 0; i < v->count; i++) {
+        voxcolor_view_get(v, i, b);
+        if (memcmp(a + 3 * i, b, 3)) {
+            CHECK_MSG(0, "range and single decode differ at %zu", i);
+            break;
+        }
+    }
+    free(a);
+}
+
+/* Every truncation is rejected; every byte patched (+1, -1, 0, 0xff, each
+   bit) is rejected or decodes in bounds. */
+static void test_mutations(void) {
+    uint8_t *c = make_colors(KIND_TEXTURE, 700, 13), *s;
+    static const double bounds[] = {0, 0.02, 0.08};
+    size_t k;
+    for (k = 0; k < 3; k++) {
+        voxcolor_encode_opts o;
+        size_t size, cut, i, accepted = 0;
+        memset(&o, 0, sizeof o);
+        o.max_error = bounds[k];
+        o.page_shift = 6;
+        size = encode_new(c, 700, &o, &s);
+        for (cut = 0; cut < size; cut++) {
+            uint8_t *t = (uint8_t *)malloc(cut ? cut : 1);
+            voxcolor_view v;
+            memcpy(t, s, cut);
+            CHECK_MSG(voxcolor_view_init(&v, cut ? t : NULL, cut) != VOXCOLOR_OK, "cut %zu", cut);
+            free(t);
+        }
+        {
+            uint8_t *t = (uint8_t *)malloc(size + 1);
+            voxcolor_view v;
+            memcpy(t, s, size);
+            t[size] = 0;
+            CHECK(voxcolor_view_init(&v, t, size + 1) == VOXCOLOR_ERR_TRAILING);
+            free(t);
+        }
+        for (i = 0; i < size; i++) {
+            static const int patch[] = {1, -1, 0x100, 0x1ff, -2};
+            uint8_t *t = (uint8_t *)malloc(size);
+            int p;
+            for (p = 0; p < 5 + 8; p++) {
+                voxcolor_view v;
+                memcpy(t, s, size);
+                if (p >= 5) t[i] ^= (uint8_t)(1u << (p - 5));
+                else if (patch[p] == 0x100) t[i] = 0;
+                else if (patch[p] == 0x1ff) t[i] = 0xff;
+                else t[i] = (uint8_t)(t[i] + patch[p]);
+                if (memcmp(t, s, size) == 0) continue;
+                if (voxcolor_view_init(&v, t, size) == VOXCOLOR_OK) {
+                    accepted++;
+                    decode_all(&v);
+                }
+            }
+            free(t);
+        }
+        /* Colour bits are free to change, so some patches must be accepted. */
+        CHECK(accepted > 0);
+        free(s);
+    }
+    free(c);
+}
+
+static void test_rejects_garbage(void) {
+    uint8_t *c = make_colors(KIND_NOISY, 300, 2), *s, buf[256];
+    size_t size = encode_new(c, 300, NULL, &s), i, n;
+    uint64_t r = 99;
+    voxcolor_view v;
+#define WITH(off, val, expect)                                             \
+    do {                                                                   \
+        uint8_t *t = (uint8_t *)malloc(size);                              \
+        memcpy(t, s, size);                                                \
+        t[off] = (uint8_t)(val);                                           \
+        CHECK(voxcolor_view_init(&v, t, size) == (expect));                \
+        free(t);                                                           \
+    } while (0)
+    WITH(0, 'W', VOXCOLOR_ERR_BAD_MAGIC);
+    WITH(4, 2, VOXCOLOR_ERR_VERSION);
+    WITH(5, 1, VOXCOLOR_ERR_VERSION);
+    WITH(6, 3, VOXCOLOR_ERR_CORRUPT);
+    WITH(6, 13, VOXCOLOR_ERR_CORRUPT);
+    WITH(7, 2, VOXCOLOR_ERR_CORRUPT);
+    WITH(15, 0x80, VOXCOLOR_ERR_TRUNCATED); /* 2^63 colours */
+    WITH(23, 0x80, VOXCOLOR_ERR_TRUNCATED); /* 2^63 data bytes */
+#undef WITH
+    CHECK(voxcolor_view_init(&v, NULL, 0) == VOXCOLOR_ERR_TRUNCATED);
+    CHECK(v.count == 0 && v.data == NULL);
+    /* Random bytes behind a plausible header. */
+    for (i = 0; i < 3000; i++) {
+        size_t k, pages;
+        uint64_t count = test_rand_below(&r, 60);
+        n = 24 + test_rand_below(&r, 200);
+        for (k = 0; k < n; k++) buf[k] = (uint8_t)test_rand(&r);
+        memcpy(buf, "VXC1\1\0", 6);
+        buf[6] = (uint8_t)(4 + test_rand_below(&r, 3));
+        buf[7] = 0;
+        pages = count ? (size_t)((count - 1) >> buf[6]) + 1 : 0;
+        for (k = 0; k < 8; k++) buf[8 + k] = (uint8_t)(count >> (8 * k));
+        if (n < 24 + 4 * pages) continue;
+        for (k = 0; k < 8; k++) buf[16 + k] = (uint8_t)((n - 24 - 4 * pages) >> (8 * k));
+        if (voxcolor_view_init(&v, buf, n) == VOXCOLOR_OK) decode_all(&v);
+    }
+    for (i = 0; i < VOXCOLOR_STATUS_COUNT; i++)
+        CHECK(strlen(voxcolor_status_string((voxcolor_status)i)) > 0);
+    CHECK(voxcolor_version() == VOXCOLOR_VERSION);
+    free(s);
+    free(c);
+}
+
+/* A stream rewritten with 8-byte page table entries decodes the same. */
+static void test_wide_table(void) {
+    uint8_t *c = make_colors(KIND_SMOOTH, 1000, 4), *s, *t, *a = (uint8_t *)malloc(3000),
+            *b = (uint8_t *)malloc(3000);
+    voxcolor_encode_opts o;
+    voxcolor_view v;
+    size_t size, pages = (1000 + 255) / 256, i;
+    memset(&o, 0, sizeof o);
+    o.max_error = 0.02;
+    size = encode_new(c, 1000, &o, &s);
+    t = (uint8_t *)malloc(size + 4 * pages);
+    memcpy(t, s, 24);
+    t[7] = 1;
+    for (i = 0; i < pages; i++) {
+        memset(t + 24 + 8 * i, 0, 8);
+        memcpy(t + 24 + 8 * i, s + 24 + 4 * i, 4);
+    }
+    memcpy(t + 24 + 8 * pages, s + 24 + 4 * pages, size - 24 - 4 * pages);
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+    voxcolor_view_get_range(&v, 0, 1000, a);
+    CHECK(voxcolor_view_init(&v, t, size + 4 * pages) == VOXCOLOR_OK && v.wide == 1);
+    voxcolor_view_get_range(&v, 0, 1000, b);
+    CHECK(memcmp(a, b, 3000) == 0);
+    free(s);
+    free(t);
+    free(a);
+    free(b);
+    free(c);
+}
+
+static void test_empty(void) {
+    uint8_t buf[64];
+    voxcolor_view v;
+    size_t size = voxcolor_encode(buf, sizeof buf, NULL, 0, NULL);
+    CHECK(size == 24 + 8);
+    CHECK(voxcolor_view_init(&v, buf, size) == VOXCOLOR_OK && v.count == 0);
+}
+
+// -- 2D mapping
+
+static void test_morton2d(void) {
+    uint64_t count;
+    uint32_t x, y, w, h;
+    uint64_t r = 1;
+    size_t i;
+    for (i = 0; i < 1000; i++) {
+        uint64_t idx = test_rand(&r) >> 2;
+        voxcolor_morton2d_decode(idx, &x, &y);
+        CHECK(voxcolor_morton2d_encode(x, y) == idx);
+    }
+    voxcolor_morton2d_decode(6, &x, &y); /* 0b110: x = 0b10... bit0 x, bit1 y */
+    CHECK(x == 2 && y == 1);
+    /* Image size against brute force: the rows actually visited. */
+    for (count = 1; count <= 5000; count += 1 + count / 50) {
+        uint32_t maxx = 0, maxy = 0;
+        uint64_t k;
+        for (k = 0; k < count; k++) {
+            voxcolor_morton2d_decode(k, &x, &y);
+            if (x > maxx) maxx = x;
+            if (y > maxy) maxy = y;
+        }
+        voxcolor_image_size(count, &w, &h);
+        CHECK_MSG(h == maxy + 1 && w > maxx && w >= h && (w & (w - 1)) == 0 && w / 2 <= maxx + 1,
+                  "count %llu: %ux%u", (unsigned long long)count, w, h);
+    }
+    {
+        uint8_t *c = make_colors(KIND_RANDOM, 777, 8), *img, *back = (uint8_t *)malloc(3 * 777);
+        voxcolor_image_size(777, &w, &h);
+        img = (uint8_t *)malloc(3 * (size_t)w * h);
+        voxcolor_to_image(img, w, h, c, 777);
+        voxcolor_from_image(back, 777, img, w, h);
+        CHECK(memcmp(c, back, 3 * 777) == 0);
+        voxcolor_morton2d_decode(776, &x, &y);
+        CHECK(memcmp(img + 3 * ((size_t)y * w + x), c + 3 * 776, 3) == 0);
+        free(c);
+        free(img);
+        free(back);
+    }
+}
+
+const test_case test_voxcolor_cases[] = {
+    {"voxcolor/error_bound", test_error_bound},
+    {"voxcolor/options", test_options},
+    {"voxcolor/lossless", test_lossless},
+    {"voxcolor/cielab", test_cielab},
+    {"voxcolor/bound_and_small_buffers", test_bound_and_small_buffers},
+    {"voxcolor/deterministic", test_deterministic},
+    {"voxcolor/golden", test_golden},
+    {"voxcolor/handmade_stream", test_handmade_stream},
+    {"voxcolor/mutations", test_mutations},
+    {"voxcolor/rejects_garbage", test_rejects_garbage},
+    {"voxcolor/wide_table", test_wide_table},
+    {"voxcolor/empty", test_empty},
+    {"voxcolor/morton2d", test_morton2d},
+    {NULL, NULL},
+};
