@@ -1,5 +1,2461 @@
-/* voxdag.h (work in progress) */
+/* voxdag.h - symmetry-aware sparse voxel DAGs in one header.      version 0.1.0
+
+   Builds a voxel scene into a sparse voxel DAG whose subtrees are shared when
+   they are equal up to a reflection along x, y and/or z (SSVDAG), with a voxel
+   count per node so that every voxel's index into a colour array is found on
+   the way down. The result is a compact byte image (the .vdag file format,
+   see FORMAT.md) that is queried in place.
+
+   QUICK START
+       #define VOXDAG_IMPLEMENTATION   // in exactly one C or C++ file
+       #include "voxdag.h"
+
+       voxdag_build_opts opts = {0};
+       opts.levels = 8;                          // a 256^3 grid
+       voxdag_builder *b; voxdag *dag; uint64_t index;
+       voxdag_builder_create(&opts, &b, NULL);
+       uint32_t xyz[] = { 1,2,3,  4,5,6 };
+       uint8_t  rgb[] = { 255,0,0,  0,255,0 };
+       voxdag_builder_add(b, xyz, rgb, 2, NULL);
+       voxdag_builder_finish(b, &dag, NULL);     // b is freed
+       if (voxdag_lookup(dag, 4, 5, 6, &index)) { ... voxdag_color(dag, index, out_rgb) ... }
+       voxdag_save_file(dag, "scene.vdag", NULL);
+       voxdag_free(dag);
+
+   CONVENTIONS
+   - Grid of N = 2^L voxels per axis, coordinates 0..N-1; the root is level 0,
+     4^3 bricks (64-bit masks) are level L-2.
+   - Octant number of a child: bit 0 = upper x half, bit 1 = y, bit 2 = z.
+   - Morton code: the octant numbers along the root-to-voxel path, root first.
+   - Voxel index = rank of a full voxel's Morton code among all full voxels;
+     colours are stored in this order.
+   - Reflection m in 0..7: bit a set mirrors axis a about the node's centre.
+
+   CONFIGURATION (define before including the implementation)
+     VOXDAG_MALLOC(sz) / VOXDAG_FREE(p)  default allocator (define both or none)
+     VOXDAG_ASSERT(x)     caller-contract checks (default: assert)
+     VOXDAG_NO_STDIO      leave out the file helpers
+     VOXDAG_NO_THREADS    single-threaded build (no pthreads)
+     VOXDAG_STATIC        give every function internal linkage
+     VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
+
+   THREADS: no global state. A voxdag is immutable: any number of threads may
+   query one at a time. A builder belongs to one thread at a time.
+
+   FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
+*/
 #ifndef VOXDAG_H
 #define VOXDAG_H
+
+#include <stddef.h>
+#include <stdint.h>
+
 #define VOXDAG_VERSION_MAJOR 0
+#define VOXDAG_VERSION_MINOR 1
+#define VOXDAG_VERSION_PATCH 0
+#define VOXDAG_VERSION \
+    (VOXDAG_VERSION_MAJOR * 10000 + VOXDAG_VERSION_MINOR * 100 + VOXDAG_VERSION_PATCH)
+#define VOXDAG_FORMAT_VERSION 1
+
+#ifndef VOXDAG_MAX_LEVELS
+#define VOXDAG_MAX_LEVELS 21
 #endif
+#if VOXDAG_MAX_LEVELS < 2 || VOXDAG_MAX_LEVELS > 21
+#error "VOXDAG_MAX_LEVELS must be between 2 and 21"
+#endif
+
+#ifndef VOXDAG_API
+#ifdef VOXDAG_STATIC
+#define VOXDAG_API static
+#else
+#define VOXDAG_API extern
+#endif
+#endif
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+// -- Status and errors
+
+typedef enum voxdag_status {
+    VOXDAG_OK = 0,
+    VOXDAG_ERR_INVALID_ARGUMENT, /* a caller argument is out of its range */
+    VOXDAG_ERR_OUT_OF_MEMORY,    /* the allocator returned NULL */
+    VOXDAG_ERR_LIMIT,            /* a configured or built-in limit was exceeded */
+    VOXDAG_ERR_COORDINATE,       /* a voxel coordinate is outside the grid */
+    VOXDAG_ERR_ORDER,            /* a voxel precedes voxels already flushed */
+    VOXDAG_ERR_TRUNCATED,        /* the data ends before a field it declares */
+    VOXDAG_ERR_BAD_MAGIC,        /* not a .vdag file */
+    VOXDAG_ERR_VERSION,          /* a format version this reader does not know */
+    VOXDAG_ERR_CHECKSUM,         /* a checksum does not match */
+    VOXDAG_ERR_CORRUPT,          /* a field is inconsistent or out of range */
+    VOXDAG_ERR_IO,               /* a file could not be read or written */
+    VOXDAG_STATUS_COUNT,
+    VOXDAG_STATUS_FORCE_32BIT = 0x7fffffff
+} voxdag_status;
+
+typedef struct voxdag_error {
+    voxdag_status status;
+    const char *message;  /* static storage; never freed */
+    uint64_t byte_offset; /* offset in the input, UINT64_MAX when not input-related */
+    uint64_t node;        /* node ordinal within its level, UINT64_MAX when none */
+} voxdag_error;
+
+/* Returns a static, human-readable name of a status. */
+VOXDAG_API const char *voxdag_status_string(voxdag_status status);
+
+/* Returns VOXDAG_VERSION of the implementation that was compiled. */
+VOXDAG_API uint32_t voxdag_version(void);
+
+// -- Allocation
+
+/* Per-call allocator. alloc/free both NULL: VOXDAG_MALLOC/VOXDAG_FREE.
+   free receives the size that was requested for the block. */
+typedef struct voxdag_allocator {
+    void *(*alloc)(void *user, size_t size);
+    void (*free)(void *user, void *ptr, size_t size);
+    void *user;
+} voxdag_allocator;
+
+// -- Building
+
+typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
+
+/* Build options. A NULL pointer or an all-zero struct means defaults. */
+typedef struct voxdag_build_opts {
+    uint32_t zero_begin;         /* must be 0 */
+    uint32_t levels;             /* L, 2..VOXDAG_MAX_LEVELS; 0 means 10 */
+    int no_symmetry;             /* 1: plain SVDAG (share identical subtrees only) */
+    int colors;                  /* 1: every voxel carries an RGB8 colour */
+    int compare_structures;      /* 1: also count SVDAG and SSVDAG nodes (2x work) */
+    uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
+    uint64_t max_memory;         /* bytes the builder may hold; 0: no limit */
+    const double *bounds;        /* optional world-space min xyz, max xyz (6) */
+    voxdag_allocator allocator;
+    voxdag_progress_fn progress; /* optional; called from the building thread */
+    void *progress_user;
+    uint32_t zero_end;           /* must be 0 */
+} voxdag_build_opts;
+
+typedef struct voxdag_builder voxdag_builder;
+typedef struct voxdag voxdag;
+
+/* Creates a builder. Returns VOXDAG_OK and *out, or an error (nothing allocated). */
+VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
+                                               voxdag_builder **out,
+                                               voxdag_error *err);
+
+/* Adds N voxels: XYZ holds 3 coordinates per voxel, RGB 3 bytes per voxel
+   (required when opts.colors is set, ignored otherwise). Any order; a voxel
+   added twice keeps the colour added last. Voxels are buffered until the next
+   flush. Returns VOXDAG_ERR_COORDINATE for a coordinate >= 2^L, or
+   VOXDAG_ERR_ORDER for a voxel before one already flushed; on error nothing of
+   this call is added. */
+VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *xyz,
+                                            const uint8_t *rgb, size_t n,
+                                            voxdag_error *err);
+
+/* Reduces every buffered voxel into the DAG and empties the buffer. The caller
+   promises that voxels added afterwards come later in Morton order (or repeat
+   the last one): this streams scenes larger than memory in Morton-ordered
+   chunks (e.g. aligned subtrees), keeping only unique nodes. */
+VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *err);
+
+/* Per-level node counts and timing of a build, filled by voxdag_builder_finish.
+   Arrays are indexed by level 0..levels-2; the last entry counts 4^3 bricks. */
+typedef struct voxdag_build_stats {
+    uint32_t levels;
+    uint64_t voxels;
+    uint64_t nodes[VOXDAG_MAX_LEVELS];        /* stored unique nodes of the result */
+    uint64_t svo_nodes[VOXDAG_MAX_LEVELS];    /* nodes of the equivalent octree */
+    uint64_t svdag_nodes[VOXDAG_MAX_LEVELS];  /* 0 unless compare_structures */
+    uint64_t ssvdag_nodes[VOXDAG_MAX_LEVELS]; /* 0 unless compare_structures */
+    uint64_t peak_memory;                     /* bytes held by the builder at most */
+} voxdag_build_stats;
+
+/* Finishes the build: encodes the DAG and frees the builder (also on error).
+   STATS may be NULL. Returns the DAG in *out; free it with voxdag_free. */
+VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
+                                               voxdag_build_stats *stats,
+                                               voxdag_error *err);
+
+/* Frees a builder that will not be finished. NULL is allowed. */
+VOXDAG_API void voxdag_builder_free(voxdag_builder *b);
+
+/* Morton code of (x, y, z) with 21 bits per axis. */
+VOXDAG_API uint64_t voxdag_morton_encode(uint32_t x, uint32_t y, uint32_t z);
+VOXDAG_API void voxdag_morton_decode(uint64_t code, uint32_t *x, uint32_t *y, uint32_t *z);
+
+// -- Loading and saving
+
+typedef struct voxdag_load_opts {
+    uint32_t zero_begin;
+    uint64_t max_input_bytes; /* 0: no limit */
+    uint64_t max_nodes;       /* total nodes and bricks; 0: no limit */
+    uint64_t max_memory;      /* bytes allocated by the load; 0: no limit */
+    uint32_t max_levels;      /* 0: VOXDAG_MAX_LEVELS */
+    int copy;                 /* 1: copy the bytes (else they must outlive the DAG) */
+    voxdag_allocator allocator;
+    uint32_t zero_end;
+} voxdag_load_opts;
+
+/* Validates a .vdag image in memory completely (structure, every pointer,
+   every count, checksums) and returns a DAG that queries it in place. Unless
+   opts->copy is set, DATA must stay valid and unchanged until voxdag_free. */
+VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
+                                            const voxdag_load_opts *opts,
+                                            voxdag **out, voxdag_error *err);
+
+/* The DAG's complete file image (owned by the DAG). */
+VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size);
+
+/* Frees a DAG with the allocator that made it. NULL is allowed. */
+VOXDAG_API void voxdag_free(voxdag *dag);
+
+#ifndef VOXDAG_NO_STDIO
+VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_opts *opts,
+                                          voxdag **out, voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path,
+                                          voxdag_error *err);
+#endif
+
+// -- Colours
+
+/* Colour section kinds of a .vdag file. */
+typedef enum voxdag_color_kind {
+    VOXDAG_COLORS_NONE = 0,
+    VOXDAG_COLORS_RGB8 = 1,     /* 3 bytes per voxel, in voxel-index order */
+    VOXDAG_COLORS_VOXCOLOR = 2, /* a voxcolor.h stream (decoded by the caller) */
+    VOXDAG_COLORS_FORCE_32BIT = 0x7fffffff
+} voxdag_color_kind;
+
+/* The colour section: its kind, payload and size (NULL/0 when none). */
+VOXDAG_API voxdag_color_kind voxdag_colors(const voxdag *dag, const void **payload,
+                                           size_t *size);
+
+/* Makes a copy of SRC whose colour section is replaced by PAYLOAD of KIND
+   (VOXDAG_COLORS_NONE removes it). An RGB8 payload must hold 3 bytes per voxel;
+   a voxcolor payload is stored as given. */
+VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind kind,
+                                            const void *payload, size_t size,
+                                            voxdag **out, voxdag_error *err);
+
+// -- Queries (thread-safe on a shared voxdag; no allocation)
+
+typedef struct voxdag_info {
+    uint32_t levels;
+    uint32_t symmetric;         /* built with reflections */
+    uint64_t voxels;
+    uint64_t nodes[VOXDAG_MAX_LEVELS]; /* stored nodes per level; last = bricks */
+    uint64_t level_bytes[VOXDAG_MAX_LEVELS];
+    uint64_t file_bytes;
+    uint64_t node_bytes;        /* all inner levels */
+    uint64_t brick_bytes;
+    uint64_t color_bytes;
+    voxdag_color_kind color_kind;
+    int has_bounds;
+    double bounds[6];           /* world-space min xyz, max xyz */
+} voxdag_info;
+
+VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info);
+
+/* Returns 1 when voxel (x, y, z) is full (and its index in *index, which may be
+   NULL), 0 when it is empty or outside the grid. */
+VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z,
+                             uint64_t *index);
+
+/* Colour of voxel INDEX from an RGB8 colour section. Returns 0 (and leaves rgb)
+   when the DAG has no RGB8 colours or INDEX is out of range. */
+VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]);
+
+/* Calls FN for every full voxel in voxel-index order; stops early when FN
+   returns nonzero. Returns the number of voxels visited. */
+typedef int (*voxdag_voxel_fn)(void *user, uint32_t x, uint32_t y, uint32_t z,
+                               uint64_t index);
+VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
+                                          void *user);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* VOXDAG_H */
+
+/* ======================================================================== */
+/*                              IMPLEMENTATION                              */
+/* ======================================================================== */
+
+#ifdef VOXDAG_IMPLEMENTATION
+#ifndef VOXDAG_IMPLEMENTED
+#define VOXDAG_IMPLEMENTED
+
+#include <string.h>
+
+#if defined(VOXDAG_MALLOC) != defined(VOXDAG_FREE)
+#error "define both VOXDAG_MALLOC and VOXDAG_FREE, or neither"
+#endif
+#ifndef VOXDAG_MALLOC
+#include <stdlib.h>
+#define VOXDAG_MALLOC(sz) malloc(sz)
+#define VOXDAG_FREE(p) free(p)
+#endif
+#ifndef VOXDAG_ASSERT
+#include <assert.h>
+#define VOXDAG_ASSERT(x) assert(x)
+#endif
+#ifndef VOXDAG_NO_STDIO
+#include <stdio.h>
+#endif
+#ifndef VOXDAG_NO_THREADS
+#include <pthread.h>
+#endif
+
+// -- File layout constants (FORMAT.md)
+
+#define VOXDAG_FILE_HEADER_SIZE 64
+#define VOXDAG_FILE_OFF_MAGIC 0
+#define VOXDAG_FILE_OFF_VERSION 8
+#define VOXDAG_FILE_OFF_ENDIAN 12
+#define VOXDAG_FILE_OFF_HEADER_SIZE 16
+#define VOXDAG_FILE_OFF_FLAGS 20
+#define VOXDAG_FILE_OFF_FILE_SIZE 24
+#define VOXDAG_FILE_OFF_VOXELS 32
+#define VOXDAG_FILE_OFF_LEVELS 40
+#define VOXDAG_FILE_OFF_ROOT_MIRROR 41
+#define VOXDAG_FILE_OFF_SECTION_COUNT 44
+#define VOXDAG_FILE_OFF_TABLE_CRC 48
+#define VOXDAG_FILE_OFF_HEADER_CRC 52
+#define VOXDAG_FILE_SECTION_ENTRY_SIZE 32
+#define VOXDAG_FILE_LEVEL_ENTRY_SIZE 24
+#define VOXDAG_FILE_ENDIAN_TAG 0x0A0B0C0Du
+#define VOXDAG_FILE_FLAG_SYMMETRIC 1u
+#define VOXDAG_FILE_SECTION_OPTIONAL 1u
+#define VOXDAG_FILE_MAX_SECTIONS 16
+#define VOXDAG_FILE_NODE_PADDING 8
+
+enum {
+    VOXDAG_SECTION_LEVELS = 1,
+    VOXDAG_SECTION_NODES = 2,
+    VOXDAG_SECTION_BRICKS = 3,
+    VOXDAG_SECTION_COLORS_RGB8 = 4,
+    VOXDAG_SECTION_COLORS_VOXCOLOR = 5,
+    VOXDAG_SECTION_BOUNDS = 6
+};
+
+static const uint8_t voxdagi_magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
+
+// -- Errors
+
+static voxdag_status voxdagi_fail(voxdag_error *err, voxdag_status status,
+                                  const char *message, uint64_t offset, uint64_t node) {
+    if (err) {
+        err->status = status;
+        err->message = message;
+        err->byte_offset = offset;
+        err->node = node;
+    }
+    return status;
+}
+
+static voxdag_status voxdagi_ok(voxdag_error *err) {
+    if (err) {
+        err->status = VOXDAG_OK;
+        err->message = "ok";
+        err->byte_offset = UINT64_MAX;
+        err->node = UINT64_MAX;
+    }
+    return VOXDAG_OK;
+}
+
+#define VOXDAGI_FAIL(err, status, msg) voxdagi_fail(err, status, msg, UINT64_MAX, UINT64_MAX)
+
+VOXDAG_API const char *voxdag_status_string(voxdag_status status) {
+    switch (status) {
+    case VOXDAG_OK: return "ok";
+    case VOXDAG_ERR_INVALID_ARGUMENT: return "invalid argument";
+    case VOXDAG_ERR_OUT_OF_MEMORY: return "out of memory";
+    case VOXDAG_ERR_LIMIT: return "limit exceeded";
+    case VOXDAG_ERR_COORDINATE: return "coordinate outside the grid";
+    case VOXDAG_ERR_ORDER: return "voxel out of streaming order";
+    case VOXDAG_ERR_TRUNCATED: return "truncated data";
+    case VOXDAG_ERR_BAD_MAGIC: return "not a .vdag file";
+    case VOXDAG_ERR_VERSION: return "unsupported format version";
+    case VOXDAG_ERR_CHECKSUM: return "checksum mismatch";
+    case VOXDAG_ERR_CORRUPT: return "corrupt data";
+    case VOXDAG_ERR_IO: return "i/o error";
+    default: return "unknown status";
+    }
+}
+
+VOXDAG_API uint32_t voxdag_version(void) { return VOXDAG_VERSION; }
+
+// -- Memory: per-call allocator with a byte count, a peak and a limit
+
+typedef struct voxdagi_mem {
+    voxdag_allocator a;
+    uint64_t used, peak, limit; /* limit 0: none */
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_t lock; /* workers allocate concurrently */
+#endif
+} voxdagi_mem;
+
+static void voxdagi_mem_init(voxdagi_mem *m, const voxdag_allocator *a, uint64_t limit) {
+    memset(m, 0, sizeof *m);
+    if (a) m->a = *a;
+    m->limit = limit;
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_init(&m->lock, NULL);
+#endif
+}
+
+static void voxdagi_mem_destroy(voxdagi_mem *m) {
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_destroy(&m->lock);
+#else
+    (void)m;
+#endif
+}
+
+static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
+    void *p = NULL;
+    int ok;
+    if (size == 0) size = 1;
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_lock(&m->lock);
+#endif
+    ok = !m->limit || (m->used <= m->limit && size <= m->limit - m->used);
+    if (ok) {
+        p = m->a.alloc ? m->a.alloc(m->a.user, size) : VOXDAG_MALLOC(size);
+        if (p) {
+            m->used += size;
+            if (m->used > m->peak) m->peak = m->used;
+        }
+    }
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_unlock(&m->lock);
+#endif
+    return p;
+}
+
+static void voxdagi_free(voxdagi_mem *m, void *p, size_t size) {
+    if (!p) return;
+    if (size == 0) size = 1;
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_lock(&m->lock);
+#endif
+    if (m->a.free) m->a.free(m->a.user, p, size);
+    else if (!m->a.alloc) VOXDAG_FREE(p);
+    m->used -= size;
+#ifndef VOXDAG_NO_THREADS
+    pthread_mutex_unlock(&m->lock);
+#endif
+}
+
+/* Grows *p (holding *cap elements of ELEM bytes) to at least NEED elements,
+   doubling. Returns 0 when out of memory (the old block is kept). */
+static int voxdagi_grow(voxdagi_mem *m, void **p, size_t *cap, size_t need, size_t elem) {
+    size_t n = *cap ? *cap : 16;
+    void *q;
+    if (need <= *cap) return 1;
+    while (n < need) {
+        if (n > ((size_t)-1 / 2) / elem) return 0;
+        n *= 2;
+    }
+    q = voxdagi_alloc(m, n * elem);
+    if (!q) return 0;
+    if (*cap) memcpy(q, *p, *cap * elem);
+    voxdagi_free(m, *p, *cap * elem);
+    *p = q;
+    *cap = n;
+    return 1;
+}
+
+// -- Bits: popcount, Morton codes, little-endian access, hashing
+
+static int voxdagi_popcount64(uint64_t x) {
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__POPCNT__)
+    return __builtin_popcountll(x);
+#else /* branch-free; faster than the library call compilers emit without -mpopcnt */
+    x = x - ((x >> 1) & 0x5555555555555555ull);
+    x = (x & 0x3333333333333333ull) + ((x >> 2) & 0x3333333333333333ull);
+    x = (x + (x >> 4)) & 0x0F0F0F0F0F0F0F0Full;
+    return (int)((x * 0x0101010101010101ull) >> 56);
+#endif
+}
+
+static uint64_t voxdagi_spread3(uint32_t v) { /* bit i of v -> bit 3i */
+    uint64_t x = v & 0x1FFFFFu;
+    x = (x | x << 32) & 0x1F00000000FFFFull;
+    x = (x | x << 16) & 0x1F0000FF0000FFull;
+    x = (x | x << 8) & 0x100F00F00F00F00Full;
+    x = (x | x << 4) & 0x10C30C30C30C30C3ull;
+    x = (x | x << 2) & 0x1249249249249249ull;
+    return x;
+}
+
+static uint32_t voxdagi_compact3(uint64_t x) { /* inverse of voxdagi_spread3 */
+    x &= 0x1249249249249249ull;
+    x = (x | x >> 2) & 0x10C30C30C30C30C3ull;
+    x = (x | x >> 4) & 0x100F00F00F00F00Full;
+    x = (x | x >> 8) & 0x1F0000FF0000FFull;
+    x = (x | x >> 16) & 0x1F00000000FFFFull;
+    x = (x | x >> 32) & 0x1FFFFFull;
+    return (uint32_t)x;
+}
+
+VOXDAG_API uint64_t voxdag_morton_encode(uint32_t x, uint32_t y, uint32_t z) {
+    return voxdagi_spread3(x) | voxdagi_spread3(y) << 1 | voxdagi_spread3(z) << 2;
+}
+
+VOXDAG_API void voxdag_morton_decode(uint64_t code, uint32_t *x, uint32_t *y, uint32_t *z) {
+    *x = voxdagi_compact3(code);
+    *y = voxdagi_compact3(code >> 1);
+    *z = voxdagi_compact3(code >> 2);
+}
+
+static uint64_t voxdagi_le(const uint8_t *p, unsigned n) { /* n <= 8 bytes */
+    uint64_t v = 0;
+    while (n--) v = v << 8 | p[n];
+    return v;
+}
+
+/* Reads N bytes at P where at least 8 bytes are readable (padded data). */
+static uint64_t voxdagi_le_fast(const uint8_t *p, unsigned n) {
+#if (defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(__aarch64__)) && \
+    (!defined(__BYTE_ORDER__) || __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+    uint64_t v;
+    memcpy(&v, p, 8);
+    return n >= 8 ? v : v & ((1ull << (8 * n)) - 1);
+#else
+    return voxdagi_le(p, n);
+#endif
+}
+
+static void voxdagi_put_le(uint8_t *p, uint64_t v, unsigned n) {
+    unsigned i;
+    for (i = 0; i < n; i++) p[i] = (uint8_t)(v >> (8 * i));
+}
+
+static uint64_t voxdagi_mix64(uint64_t z) { /* a strong 64-bit finalizer */
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return z ^ (z >> 31);
+}
+
+/* CRC-32C (Castagnoli), bitwise table built per call: sections are large and
+   few, so the 256-entry table costs nothing next to the data. */
+static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
+    uint32_t table[256], crc = 0xFFFFFFFFu;
+    uint32_t i, k;
+    for (i = 0; i < 256; i++) {
+        uint32_t c = i;
+        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0x82F63B78u & (0u - (c & 1)));
+        table[i] = c;
+    }
+    while (n--) crc = table[(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+    return ~crc;
+}
+
+static unsigned voxdagi_bytes_for(uint64_t v) { /* bytes to hold v, >= 1 */
+    unsigned n = 1;
+    while (n < 8 && (v >> (8 * n))) n++;
+    return n;
+}
+
+// -- Reflections (DESIGN 2, 3.2): the group {0..7} under XOR
+
+/* Reflecting a 4^3 brick by m moves Morton position p to p ^ (m | m << 3):
+   one swap stage per set bit. */
+static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
+    static const uint64_t keep[6] = {0x5555555555555555ull, 0x3333333333333333ull,
+                                     0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
+                                     0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
+    unsigned c = m | m << 3, k;
+    for (k = 0; k < 6; k++)
+        if (c >> k & 1) {
+            unsigned s = 1u << k;
+            x = (x & keep[k]) << s | ((x >> s) & keep[k]);
+        }
+    return x;
+}
+
+/* Reflecting an 8-bit child mask by m moves octant i to i ^ m. */
+static unsigned voxdagi_reflect_mask8(unsigned x, unsigned m) {
+    if (m & 1) x = (x & 0x55) << 1 | ((x >> 1) & 0x55);
+    if (m & 2) x = (x & 0x33) << 2 | ((x >> 2) & 0x33);
+    if (m & 4) x = (x & 0x0F) << 4 | ((x >> 4) & 0x0F);
+    return x & 0xFF;
+}
+
+// -- Unique node stores (one per level) with hash-consing
+
+#define VOXDAGI_NONE 0xFFFFFFFFu    /* an absent child reference */
+#define VOXDAGI_MAX_IDS (1u << 29)  /* references pack (id << 3 | mirror) */
+
+/* The unique nodes of one level. Inner nodes keep 8 child references (each
+   (id << 3 | tag) into the next level, tag normalized by the child's
+   stabilizer) and a fingerprint; bricks keep their 64-bit mask in KEY. */
+typedef struct voxdagi_store {
+    uint32_t *child;   /* 8 per node; NULL on the brick level */
+    uint64_t *key;     /* fingerprint (inner) or mask (brick) */
+    uint64_t *count;   /* voxels below (inner only) */
+    uint8_t *stab;     /* stabilizer: bit s set when reflecting by s is identity */
+    size_t n, cap;
+    uint32_t *slot;    /* open-addressing table of id + 1; 0 = free */
+    size_t slot_count; /* power of two */
+    uint64_t svo;      /* tree nodes reduced into this level */
+} voxdagi_store;
+
+static void voxdagi_store_free_arrays(voxdagi_mem *m, voxdagi_store *s) {
+    voxdagi_free(m, s->child, s->cap * 8 * sizeof *s->child);
+    voxdagi_free(m, s->key, s->cap * sizeof *s->key);
+    voxdagi_free(m, s->count, s->cap * sizeof *s->count);
+    voxdagi_free(m, s->stab, s->cap);
+}
+
+static void voxdagi_store_free(voxdagi_mem *m, voxdagi_store *s) {
+    voxdagi_store_free_arrays(m, s);
+    voxdagi_free(m, s->slot, s->slot_count * sizeof *s->slot);
+    memset(s, 0, sizeof *s);
+}
+
+static uint64_t voxdagi_store_count(const voxdagi_store *s, uint32_t id) {
+    return s->child ? s->count[id] : (uint64_t)voxdagi_popcount64(s->key[id]);
+}
+
+static int voxdagi_store_same(const voxdagi_store *s, uint32_t id, uint64_t key,
+                              const uint32_t *child) {
+    return s->key[id] == key &&
+           (!child || !memcmp(s->child + 8 * (size_t)id, child, 8 * sizeof *child));
+}
+
+/* Doubles the capacity of every array of S, all or nothing. */
+static int voxdagi_store_reserve(voxdagi_mem *m, voxdagi_store *s, int inner) {
+    size_t cap = s->cap ? s->cap * 2 : 256;
+    uint64_t *key = (uint64_t *)voxdagi_alloc(m, cap * sizeof *key);
+    uint8_t *stab = (uint8_t *)voxdagi_alloc(m, cap);
+    uint32_t *child = inner ? (uint32_t *)voxdagi_alloc(m, cap * 8 * sizeof *child) : NULL;
+    uint64_t *count = inner ? (uint64_t *)voxdagi_alloc(m, cap * sizeof *count) : NULL;
+    if (!key || !stab || (inner && (!child || !count))) {
+        voxdagi_free(m, key, cap * sizeof *key);
+        voxdagi_free(m, stab, cap);
+        voxdagi_free(m, child, cap * 8 * sizeof *child);
+        voxdagi_free(m, count, cap * sizeof *count);
+        return 0;
+    }
+    if (s->n) {
+        memcpy(key, s->key, s->n * sizeof *key);
+        memcpy(stab, s->stab, s->n);
+        if (inner) {
+            memcpy(child, s->child, s->n * 8 * sizeof *child);
+            memcpy(count, s->count, s->n * sizeof *count);
+        }
+    }
+    voxdagi_store_free_arrays(m, s);
+    s->key = key;
+    s->stab = stab;
+    s->child = child;
+    s->count = count;
+    s->cap = cap;
+    return 1;
+}
+
+/* Finds the node (KEY, CHILD) or appends it. Returns its id, or VOXDAGI_NONE
+   when out of memory or ids. */
+static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner,
+                                     uint64_t key, const uint32_t *child,
+                                     uint64_t count, unsigned stab) {
+    uint64_t h = inner ? key : voxdagi_mix64(key);
+    size_t i, mask;
+    uint32_t id;
+    if (s->slot_count) {
+        mask = s->slot_count - 1;
+        for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask)
+            if (voxdagi_store_same(s, s->slot[i] - 1, key, child)) return s->slot[i] - 1;
+    }
+    if (s->n + 1 >= VOXDAGI_MAX_IDS) return VOXDAGI_NONE;
+    if ((s->n + 1) * 2 > s->slot_count) { /* rehash at half load */
+        size_t count2 = s->slot_count ? s->slot_count * 2 : 64, j;
+        uint32_t *slot = (uint32_t *)voxdagi_alloc(m, count2 * sizeof *slot);
+        if (!slot) return VOXDAGI_NONE;
+        memset(slot, 0, count2 * sizeof *slot);
+        for (j = 0; j < s->n; j++) {
+            uint64_t hj = inner ? s->key[j] : voxdagi_mix64(s->key[j]);
+            for (i = (size_t)hj & (count2 - 1); slot[i]; i = (i + 1) & (count2 - 1)) {}
+            slot[i] = (uint32_t)j + 1;
+        }
+        voxdagi_free(m, s->slot, s->slot_count * sizeof *s->slot);
+        s->slot = slot;
+        s->slot_count = count2;
+    }
+    if (s->n == s->cap && !voxdagi_store_reserve(m, s, inner)) return VOXDAGI_NONE;
+    id = (uint32_t)s->n++;
+    s->key[id] = key;
+    s->stab[id] = (uint8_t)stab;
+    if (inner) {
+        memcpy(s->child + 8 * (size_t)id, child, 8 * sizeof *child);
+        s->count[id] = count;
+    }
+    mask = s->slot_count - 1;
+    for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask) {}
+    s->slot[i] = id + 1;
+    return id;
+}
+
+// -- Canonical forms under reflection (DESIGN 3.3)
+
+/* norm[S][t]: the smallest tag of the coset { t ^ s : s in S } for every
+   stabilizer bitmask S. References (n, t) and (n, t ^ s) with s in S(n) name
+   the same subtree; keys use the smallest so that equal subtrees compare equal. */
+typedef struct voxdagi_group {
+    uint8_t norm[256][8];
+    unsigned reflections; /* 8 with symmetry, 1 without */
+} voxdagi_group;
+
+static void voxdagi_group_init(voxdagi_group *g, int symmetric) {
+    unsigned S, t, s;
+    for (S = 0; S < 256; S++)
+        for (t = 0; t < 8; t++) {
+            unsigned best = t;
+            for (s = 0; s < 8; s++)
+                if ((S >> s & 1) && (t ^ s) < best) best = t ^ s;
+            g->norm[S][t] = (uint8_t)best;
+        }
+    g->reflections = symmetric ? 8 : 1;
+}
+
+/* A reference to the canonical node ID reached through reflection M. */
+typedef struct voxdagi_canon {
+    uint64_t key;
+    unsigned mirror, stab;
+} voxdagi_canon;
+
+/* Bricks: the canonical form is the reflection with the smallest mask. */
+static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
+    voxdagi_canon c;
+    uint64_t r[8];
+    unsigned m;
+    c.key = mask;
+    c.mirror = 0;
+    for (m = 0; m < g->reflections; m++) {
+        r[m] = m ? voxdagi_reflect_brick(mask, m) : mask;
+        if (r[m] < c.key) {
+            c.key = r[m];
+            c.mirror = m;
+        }
+    }
+    c.stab = 0;
+    for (m = 0; m < g->reflections; m++)
+        if (r[m] == mask) c.stab |= 1u << m;
+    return c;
+}
+
+/* The slots of an inner node seen through reflection m: slot i holds the
+   child of octant i ^ m with its tag composed with m and normalized. */
+typedef struct voxdagi_children {
+    unsigned present;  /* bit j: octant j has a child */
+    uint32_t id[8];
+    unsigned tag[8];
+    unsigned stab[8];
+    uint64_t fp[8];    /* the child's fingerprint */
+} voxdagi_children;
+
+/* Total order on reflections of one node: presence mask first, then per slot
+   the child's fingerprint, normalized tag and id. Fingerprints come first so
+   that the choice does not depend on id numbering (which varies with thread
+   count); ids only break fingerprint collisions, keeping the order total. */
+static int voxdagi_compare_reflections(const voxdagi_group *g, const voxdagi_children *c,
+                                       unsigned present, unsigned a, unsigned b) {
+    unsigned i;
+    for (i = 0; i < 8; i++) {
+        unsigned ja = i ^ a, jb = i ^ b, ta, tb;
+        if (!(present >> i & 1)) continue;
+        if (c->fp[ja] != c->fp[jb]) return c->fp[ja] < c->fp[jb] ? -1 : 1;
+        ta = g->norm[c->stab[ja]][c->tag[ja] ^ a];
+        tb = g->norm[c->stab[jb]][c->tag[jb] ^ b];
+        if (ta != tb) return ta < tb ? -1 : 1;
+        if (c->id[ja] != c->id[jb]) return c->id[ja] < c->id[jb] ? -1 : 1;
+    }
+    return 0;
+}
+
+/* Inner nodes: the canonical key (child slots) is the smallest reflection in
+   the order above; all reflections reaching it form mirror ^ stabilizer. */
+static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_children *c,
+                                        uint32_t slots[8]) {
+    voxdagi_canon r;
+    unsigned m, i, best_present = 0x100;
+    uint64_t h = 0x9E3779B97F4A7C15ull;
+    r.mirror = 0;
+    for (m = 0; m < g->reflections; m++) {
+        unsigned p = voxdagi_reflect_mask8(c->present, m);
+        if (p < best_present ||
+            (p == best_present && voxdagi_compare_reflections(g, c, p, m, r.mirror) < 0)) {
+            best_present = p;
+            r.mirror = m;
+        }
+    }
+    r.stab = 0;
+    for (m = 0; m < g->reflections; m++)
+        if (voxdagi_reflect_mask8(c->present, m) == best_present &&
+            voxdagi_compare_reflections(g, c, best_present, m, r.mirror) == 0)
+            r.stab |= 1u << (m ^ r.mirror);
+    for (i = 0; i < 8; i++) {
+        unsigned j = i ^ r.mirror, t;
+        uint64_t v = 0;
+        if (best_present >> i & 1) {
+            t = g->norm[c->stab[j]][c->tag[j] ^ r.mirror];
+            slots[i] = c->id[j] << 3 | t;
+            v = c->fp[j] + (uint64_t)(t + 1) * 0xD6E8FEB86659FD93ull;
+        } else {
+            slots[i] = VOXDAGI_NONE;
+        }
+        h = voxdagi_mix64(h ^ v) + i;
+    }
+    r.key = h;
+    return r;
+}
+
+// -- Streaming bottom-up reduction (DESIGN 3.1)
+
+/* Consumes voxels (or finished subtrees) in Morton order, keeping one open
+   brick and one partially filled node per level; a node is reduced as soon as
+   the Morton prefix of its level changes. TOP is the level of the root this
+   reducer produces (0 for a whole scene, deeper for a worker's subtree). */
+typedef struct voxdagi_reducer {
+    voxdagi_mem *mem;
+    const voxdagi_group *group;
+    uint32_t levels, top;
+    voxdagi_store store[VOXDAG_MAX_LEVELS]; /* levels top..L-2 */
+    uint64_t brick_key, brick_mask;
+    int brick_open;
+    uint64_t part_key[VOXDAG_MAX_LEVELS];
+    int part_open[VOXDAG_MAX_LEVELS];
+    uint32_t part_child[VOXDAG_MAX_LEVELS][8];
+    uint32_t root; /* reference to the root, or VOXDAGI_NONE */
+    int failed;    /* out of memory or node ids */
+} voxdagi_reducer;
+
+static void voxdagi_reducer_init(voxdagi_reducer *r, voxdagi_mem *mem,
+                                 const voxdagi_group *g, uint32_t levels, uint32_t top) {
+    memset(r, 0, sizeof *r);
+    r->mem = mem;
+    r->group = g;
+    r->levels = levels;
+    r->top = top;
+    r->root = VOXDAGI_NONE;
+}
+
+static void voxdagi_reducer_free(voxdagi_reducer *r) {
+    uint32_t l;
+    for (l = 0; l < VOXDAG_MAX_LEVELS; l++) voxdagi_store_free(r->mem, &r->store[l]);
+}
+
+/* Interns a brick mask; returns the reference (id << 3 | mirror). */
+static uint32_t voxdagi_reduce_brick(voxdagi_reducer *r, uint64_t mask) {
+    voxdagi_canon c = voxdagi_canon_brick(r->group, mask);
+    uint32_t id = voxdagi_store_intern(r->mem, &r->store[r->levels - 2], 0, c.key, NULL,
+                                       0, c.stab);
+    if (id == VOXDAGI_NONE) {
+        r->failed = 1;
+        return VOXDAGI_NONE;
+    }
+    return id << 3 | c.mirror;
+}
+
+/* Interns the inner node of level L with child references REF[8] (into level
+   L+1); returns its reference. */
+static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const uint32_t ref[8]) {
+    const voxdagi_store *cs = &r->store[level + 1];
+    voxdagi_children c;
+    voxdagi_canon k;
+    uint32_t slots[8], id;
+    uint64_t count = 0;
+    unsigned j;
+    c.present = 0;
+    for (j = 0; j < 8; j++) {
+        if (ref[j] == VOXDAGI_NONE) {
+            c.id[j] = 0;
+            c.tag[j] = c.stab[j] = 0;
+            c.fp[j] = 0;
+            continue;
+        }
+        c.present |= 1u << j;
+        c.id[j] = ref[j] >> 3;
+        c.tag[j] = ref[j] & 7;
+        c.stab[j] = cs->stab[c.id[j]];
+        c.fp[j] = cs->key[c.id[j]];
+        count += voxdagi_store_count(cs, c.id[j]);
+    }
+    k = voxdagi_canon_node(r->group, &c, slots);
+    id = voxdagi_store_intern(r->mem, &r->store[level], 1, k.key, slots, count, k.stab);
+    if (id == VOXDAGI_NONE) {
+        r->failed = 1;
+        return VOXDAGI_NONE;
+    }
+    return id << 3 | k.mirror;
+}
+
+static void voxdagi_reducer_push(voxdagi_reducer *r, uint32_t level, uint64_t key, uint32_t ref);
+
+/* Reduces the open node of LEVEL and hands it to its parent. */
+static void voxdagi_reducer_close(voxdagi_reducer *r, uint32_t level) {
+    uint32_t ref = voxdagi_reduce_node(r, level, r->part_child[level]);
+    r->part_open[level] = 0;
+    r->store[level].svo++;
+    if (ref != VOXDAGI_NONE) voxdagi_reducer_push(r, level, r->part_key[level], ref);
+}
+
+/* Hands the finished subtree REF of LEVEL with Morton prefix KEY to its parent. */
+static void voxdagi_reducer_push(voxdagi_reducer *r, uint32_t level, uint64_t key, uint32_t ref) {
+    uint32_t p;
+    unsigned j;
+    if (level == r->top) {
+        r->root = ref;
+        return;
+    }
+    p = level - 1;
+    if (r->part_open[p] && r->part_key[p] != key >> 3) voxdagi_reducer_close(r, p);
+    if (!r->part_open[p]) {
+        r->part_open[p] = 1;
+        r->part_key[p] = key >> 3;
+        for (j = 0; j < 8; j++) r->part_child[p][j] = VOXDAGI_NONE;
+    }
+    r->part_child[p][key & 7] = ref;
+}
+
+static void voxdagi_reducer_close_brick(voxdagi_reducer *r) {
+    uint32_t ref;
+    if (!r->brick_open) return;
+    r->brick_open = 0;
+    r->store[r->levels - 2].svo++;
+    ref = voxdagi_reduce_brick(r, r->brick_mask);
+    if (ref != VOXDAGI_NONE) voxdagi_reducer_push(r, r->levels - 2, r->brick_key, ref);
+}
+
+/* Adds one voxel; CODE must not precede the previous one. */
+static void voxdagi_reducer_voxel(voxdagi_reducer *r, uint64_t code) {
+    if (r->brick_open && r->brick_key != code >> 6) voxdagi_reducer_close_brick(r);
+    if (!r->brick_open) {
+        r->brick_open = 1;
+        r->brick_key = code >> 6;
+        r->brick_mask = 0;
+    }
+    r->brick_mask |= 1ull << (code & 63);
+}
+
+/* Closes everything still open; the root reference is then in r->root. */
+static void voxdagi_reducer_finish(voxdagi_reducer *r) {
+    uint32_t l;
+    voxdagi_reducer_close_brick(r);
+    for (l = r->levels - 2; l-- > r->top;)
+        if (r->part_open[l]) voxdagi_reducer_close(r, l);
+}
+
+// -- Sorting: LSD radix sort of Morton codes with their colours
+
+/* Sorts CODE (and RGB, packed 0xRRGGBB, when non-NULL) by the low BITS bits
+   of the codes, stably. TMP_CODE/TMP_RGB hold N elements each. */
+static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code,
+                               uint32_t *tmp_rgb, size_t n, unsigned bits) {
+    enum { DIGIT = 11, BUCKETS = 1 << DIGIT };
+    size_t count[BUCKETS];
+    unsigned shift;
+    for (shift = 0; shift < bits; shift += DIGIT) {
+        size_t i, sum = 0;
+        uint64_t *c;
+        uint32_t *t;
+        memset(count, 0, sizeof count);
+        for (i = 0; i < n; i++) count[(code[i] >> shift) & (BUCKETS - 1)]++;
+        for (i = 0; i < BUCKETS; i++) {
+            size_t k = count[i];
+            count[i] = sum;
+            sum += k;
+        }
+        for (i = 0; i < n; i++) {
+            size_t d = count[(code[i] >> shift) & (BUCKETS - 1)]++;
+            tmp_code[d] = code[i];
+            if (rgb) tmp_rgb[d] = rgb[i];
+        }
+        c = code; code = tmp_code; tmp_code = c;
+        t = rgb; rgb = tmp_rgb; tmp_rgb = t;
+    }
+    if (((bits + DIGIT - 1) / DIGIT) & 1) { /* odd pass count: result is in tmp */
+        memcpy(tmp_code, code, n * sizeof *code);
+        if (rgb) memcpy(tmp_rgb, rgb, n * sizeof *rgb);
+    }
+}
+
+// -- Builder
+
+#define VOXDAGI_MAX_THREADS 64
+
+struct voxdag_builder {
+    voxdagi_mem mem;
+    voxdag_build_opts opts;
+    uint32_t levels;
+    uint32_t threads;
+    int has_bounds;
+    double bounds[6];
+    voxdagi_group group[2];      /* [0]: as requested, [1]: plain (comparison) */
+    voxdagi_reducer red[2];      /* the result, and the other structure when compared */
+    unsigned red_count;
+    uint64_t *pend_code;         /* buffered voxels */
+    uint32_t *pend_rgb;
+    size_t pend_n, pend_cap;
+    uint64_t last_code;          /* largest code reduced so far */
+    int any_reduced;
+    uint8_t *colors;             /* RGB8 in voxel-index order */
+    size_t colors_cap;           /* in voxels */
+    uint64_t voxels;
+    voxdag_status failed;        /* sticky error */
+};
+
+VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
+                                               voxdag_builder **out, voxdag_error *err) {
+    voxdag_build_opts o;
+    voxdagi_mem mem;
+    voxdag_builder *b;
+    unsigned k;
+    if (!out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "out is NULL");
+    *out = NULL;
+    memset(&o, 0, sizeof o);
+    if (opts) o = *opts;
+    if (o.zero_begin || o.zero_end)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                            "build options not zero-initialized");
+    if (!o.levels) o.levels = 10;
+    if (o.levels < 2 || o.levels > VOXDAG_MAX_LEVELS)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "levels outside 2..VOXDAG_MAX_LEVELS");
+    if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                            "allocator needs both alloc and free");
+    if (o.bounds) {
+        for (k = 0; k < 3; k++)
+            if (!(o.bounds[k] < o.bounds[k + 3]) || o.bounds[k] != o.bounds[k] ||
+                o.bounds[k + 3] - o.bounds[k] > 1e300)
+                return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                                    "bounds must be finite with min < max");
+    }
+    voxdagi_mem_init(&mem, &o.allocator, o.max_memory);
+    b = (voxdag_builder *)voxdagi_alloc(&mem, sizeof *b);
+    if (!b) {
+        voxdagi_mem_destroy(&mem);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the builder");
+    }
+    memset(b, 0, sizeof *b);
+    b->mem = mem; /* the mutex is moved before any other use */
+    b->opts = o;
+    b->levels = o.levels;
+    b->threads = o.threads < 1 ? 1 : o.threads > VOXDAGI_MAX_THREADS ? VOXDAGI_MAX_THREADS : o.threads;
+#ifdef VOXDAG_NO_THREADS
+    b->threads = 1;
+#endif
+    if (o.bounds) {
+        b->has_bounds = 1;
+        memcpy(b->bounds, o.bounds, sizeof b->bounds);
+    }
+    b->opts.bounds = NULL;
+    voxdagi_group_init(&b->group[0], !o.no_symmetry);
+    voxdagi_group_init(&b->group[1], o.no_symmetry);
+    b->red_count = o.compare_structures ? 2 : 1;
+    for (k = 0; k < b->red_count; k++)
+        voxdagi_reducer_init(&b->red[k], &b->mem, &b->group[k], b->levels, 0);
+    *out = b;
+    return voxdagi_ok(err);
+}
+
+VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
+    voxdagi_mem mem;
+    unsigned k;
+    if (!b) return;
+    for (k = 0; k < b->red_count; k++) voxdagi_reducer_free(&b->red[k]);
+    voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *b->pend_code);
+    voxdagi_free(&b->mem, b->pend_rgb, b->opts.colors ? b->pend_cap * sizeof *b->pend_rgb : 0);
+    voxdagi_free(&b->mem, b->colors, b->colors_cap * 3);
+    mem = b->mem;
+    voxdagi_free(&mem, b, sizeof *b);
+    voxdagi_mem_destroy(&mem);
+}
+
+/* Grows the voxel buffer (codes and colours together) to hold NEED voxels. */
+static int voxdagi_builder_reserve(voxdag_builder *b, size_t need) {
+    size_t cap = b->pend_cap ? b->pend_cap : 1024;
+    size_t rgb_size = b->opts.colors ? sizeof *b->pend_rgb : 0;
+    uint64_t *code;
+    uint32_t *rgb = NULL;
+    while (cap < need) cap *= 2;
+    code = (uint64_t *)voxdagi_alloc(&b->mem, cap * sizeof *code);
+    if (rgb_size) rgb = (uint32_t *)voxdagi_alloc(&b->mem, cap * rgb_size);
+    if (!code || (rgb_size && !rgb)) {
+        voxdagi_free(&b->mem, code, cap * sizeof *code);
+        voxdagi_free(&b->mem, rgb, cap * rgb_size);
+        return 0;
+    }
+    if (b->pend_n) {
+        memcpy(code, b->pend_code, b->pend_n * sizeof *code);
+        if (rgb) memcpy(rgb, b->pend_rgb, b->pend_n * rgb_size);
+    }
+    voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *code);
+    voxdagi_free(&b->mem, b->pend_rgb, b->pend_cap * rgb_size);
+    b->pend_code = code;
+    b->pend_rgb = rgb;
+    b->pend_cap = cap;
+    return 1;
+}
+
+VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *xyz,
+                                            const uint8_t *rgb, size_t n, voxdag_error *err) {
+    uint32_t limit;
+    size_t i;
+    if (!b || (n && !xyz) || (n && b->opts.colors && !rgb))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                            "builder, coordinates or colours missing");
+    if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
+    limit = (uint32_t)1 << b->levels;
+    for (i = 0; i < n; i++) {
+        uint64_t code;
+        if (xyz[3 * i] >= limit || xyz[3 * i + 1] >= limit || xyz[3 * i + 2] >= limit)
+            return voxdagi_fail(err, VOXDAG_ERR_COORDINATE, "voxel coordinate >= 2^levels",
+                                UINT64_MAX, (uint64_t)i);
+        code = voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+        if (b->any_reduced && code < b->last_code)
+            return voxdagi_fail(err, VOXDAG_ERR_ORDER,
+                                "voxel precedes voxels already flushed", UINT64_MAX,
+                                (uint64_t)i);
+    }
+    if (n > ((size_t)-1) / 16 - b->pend_n)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "too many voxels");
+    if (b->pend_n + n > b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + n))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot grow the voxel buffer");
+    for (i = 0; i < n; i++) {
+        b->pend_code[b->pend_n + i] = voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+        if (b->opts.colors)
+            b->pend_rgb[b->pend_n + i] = (uint32_t)rgb[3 * i] << 16 |
+                                         (uint32_t)rgb[3 * i + 1] << 8 | rgb[3 * i + 2];
+    }
+    b->pend_n += n;
+    return voxdagi_ok(err);
+}
+
+/* Appends the colours of N sorted, distinct voxels to the colour array. */
+static int voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, size_t n) {
+    size_t i;
+    uint8_t *c;
+    if (!b->opts.colors) return 1;
+    if (!voxdagi_grow(&b->mem, (void **)&b->colors, &b->colors_cap, (size_t)b->voxels + n, 3))
+        return 0;
+    c = b->colors + 3 * (size_t)b->voxels;
+    for (i = 0; i < n; i++) {
+        c[3 * i] = (uint8_t)(rgb[i] >> 16);
+        c[3 * i + 1] = (uint8_t)(rgb[i] >> 8);
+        c[3 * i + 2] = (uint8_t)rgb[i];
+    }
+    return 1;
+}
+
+/* Closes the open brick and the open nodes of levels >= LEVEL (they belong to
+   subtrees that precede the one about to be pushed at LEVEL). */
+static void voxdagi_reducer_close_below(voxdagi_reducer *r, uint32_t level) {
+    uint32_t l;
+    voxdagi_reducer_close_brick(r);
+    for (l = r->levels - 2; l-- > level;)
+        if (r->part_open[l]) voxdagi_reducer_close(r, l);
+}
+
+#ifndef VOXDAG_NO_THREADS
+/* Parallel reduction (DESIGN 3.1): complete subtrees of level SPLIT are
+   reduced by workers into stores of their own, then merged into the builder's
+   stores in Morton order with the same interning (so the result does not
+   depend on how the work was split). */
+typedef struct voxdagi_piece {
+    size_t begin, end;  /* range of buffered voxels */
+    uint32_t root[2];   /* the worker's root reference, per reducer */
+} voxdagi_piece;
+
+typedef struct voxdagi_worker {
+    voxdag_builder *b;
+    voxdagi_reducer red[2];
+    voxdagi_piece *piece;
+    size_t piece_count;
+    const uint64_t *code;
+} voxdagi_worker;
+
+static void *voxdagi_worker_run(void *arg) {
+    voxdagi_worker *w = (voxdagi_worker *)arg;
+    size_t p, i;
+    unsigned k;
+    for (p = 0; p < w->piece_count; p++) {
+        voxdagi_piece *pc = &w->piece[p];
+        for (k = 0; k < w->b->red_count; k++) {
+            voxdagi_reducer *r = &w->red[k];
+            for (i = pc->begin; i < pc->end; i++) voxdagi_reducer_voxel(r, w->code[i]);
+            voxdagi_reducer_finish(r);
+            pc->root[k] = r->root;
+            r->root = VOXDAGI_NONE;
+        }
+    }
+    return NULL;
+}
+
+/* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
+   receives, per worker id, the reference in R. Returns 0 when out of memory. */
+static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map, size_t *map_size) {
+    uint32_t l = r->levels - 1;
+    while (l-- > w->top) {
+        voxdagi_store *s = &w->store[l];
+        size_t i;
+        unsigned j;
+        if (!s->n) continue;
+        map_size[l] = s->n * sizeof(uint32_t);
+        map[l] = (uint32_t *)voxdagi_alloc(r->mem, map_size[l]);
+        if (!map[l]) return 0;
+        for (i = 0; i < s->n; i++) {
+            uint32_t ref;
+            if (!s->child) {
+                ref = voxdagi_reduce_brick(r, s->key[i]);
+            } else {
+                uint32_t c[8];
+                for (j = 0; j < 8; j++) {
+                    uint32_t x = s->child[8 * i + j];
+                    c[j] = x == VOXDAGI_NONE ? x : map[l + 1][x >> 3] ^ (x & 7);
+                }
+                ref = voxdagi_reduce_node(r, l, c);
+            }
+            if (ref == VOXDAGI_NONE) return 0;
+            map[l][i] = ref;
+        }
+        r->store[l].svo += s->svo;
+    }
+    return 1;
+}
+
+/* Reduces sorted distinct voxels CODE[0..n) with workers. Returns 0 when
+   the split does not pay (the caller then reduces serially). */
+static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *code, size_t n,
+                                             int final, int *done) {
+    uint32_t split = 1, L = b->levels;
+    size_t npieces = 0, cap = 0, i, start, per;
+    voxdagi_piece *piece = NULL;
+    voxdagi_worker *worker;
+    pthread_t tid[VOXDAGI_MAX_THREADS];
+    unsigned t, k, started = 0;
+    voxdag_status st = VOXDAG_OK;
+    uint64_t shift, first_open = UINT64_MAX, last_open = UINT64_MAX;
+    *done = 0;
+    while ((1ull << (3 * split)) < 16ull * b->threads) split++;
+    if (b->threads < 2 || split + 3 > L || n < 4096) return VOXDAG_OK;
+    shift = 3ull * (L - split);
+    /* A subtree may continue from an earlier flush, or into a later one: those
+       two are reduced by the builder itself, not as pieces. */
+    if (b->any_reduced) first_open = b->last_code >> shift;
+    if (!final) last_open = code[n - 1] >> shift;
+    for (start = 0; start < n;) {
+        uint64_t prefix = code[start] >> shift;
+        size_t end = start + 1;
+        while (end < n && code[end] >> shift == prefix) end++;
+        if (prefix != first_open && prefix != last_open) {
+            if (!voxdagi_grow(&b->mem, (void **)&piece, &cap, npieces + 1, sizeof *piece)) {
+                voxdagi_free(&b->mem, piece, cap * sizeof *piece);
+                return VOXDAG_ERR_OUT_OF_MEMORY;
+            }
+            piece[npieces].begin = start;
+            piece[npieces].end = end;
+            npieces++;
+        }
+        start = end;
+    }
+    if (npieces < 2 * b->threads) {
+        voxdagi_free(&b->mem, piece, cap * sizeof *piece);
+        return VOXDAG_OK;
+    }
+    worker = (voxdagi_worker *)voxdagi_alloc(&b->mem, b->threads * sizeof *worker);
+    if (!worker) {
+        voxdagi_free(&b->mem, piece, cap * sizeof *piece);
+        return VOXDAG_ERR_OUT_OF_MEMORY;
+    }
+    /* Contiguous runs of pieces with about n / threads voxels each. */
+    per = n / b->threads + 1;
+    for (t = 0, i = 0; t < b->threads; t++) {
+        size_t first = i, load = 0;
+        while (i < npieces && (load < per || t + 1 == b->threads)) {
+            load += piece[i].end - piece[i].begin;
+            i++;
+        }
+        worker[t].b = b;
+        worker[t].piece = piece + first;
+        worker[t].piece_count = i - first;
+        worker[t].code = code;
+        for (k = 0; k < b->red_count; k++)
+            voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], L, split);
+    }
+    for (t = 1; t < b->threads; t++) {
+        if (pthread_create(&tid[t], NULL, voxdagi_worker_run, &worker[t]) != 0) break;
+        started = t;
+    }
+    voxdagi_worker_run(&worker[0]);
+    for (t = 1; t <= started; t++) pthread_join(tid[t], NULL);
+    for (t = started + 1; t < b->threads; t++) voxdagi_worker_run(&worker[t]);
+
+    /* Merge in worker order, then feed voxels and subtrees in Morton order. */
+    for (t = 0; t < b->threads && st == VOXDAG_OK; t++)
+        for (k = 0; k < b->red_count; k++) {
+            uint32_t *map[VOXDAG_MAX_LEVELS];
+            size_t map_size[VOXDAG_MAX_LEVELS], p;
+            memset(map, 0, sizeof map);
+            memset(map_size, 0, sizeof map_size);
+            if (worker[t].red[k].failed || !voxdagi_merge(&b->red[k], &worker[t].red[k], map, map_size))
+                st = VOXDAG_ERR_OUT_OF_MEMORY;
+            for (p = 0; p < worker[t].piece_count && st == VOXDAG_OK; p++) {
+                uint32_t x = worker[t].piece[p].root[k];
+                worker[t].piece[p].root[k] = map[split][x >> 3] ^ (x & 7);
+            }
+            for (i = 0; i < VOXDAG_MAX_LEVELS; i++) voxdagi_free(&b->mem, map[i], map_size[i]);
+        }
+    for (t = 0; t < b->threads; t++)
+        for (k = 0; k < b->red_count; k++) voxdagi_reducer_free(&worker[t].red[k]);
+    if (st == VOXDAG_OK) {
+        size_t p = 0;
+        for (start = 0; start < n; start++) {
+            if (p < npieces && piece[p].begin == start) {
+                for (k = 0; k < b->red_count; k++) {
+                    voxdagi_reducer_close_below(&b->red[k], split);
+                    voxdagi_reducer_push(&b->red[k], split, code[start] >> shift, piece[p].root[k]);
+                }
+                start = piece[p].end - 1;
+                p++;
+                continue;
+            }
+            for (k = 0; k < b->red_count; k++) voxdagi_reducer_voxel(&b->red[k], code[start]);
+        }
+        *done = 1;
+    }
+    voxdagi_free(&b->mem, worker, b->threads * sizeof *worker);
+    voxdagi_free(&b->mem, piece, cap * sizeof *piece);
+    return st;
+}
+#endif
+
+/* Sorts, deduplicates and reduces the buffered voxels. FINAL: no voxel follows. */
+static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
+    size_t n = b->pend_n, i, w;
+    uint64_t *code = b->pend_code;
+    uint32_t *rgb = b->pend_rgb;
+    int sorted = 1, done = 0;
+    unsigned k;
+    if (!n) return VOXDAG_OK;
+    for (i = 1; i < n && sorted; i++) sorted = code[i - 1] <= code[i];
+    if (!sorted) {
+        size_t rgb_size = rgb ? n * sizeof *rgb : 0;
+        uint64_t *tc = (uint64_t *)voxdagi_alloc(&b->mem, n * sizeof *tc);
+        uint32_t *tr = rgb ? (uint32_t *)voxdagi_alloc(&b->mem, rgb_size) : NULL;
+        if (!tc || (rgb && !tr)) {
+            voxdagi_free(&b->mem, tc, n * sizeof *tc);
+            voxdagi_free(&b->mem, tr, rgb_size);
+            return VOXDAG_ERR_OUT_OF_MEMORY;
+        }
+        voxdagi_radix_sort(code, rgb, tc, tr, n, 3 * b->levels);
+        voxdagi_free(&b->mem, tc, n * sizeof *tc);
+        voxdagi_free(&b->mem, tr, rgb_size);
+    }
+    /* Keep the last of equal codes; a repeat of the last reduced voxel only
+       replaces its colour. */
+    w = 0;
+    for (i = 0; i < n; i++) {
+        if (w && code[w - 1] == code[i]) {
+            if (rgb) rgb[w - 1] = rgb[i];
+            continue;
+        }
+        code[w] = code[i];
+        if (rgb) rgb[w] = rgb[i];
+        w++;
+    }
+    i = 0;
+    if (b->any_reduced && code[0] == b->last_code) {
+        if (rgb) {
+            uint8_t *c = b->colors + 3 * (size_t)(b->voxels - 1);
+            c[0] = (uint8_t)(rgb[0] >> 16);
+            c[1] = (uint8_t)(rgb[0] >> 8);
+            c[2] = (uint8_t)rgb[0];
+        }
+        i = 1;
+    }
+    n = w - i;
+    code += i;
+    if (rgb) rgb += i;
+    b->pend_n = 0;
+    if (!n) return VOXDAG_OK;
+    if (!voxdagi_builder_colors(b, rgb, n)) return VOXDAG_ERR_OUT_OF_MEMORY;
+#ifndef VOXDAG_NO_THREADS
+    {
+        voxdag_status st = voxdagi_reduce_parallel(b, code, n, final, &done);
+        if (st != VOXDAG_OK) return st;
+    }
+#else
+    (void)final;
+#endif
+    if (!done)
+        for (k = 0; k < b->red_count; k++)
+            for (i = 0; i < n; i++) voxdagi_reducer_voxel(&b->red[k], code[i]);
+    for (k = 0; k < b->red_count; k++)
+        if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
+    b->voxels += n;
+    b->last_code = code[n - 1];
+    b->any_reduced = 1;
+    return VOXDAG_OK;
+}
+
+VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *err) {
+    voxdag_status st;
+    if (!b) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "builder is NULL");
+    if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
+    st = voxdagi_builder_reduce(b, 0);
+    if (st != VOXDAG_OK) {
+        b->failed = st;
+        return VOXDAGI_FAIL(err, st, "out of memory while reducing voxels");
+    }
+    return voxdagi_ok(err);
+}
+
+// -- File image assembly (FORMAT.md: header, section table, sections)
+
+typedef struct voxdagi_layout {
+    uint32_t count;
+    uint32_t type[VOXDAG_FILE_MAX_SECTIONS];
+    uint32_t flags[VOXDAG_FILE_MAX_SECTIONS];
+    uint64_t offset[VOXDAG_FILE_MAX_SECTIONS];
+    uint64_t size[VOXDAG_FILE_MAX_SECTIONS];
+    uint64_t total;
+} voxdagi_layout;
+
+static void voxdagi_layout_add(voxdagi_layout *lay, uint32_t type, uint32_t flags, uint64_t size) {
+    lay->type[lay->count] = type;
+    lay->flags[lay->count] = flags;
+    lay->size[lay->count] = size;
+    lay->count++;
+}
+
+/* Places the sections one after the other at 8-byte alignment. Returns 0 when
+   the total does not fit in size_t. */
+static int voxdagi_layout_place(voxdagi_layout *lay) {
+    uint64_t at = VOXDAG_FILE_HEADER_SIZE + (uint64_t)lay->count * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+    uint32_t i;
+    for (i = 0; i < lay->count; i++) {
+        at = (at + 7) & ~(uint64_t)7;
+        lay->offset[i] = at;
+        if (lay->size[i] > ((uint64_t)(size_t)-1) - at) return 0;
+        at += lay->size[i];
+    }
+    lay->total = at;
+    return (uint64_t)(size_t)at == at;
+}
+
+static uint8_t *voxdagi_layout_section(uint8_t *image, const voxdagi_layout *lay, uint32_t type) {
+    uint32_t i;
+    for (i = 0; i < lay->count; i++)
+        if (lay->type[i] == type) return image + lay->offset[i];
+    return NULL;
+}
+
+/* Writes the header and section table (with checksums) of a filled image. */
+static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, uint32_t flags,
+                                uint32_t levels, uint32_t root_mirror, uint64_t voxels) {
+    uint8_t *table = img + VOXDAG_FILE_HEADER_SIZE;
+    uint32_t i;
+    memcpy(img + VOXDAG_FILE_OFF_MAGIC, voxdagi_magic, 8);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_VERSION, VOXDAG_FORMAT_VERSION, 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_ENDIAN, VOXDAG_FILE_ENDIAN_TAG, 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_HEADER_SIZE, VOXDAG_FILE_HEADER_SIZE, 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_FLAGS, flags, 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_FILE_SIZE, lay->total, 8);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_VOXELS, voxels, 8);
+    img[VOXDAG_FILE_OFF_LEVELS] = (uint8_t)levels;
+    img[VOXDAG_FILE_OFF_ROOT_MIRROR] = (uint8_t)root_mirror;
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, lay->count, 4);
+    for (i = 0; i < lay->count; i++) {
+        uint8_t *e = table + i * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+        voxdagi_put_le(e, lay->type[i], 4);
+        voxdagi_put_le(e + 4, lay->flags[i], 4);
+        voxdagi_put_le(e + 8, lay->offset[i], 8);
+        voxdagi_put_le(e + 16, lay->size[i], 8);
+        voxdagi_put_le(e + 24, voxdagi_crc32c(img + lay->offset[i], lay->size[i]), 4);
+    }
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_TABLE_CRC,
+                   voxdagi_crc32c(table, (uint64_t)lay->count * VOXDAG_FILE_SECTION_ENTRY_SIZE), 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_HEADER_CRC, voxdagi_crc32c(img, VOXDAG_FILE_HEADER_SIZE), 4);
+}
+
+// -- Compact encoding (DESIGN 4; SSVDAG 4.3, extended with voxel counts)
+//
+// Per level, nodes are ordered by reference count (most referenced first) so
+// that most pointers are short. A node record is: a 16-bit header with a
+// 2-bit tag per child octant (0 absent, 1: 2-byte, 2: 3-byte, 3: the level's
+// long pointer of 4..8 bytes), the node's voxel count in the level's count
+// width (levels above L-3 only: an L-3 count is the popcount of its bricks),
+// then the present children's pointers in octant order. A pointer is
+// (target << 3 | mirror), little-endian; the target is a byte offset into the
+// next level, or a brick index. Records are byte-aligned: 3-byte pointers
+// and unpadded records are what pays for the counts.
+
+typedef struct voxdagi_sortrec {
+    uint32_t refs, id;
+    uint64_t key;
+} voxdagi_sortrec;
+
+static int voxdagi_sortrec_cmp(const void *pa, const void *pb) {
+    const voxdagi_sortrec *a = (const voxdagi_sortrec *)pa, *b = (const voxdagi_sortrec *)pb;
+    if (a->refs != b->refs) return a->refs > b->refs ? -1 : 1;
+    if (a->key != b->key) return a->key < b->key ? -1 : 1;
+    return a->id < b->id ? -1 : a->id > b->id;
+}
+
+static unsigned voxdagi_pointer_bytes(uint64_t v, unsigned long_bytes) {
+    return v < (1u << 16) ? 2 : v < (1u << 24) ? 3 : long_bytes;
+}
+
+static unsigned voxdagi_pointer_tag(uint64_t v) {
+    return v < (1u << 16) ? 1 : v < (1u << 24) ? 2 : 3;
+}
+
+typedef struct voxdagi_encoder {
+    voxdagi_mem *mem;
+    const voxdagi_reducer *r;
+    uint32_t levels;
+    uint32_t *order[VOXDAG_MAX_LEVELS]; /* ids in storage order */
+    uint64_t *pos[VOXDAG_MAX_LEVELS];   /* per id: byte offset, or brick index */
+    uint64_t size[VOXDAG_MAX_LEVELS];   /* bytes of each inner level */
+    unsigned count_bytes[VOXDAG_MAX_LEVELS], long_bytes[VOXDAG_MAX_LEVELS];
+} voxdagi_encoder;
+
+static void voxdagi_encoder_free(voxdagi_encoder *e) {
+    uint32_t l;
+    for (l = 0; l < VOXDAG_MAX_LEVELS; l++) {
+        size_t n = e->r->store[l].n;
+        voxdagi_free(e->mem, e->order[l], n * sizeof(uint32_t));
+        voxdagi_free(e->mem, e->pos[l], n * sizeof(uint64_t));
+    }
+}
+
+/* Orders every level and computes record offsets, bottom-up (pointer sizes
+   depend on where the next level put its nodes). Returns 0 when out of memory. */
+static int voxdagi_encoder_plan(voxdagi_encoder *e) {
+    const voxdagi_reducer *r = e->r;
+    uint32_t B = e->levels - 2, l;
+    uint32_t *refs[VOXDAG_MAX_LEVELS];
+    int ok = 1;
+    memset(refs, 0, sizeof refs);
+    for (l = 0; l <= B; l++) {
+        size_t n = r->store[l].n;
+        refs[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
+        e->order[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
+        e->pos[l] = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof(uint64_t));
+        if (!refs[l] || !e->order[l] || !e->pos[l]) ok = 0;
+        else memset(refs[l], 0, n * sizeof(uint32_t));
+    }
+    if (ok) {
+        refs[0][r->root >> 3] = 1;
+        for (l = 0; l < B; l++) { /* reference counts, saturating */
+            const voxdagi_store *s = &r->store[l];
+            size_t i;
+            for (i = 0; i < 8 * s->n; i++)
+                if (s->child[i] != VOXDAGI_NONE && refs[l + 1][s->child[i] >> 3] != UINT32_MAX)
+                    refs[l + 1][s->child[i] >> 3]++;
+        }
+    }
+    for (l = B + 1; ok && l-- > 0;) {
+        const voxdagi_store *s = &r->store[l];
+        size_t n = s->n, i;
+        voxdagi_sortrec *rec = (voxdagi_sortrec *)voxdagi_alloc(e->mem, n * sizeof *rec);
+        uint64_t at = 0, max_count = 0, max_target;
+        if (!rec) {
+            ok = 0;
+            break;
+        }
+        for (i = 0; i < n; i++) {
+            rec[i].refs = refs[l][i];
+            rec[i].id = (uint32_t)i;
+            rec[i].key = s->key[i];
+            if (s->count && s->count[i] > max_count) max_count = s->count[i];
+        }
+        qsort(rec, n, sizeof *rec, voxdagi_sortrec_cmp);
+        if (l < B) {
+            max_target = l + 1 == B ? r->store[B].n : e->size[l + 1];
+            e->long_bytes[l] = voxdagi_bytes_for(max_target << 3 | 7);
+            if (e->long_bytes[l] < 4) e->long_bytes[l] = 4;
+            e->count_bytes[l] = l + 1 < B ? voxdagi_bytes_for(max_count) : 0;
+        }
+        for (i = 0; i < n; i++) {
+            uint32_t id = rec[i].id;
+            e->order[l][i] = id;
+            if (l == B) {
+                e->pos[l][id] = i;
+                continue;
+            }
+            e->pos[l][id] = at;
+            at += 2 + e->count_bytes[l];
+            {
+                unsigned j;
+                for (j = 0; j < 8; j++) {
+                    uint32_t x = s->child[8 * (size_t)id + j];
+                    if (x != VOXDAGI_NONE)
+                        at += voxdagi_pointer_bytes(e->pos[l + 1][x >> 3] << 3 | (x & 7),
+                                                    e->long_bytes[l]);
+                }
+            }
+        }
+        e->size[l] = at;
+        voxdagi_free(e->mem, rec, n * sizeof *rec);
+    }
+    for (l = 0; l <= B; l++) voxdagi_free(e->mem, refs[l], r->store[l].n * sizeof(uint32_t));
+    return ok;
+}
+
+/* Writes the inner levels into NODES and the bricks into BRICKS. */
+static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_table, uint8_t *nodes,
+                                  uint8_t *bricks) {
+    const voxdagi_reducer *r = e->r;
+    uint32_t B = e->levels - 2, l;
+    uint64_t level_at = 0;
+    size_t i;
+    for (l = 0; l < B; l++) {
+        const voxdagi_store *s = &r->store[l];
+        uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
+        voxdagi_put_le(te, level_at, 8);
+        voxdagi_put_le(te + 8, e->size[l], 8);
+        voxdagi_put_le(te + 16, s->n, 4);
+        te[20] = (uint8_t)e->count_bytes[l];
+        te[21] = (uint8_t)e->long_bytes[l];
+        for (i = 0; i < s->n; i++) {
+            uint32_t id = e->order[l][i];
+            const uint32_t *ch = s->child + 8 * (size_t)id;
+            unsigned header = 0, j, at = 2 + e->count_bytes[l];
+            voxdagi_put_le(p + 2, s->count[id], e->count_bytes[l]);
+            for (j = 0; j < 8; j++) {
+                uint64_t v;
+                unsigned n;
+                if (ch[j] == VOXDAGI_NONE) continue;
+                v = e->pos[l + 1][ch[j] >> 3] << 3 | (ch[j] & 7);
+                n = voxdagi_pointer_bytes(v, e->long_bytes[l]);
+                header |= voxdagi_pointer_tag(v) << (2 * j);
+                voxdagi_put_le(p + at, v, n);
+                at += n;
+            }
+            voxdagi_put_le(p, header, 2);
+            p += at;
+        }
+        level_at += e->size[l];
+    }
+    for (i = 0; i < r->store[B].n; i++)
+        voxdagi_put_le(bricks + 8 * i, r->store[B].key[e->order[B][i]], 8);
+}
+
+// -- The DAG: a parsed view of a file image
+
+typedef struct voxdagi_level {
+    const uint8_t *data;
+    uint64_t size, nodes;
+    unsigned count_bytes, long_bytes;
+} voxdagi_level;
+
+struct voxdag {
+    voxdag_allocator alloc;
+    uint8_t *owned;               /* the image when the DAG owns it */
+    size_t owned_size;
+    const uint8_t *image;
+    size_t image_size;
+    uint32_t levels, root_mirror, flags;
+    uint64_t voxels;
+    voxdagi_level level[VOXDAG_MAX_LEVELS]; /* inner levels 0..L-3 */
+    uint64_t node_bytes;
+    const uint8_t *bricks;
+    uint64_t brick_count;
+    voxdag_color_kind color_kind;
+    const uint8_t *color;
+    uint64_t color_size;
+    int has_bounds;
+    double bounds[6];
+};
+
+static void voxdagi_release(const voxdag_allocator *a, void *p, size_t size) {
+    if (!p) return;
+    if (a->free) a->free(a->user, p, size ? size : 1);
+    else if (!a->alloc) VOXDAG_FREE(p);
+}
+
+VOXDAG_API void voxdag_free(voxdag *dag) {
+    voxdag_allocator a;
+    if (!dag) return;
+    a = dag->alloc;
+    voxdagi_release(&a, dag->owned, dag->owned_size);
+    voxdagi_release(&a, dag, sizeof *dag);
+}
+
+VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size) {
+    if (size) *size = dag->image_size;
+    return dag->image;
+}
+
+// -- Node access on the encoded form
+
+/* Byte offset of child octant S's pointer inside a record with HEADER: the
+   sum of the pointer sizes of the lower octants (popcounts over the tags). */
+static unsigned voxdagi_child_offset(unsigned header, unsigned s, unsigned long_bytes) {
+    unsigned h = header & ((1u << (2 * s)) - 1);
+    unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
+    return 2u * (unsigned)voxdagi_popcount64(lo & ~hi) + 3u * (unsigned)voxdagi_popcount64(hi & ~lo) +
+           long_bytes * (unsigned)voxdagi_popcount64(lo & hi);
+}
+
+static unsigned voxdagi_record_size(const voxdagi_level *lv, unsigned header) {
+    return 2 + lv->count_bytes + voxdagi_child_offset(header, 8, lv->long_bytes);
+}
+
+/* The pointer of stored octant S (which must be present): target << 3 | mirror. */
+static uint64_t voxdagi_child(const voxdagi_level *lv, const uint8_t *rec, unsigned header, unsigned s) {
+    static const unsigned char size_of_tag[4] = {0, 2, 3, 0};
+    unsigned tag = header >> (2 * s) & 3;
+    unsigned n = tag == 3 ? lv->long_bytes : size_of_tag[tag];
+    return voxdagi_le_fast(rec + 2 + lv->count_bytes + voxdagi_child_offset(header, s, lv->long_bytes), n);
+}
+
+static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
+    return voxdagi_le(d->bricks + 8 * index, 8);
+}
+
+/* Voxels below the node at byte OFFSET of inner level L (or brick OFFSET when
+   L is the brick level). */
+static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset) {
+    const voxdagi_level *lv;
+    const uint8_t *rec;
+    unsigned header, s;
+    uint64_t sum = 0;
+    if (l == d->levels - 2) return (uint64_t)voxdagi_popcount64(voxdagi_brick(d, offset));
+    lv = &d->level[l];
+    rec = lv->data + offset;
+    if (lv->count_bytes) return voxdagi_le_fast(rec + 2, lv->count_bytes);
+    header = (unsigned)voxdagi_le(rec, 2);
+    for (s = 0; s < 8; s++)
+        if (header >> (2 * s) & 3)
+            sum += (uint64_t)voxdagi_popcount64(voxdagi_brick(d, voxdagi_child(lv, rec, header, s) >> 3));
+    return sum;
+}
+
+// -- Loading: header, sections and full structural validation (DESIGN 4)
+
+/* Bitmap helpers for validation: which byte offsets start a record, and which
+   records some parent points to. */
+static int voxdagi_bit(const uint8_t *bits, uint64_t i) { return bits[i >> 3] >> (i & 7) & 1; }
+static void voxdagi_set_bit(uint8_t *bits, uint64_t i) { bits[i >> 3] = (uint8_t)(bits[i >> 3] | 1u << (i & 7)); }
+
+typedef struct voxdagi_bitmaps {
+    uint8_t *start, *ref;
+    size_t bytes;
+} voxdagi_bitmaps;
+
+static int voxdagi_bitmaps_alloc(voxdagi_mem *m, voxdagi_bitmaps *b, uint64_t bits) {
+    b->bytes = (size_t)((bits + 7) / 8);
+    b->start = (uint8_t *)voxdagi_alloc(m, b->bytes);
+    b->ref = (uint8_t *)voxdagi_alloc(m, b->bytes);
+    if (b->start) memset(b->start, 0, b->bytes);
+    if (b->ref) memset(b->ref, 0, b->bytes);
+    return b->start && b->ref;
+}
+
+static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
+    voxdagi_free(m, b->start, b->bytes);
+    voxdagi_free(m, b->ref, b->bytes);
+    b->start = b->ref = NULL;
+}
+
+/* Every record of every inner level, bottom-up: sizes, pointer targets (a
+   record start of the next level, or a brick), counts (the sum of the
+   children's), every node and brick referenced, one root holding every voxel. */
+static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
+    uint32_t B = d->levels - 2, l;
+    uint64_t base = (uint64_t)(d->level[0].data - d->image), i;
+    voxdagi_bitmaps child, cur;
+    voxdag_status st = VOXDAG_OK;
+    const char *msg = NULL;
+    uint64_t where = UINT64_MAX, node = UINT64_MAX;
+    memset(&child, 0, sizeof child);
+    memset(&cur, 0, sizeof cur);
+    for (i = 0; i < d->brick_count; i++)
+        if (!voxdagi_brick(d, i))
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "empty brick",
+                                (uint64_t)(d->bricks - d->image) + 8 * i, i);
+    if (d->voxels == 0) {
+        if (d->brick_count || d->node_bytes)
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "nodes in an empty scene");
+        return VOXDAG_OK;
+    }
+    if (B == 0) {
+        if (d->brick_count != 1 || (uint64_t)voxdagi_popcount64(voxdagi_brick(d, 0)) != d->voxels)
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "root brick does not match the voxel count");
+        return VOXDAG_OK;
+    }
+    if (!voxdagi_bitmaps_alloc(m, &child, d->brick_count))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
+    for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.start, i); /* every brick starts a record */
+    for (l = B; st == VOXDAG_OK && l-- > 0;) {
+        const voxdagi_level *lv = &d->level[l];
+        uint64_t at = 0, records = 0, child_units = l + 1 == B ? d->brick_count : d->level[l + 1].size;
+        if (!voxdagi_bitmaps_alloc(m, &cur, lv->size)) {
+            st = VOXDAG_ERR_OUT_OF_MEMORY;
+            msg = "cannot allocate validation bitmaps";
+            break;
+        }
+        while (at < lv->size) {
+            const uint8_t *rec = lv->data + at;
+            unsigned header, s;
+            uint64_t sum = 0;
+            where = base + (uint64_t)(rec - d->level[0].data);
+            node = records;
+            if (lv->size - at < 2) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
+            header = (unsigned)voxdagi_le(rec, 2);
+            if (!header) { st = VOXDAG_ERR_CORRUPT; msg = "node without children"; break; }
+            if (lv->size - at < voxdagi_record_size(lv, header)) {
+                st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break;
+            }
+            for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
+                uint64_t target, c;
+                if (!(header >> (2 * s) & 3)) continue;
+                target = voxdagi_child(lv, rec, header, s) >> 3;
+                if (target >= child_units || !voxdagi_bit(child.start, target)) {
+                    st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
+                }
+                voxdagi_set_bit(child.ref, target);
+                c = voxdagi_node_count(d, l + 1, target);
+                if (sum + c < sum) { st = VOXDAG_ERR_CORRUPT; msg = "voxel count overflows"; break; }
+                sum += c;
+            }
+            if (st != VOXDAG_OK) break;
+            if (lv->count_bytes && voxdagi_le(rec + 2, lv->count_bytes) != sum) {
+                st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
+            }
+            voxdagi_set_bit(cur.start, at);
+            at += voxdagi_record_size(lv, header);
+            records++;
+        }
+        if (st == VOXDAG_OK && records != lv->nodes) {
+            st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records"; where = UINT64_MAX; node = UINT64_MAX;
+        }
+        for (i = 0; st == VOXDAG_OK && i < child.bytes; i++)
+            if (child.start[i] & ~child.ref[i]) {
+                st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; where = UINT64_MAX; node = UINT64_MAX;
+            }
+        voxdagi_bitmaps_free(m, &child);
+        child = cur;
+        memset(&cur, 0, sizeof cur);
+    }
+    if (st == VOXDAG_OK && (d->level[0].nodes != 1 || voxdagi_node_count(d, 0, 0) != d->voxels)) {
+        st = VOXDAG_ERR_CORRUPT; msg = "root does not hold the header's voxel count"; where = base; node = 0;
+    }
+    voxdagi_bitmaps_free(m, &child);
+    voxdagi_bitmaps_free(m, &cur);
+    return st == VOXDAG_OK ? VOXDAG_OK : voxdagi_fail(err, st, msg, where, node);
+}
+
+static int voxdagi_all_zero(const uint8_t *p, uint64_t n) {
+    while (n--)
+        if (*p++) return 0;
+    return 1;
+}
+
+/* Parses header and sections of IMG into D. DEEP: also verify checksums and
+   every record (skipped only for images this library just wrote). */
+static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, int deep,
+                                  uint32_t max_levels, uint64_t max_nodes, voxdagi_mem *m,
+                                  voxdag_error *err) {
+    uint32_t count, i, l, B, seen = 0;
+    uint64_t end, node_sum = 0, level_at = 0;
+    const uint8_t *levels = NULL, *nodes = NULL;
+    uint64_t nodes_size = 0;
+    d->image = img;
+    d->image_size = size;
+    if (size < VOXDAG_FILE_HEADER_SIZE)
+        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its header", size, UINT64_MAX);
+    if (memcmp(img, voxdagi_magic, 8))
+        return voxdagi_fail(err, VOXDAG_ERR_BAD_MAGIC, "bad magic bytes", 0, UINT64_MAX);
+    if (voxdagi_le(img + VOXDAG_FILE_OFF_VERSION, 4) != VOXDAG_FORMAT_VERSION)
+        return voxdagi_fail(err, VOXDAG_ERR_VERSION, "unsupported format version",
+                            VOXDAG_FILE_OFF_VERSION, UINT64_MAX);
+    {
+        uint8_t h[VOXDAG_FILE_HEADER_SIZE];
+        memcpy(h, img, sizeof h);
+        voxdagi_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
+        if (voxdagi_crc32c(h, sizeof h) != voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_CRC, 4))
+            return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "header checksum mismatch",
+                                VOXDAG_FILE_OFF_HEADER_CRC, UINT64_MAX);
+    }
+    if (voxdagi_le(img + VOXDAG_FILE_OFF_ENDIAN, 4) != VOXDAG_FILE_ENDIAN_TAG ||
+        voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_SIZE, 4) != VOXDAG_FILE_HEADER_SIZE ||
+        img[42] || img[43] || !voxdagi_all_zero(img + 56, 8))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad header field", VOXDAG_FILE_OFF_ENDIAN, UINT64_MAX);
+    d->flags = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_FLAGS, 4);
+    if (d->flags & ~VOXDAG_FILE_FLAG_SYMMETRIC)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "unknown header flags", VOXDAG_FILE_OFF_FLAGS, UINT64_MAX);
+    end = voxdagi_le(img + VOXDAG_FILE_OFF_FILE_SIZE, 8);
+    if (end > size)
+        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its declared size", size, UINT64_MAX);
+    if (end < size)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the file", end, UINT64_MAX);
+    d->voxels = voxdagi_le(img + VOXDAG_FILE_OFF_VOXELS, 8);
+    d->levels = img[VOXDAG_FILE_OFF_LEVELS];
+    d->root_mirror = img[VOXDAG_FILE_OFF_ROOT_MIRROR];
+    if (d->levels < 2 || d->levels > max_levels)
+        return voxdagi_fail(err, VOXDAG_ERR_LIMIT, "levels outside the accepted range",
+                            VOXDAG_FILE_OFF_LEVELS, UINT64_MAX);
+    if (d->root_mirror > 7 || d->voxels > (1ull << (3 * d->levels)))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad root mirror or voxel count",
+                            VOXDAG_FILE_OFF_VOXELS, UINT64_MAX);
+    count = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
+    if (count > VOXDAG_FILE_MAX_SECTIONS)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "too many sections", VOXDAG_FILE_OFF_SECTION_COUNT, UINT64_MAX);
+    end = VOXDAG_FILE_HEADER_SIZE + (uint64_t)count * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+    if (end > size)
+        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "section table runs past the end", size, UINT64_MAX);
+    if (voxdagi_crc32c(img + VOXDAG_FILE_HEADER_SIZE, end - VOXDAG_FILE_HEADER_SIZE) !=
+        voxdagi_le(img + VOXDAG_FILE_OFF_TABLE_CRC, 4))
+        return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "section table checksum mismatch",
+                            VOXDAG_FILE_OFF_TABLE_CRC, UINT64_MAX);
+    for (i = 0; i < count; i++) {
+        const uint8_t *e = img + VOXDAG_FILE_HEADER_SIZE + i * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+        uint32_t type = (uint32_t)voxdagi_le(e, 4), flags = (uint32_t)voxdagi_le(e + 4, 4);
+        uint64_t off = voxdagi_le(e + 8, 8), sz = voxdagi_le(e + 16, 8);
+        uint64_t at = (uint64_t)(e - img);
+        const uint8_t *p;
+        if ((flags & ~VOXDAG_FILE_SECTION_OPTIONAL) || voxdagi_le(e + 28, 4) || (off & 7) || off < end ||
+            off > size || sz > size - off || !voxdagi_all_zero(img + end, off - end))
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad section entry", at, UINT64_MAX);
+        if (type >= 1 && type <= VOXDAG_SECTION_BOUNDS) {
+            if (seen >> type & 1)
+                return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "duplicate section", at, UINT64_MAX);
+            seen |= 1u << type;
+        } else if (!(flags & VOXDAG_FILE_SECTION_OPTIONAL)) {
+            return voxdagi_fail(err, VOXDAG_ERR_VERSION, "unknown required section", at, UINT64_MAX);
+        }
+        if (deep && voxdagi_crc32c(img + off, sz) != voxdagi_le(e + 24, 4))
+            return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "section checksum mismatch", at + 24, UINT64_MAX);
+        end = off + sz;
+        p = img + off;
+        switch (type) {
+        case VOXDAG_SECTION_LEVELS: levels = p;
+            if (sz != (uint64_t)(d->levels - 2) * VOXDAG_FILE_LEVEL_ENTRY_SIZE)
+                return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level table size", at, UINT64_MAX);
+            break;
+        case VOXDAG_SECTION_NODES: nodes = p; nodes_size = sz; break;
+        case VOXDAG_SECTION_BRICKS:
+            if (sz & 7) return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "brick section size", at, UINT64_MAX);
+            d->bricks = p;
+            d->brick_count = sz / 8;
+            break;
+        case VOXDAG_SECTION_COLORS_RGB8:
+        case VOXDAG_SECTION_COLORS_VOXCOLOR:
+            if (d->color_kind != VOXDAG_COLORS_NONE)
+                return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "two colour sections", at, UINT64_MAX);
+            if (type == VOXDAG_SECTION_COLORS_RGB8 && (d->voxels > UINT64_MAX / 3 || sz != 3 * d->voxels))
+                return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "colour section size", at, UINT64_MAX);
+            d->color_kind = type == VOXDAG_SECTION_COLORS_RGB8 ? VOXDAG_COLORS_RGB8 : VOXDAG_COLORS_VOXCOLOR;
+            d->color = p;
+            d->color_size = sz;
+            break;
+        case VOXDAG_SECTION_BOUNDS: {
+            unsigned k;
+            if (sz != 48) return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bounds section size", at, UINT64_MAX);
+            for (k = 0; k < 6; k++) {
+                uint64_t bits = voxdagi_le(p + 8 * k, 8);
+                memcpy(&d->bounds[k], &bits, 8);
+            }
+            for (k = 0; k < 3; k++)
+                if (!(d->bounds[k] < d->bounds[k + 3]) || d->bounds[k + 3] - d->bounds[k] > 1e300)
+                    return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bounds not finite with min < max", off, UINT64_MAX);
+            d->has_bounds = 1;
+            break;
+        }
+        default: break;
+        }
+    }
+    if (end != size)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the last section", end, UINT64_MAX);
+    if (!levels || !nodes || !d->bricks)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "missing level, node or brick section");
+    B = d->levels - 2;
+    for (l = 0; l < B; l++) {
+        const uint8_t *e = levels + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
+        voxdagi_level *lv = &d->level[l];
+        uint64_t at = (uint64_t)(e - img);
+        lv->size = voxdagi_le(e + 8, 8);
+        lv->nodes = voxdagi_le(e + 16, 4);
+        lv->count_bytes = e[20];
+        lv->long_bytes = e[21];
+        if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at || e[22] || e[23] ||
+            lv->nodes > lv->size / 2 || lv->long_bytes < 4 || lv->long_bytes > 8 ||
+            (l + 1 < B ? lv->count_bytes < 1 || lv->count_bytes > 8 : lv->count_bytes != 0))
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad level entry", at, l);
+        lv->data = nodes + level_at;
+        level_at += lv->size;
+        node_sum += lv->nodes;
+    }
+    if (nodes_size != level_at + VOXDAG_FILE_NODE_PADDING ||
+        !voxdagi_all_zero(nodes + level_at, VOXDAG_FILE_NODE_PADDING))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "node section size or padding",
+                            (uint64_t)(nodes - img), UINT64_MAX);
+    d->node_bytes = level_at;
+    if (max_nodes && (node_sum > max_nodes || d->brick_count > max_nodes - node_sum))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more nodes than max_nodes");
+    if (!deep) return VOXDAG_OK;
+    return voxdagi_validate_nodes(d, m, err);
+}
+
+static voxdag_status voxdagi_new_dag(voxdagi_mem *m, voxdag **out) {
+    *out = (voxdag *)voxdagi_alloc(m, sizeof **out);
+    if (!*out) return VOXDAG_ERR_OUT_OF_MEMORY;
+    memset(*out, 0, sizeof **out);
+    (*out)->alloc = m->a;
+    return VOXDAG_OK;
+}
+
+VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
+                                            const voxdag_load_opts *opts, voxdag **out,
+                                            voxdag_error *err) {
+    voxdag_load_opts o;
+    voxdagi_mem m;
+    voxdag *d;
+    voxdag_status st;
+    if (!out || (!data && size)) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "data or out is NULL");
+    *out = NULL;
+    memset(&o, 0, sizeof o);
+    if (opts) o = *opts;
+    if (o.zero_begin || o.zero_end)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "load options not zero-initialized");
+    if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
+    if (o.max_input_bytes && size > o.max_input_bytes)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "input larger than max_input_bytes");
+    if (!o.max_levels || o.max_levels > VOXDAG_MAX_LEVELS) o.max_levels = VOXDAG_MAX_LEVELS;
+    voxdagi_mem_init(&m, &o.allocator, o.max_memory);
+    st = voxdagi_new_dag(&m, &d);
+    if (st != VOXDAG_OK) {
+        voxdagi_mem_destroy(&m);
+        return VOXDAGI_FAIL(err, st, "cannot allocate the DAG");
+    }
+    if (o.copy) {
+        d->owned = (uint8_t *)voxdagi_alloc(&m, size);
+        if (!d->owned) {
+            voxdag_free(d);
+            voxdagi_mem_destroy(&m);
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot copy the input");
+        }
+        d->owned_size = size;
+        if (size) memcpy(d->owned, data, size);
+        data = d->owned;
+    }
+    st = voxdagi_open(d, (const uint8_t *)data, size, 1, o.max_levels, o.max_nodes, &m, err);
+    voxdagi_mem_destroy(&m);
+    if (st != VOXDAG_OK) {
+        voxdag_free(d);
+        return st;
+    }
+    *out = d;
+    return voxdagi_ok(err);
+}
+
+// -- Finishing a build: encode into a file image
+
+static void voxdagi_write_bounds(uint8_t *p, const double *bounds) {
+    unsigned k;
+    for (k = 0; k < 6; k++) {
+        uint64_t bits;
+        memcpy(&bits, &bounds[k], 8);
+        voxdagi_put_le(p + 8 * k, bits, 8);
+    }
+}
+
+static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, voxdag_error *err) {
+    const voxdagi_reducer *r = &b->red[0];
+    voxdagi_encoder e;
+    voxdagi_layout lay;
+    uint32_t B = b->levels - 2, l;
+    uint64_t node_bytes = 0;
+    uint8_t *img;
+    voxdag *d;
+    voxdag_status st;
+    memset(&e, 0, sizeof e);
+    e.mem = &b->mem;
+    e.r = r;
+    e.levels = b->levels;
+    for (l = 0; l < B; l++) { /* what an empty scene's level table says */
+        e.long_bytes[l] = 4;
+        e.count_bytes[l] = l + 1 < B;
+    }
+    if (r->root != VOXDAGI_NONE && !voxdagi_encoder_plan(&e)) {
+        voxdagi_encoder_free(&e);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
+    }
+    for (l = 0; l < B; l++) node_bytes += e.size[l];
+    memset(&lay, 0, sizeof lay);
+    voxdagi_layout_add(&lay, VOXDAG_SECTION_LEVELS, 0, (uint64_t)B * VOXDAG_FILE_LEVEL_ENTRY_SIZE);
+    voxdagi_layout_add(&lay, VOXDAG_SECTION_NODES, 0, node_bytes + VOXDAG_FILE_NODE_PADDING);
+    voxdagi_layout_add(&lay, VOXDAG_SECTION_BRICKS, 0, 8 * (uint64_t)r->store[B].n);
+    if (b->opts.colors) voxdagi_layout_add(&lay, VOXDAG_SECTION_COLORS_RGB8, 0, 3 * b->voxels);
+    if (b->has_bounds) voxdagi_layout_add(&lay, VOXDAG_SECTION_BOUNDS, 0, 48);
+    st = voxdagi_new_dag(&b->mem, &d);
+    img = !voxdagi_layout_place(&lay) || st != VOXDAG_OK ? NULL
+                                                        : (uint8_t *)voxdagi_alloc(&b->mem, (size_t)lay.total);
+    if (!img) {
+        voxdagi_encoder_free(&e);
+        if (d) voxdag_free(d);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file image");
+    }
+    memset(img, 0, (size_t)lay.total);
+    voxdagi_encoder_write(&e, voxdagi_layout_section(img, &lay, VOXDAG_SECTION_LEVELS),
+                          voxdagi_layout_section(img, &lay, VOXDAG_SECTION_NODES),
+                          voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BRICKS));
+    voxdagi_encoder_free(&e);
+    if (b->opts.colors && b->voxels)
+        memcpy(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_COLORS_RGB8), b->colors, 3 * (size_t)b->voxels);
+    if (b->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), b->bounds);
+    voxdagi_layout_seal(img, &lay, b->opts.no_symmetry ? 0 : VOXDAG_FILE_FLAG_SYMMETRIC, b->levels,
+                        r->root == VOXDAGI_NONE ? 0 : r->root & 7, b->voxels);
+    d->owned = img;
+    d->owned_size = (size_t)lay.total;
+    st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &b->mem, err);
+    if (st != VOXDAG_OK) {
+        voxdag_free(d);
+        return st;
+    }
+    *out = d;
+    return VOXDAG_OK;
+}
+
+VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
+                                               voxdag_build_stats *stats, voxdag_error *err) {
+    voxdag_status st;
+    unsigned k;
+    uint32_t l;
+    if (!b || !out) {
+        voxdag_builder_free(b);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "builder or out is NULL");
+    }
+    *out = NULL;
+    st = b->failed ? b->failed : voxdagi_builder_reduce(b, 1);
+    if (st != VOXDAG_OK) {
+        voxdag_builder_free(b);
+        return VOXDAGI_FAIL(err, st, "out of memory while reducing voxels");
+    }
+    if (b->opts.progress) b->opts.progress(b->opts.progress_user, "reduce", 1.0);
+    for (k = 0; k < b->red_count; k++) {
+        voxdagi_reducer_finish(&b->red[k]);
+        if (b->red[k].failed) {
+            voxdag_builder_free(b);
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while reducing voxels");
+        }
+    }
+    if (stats) {
+        memset(stats, 0, sizeof *stats);
+        stats->levels = b->levels;
+        stats->voxels = b->voxels;
+        for (l = 0; l + 1 < b->levels; l++) {
+            stats->nodes[l] = b->red[0].store[l].n;
+            stats->svo_nodes[l] = b->red[0].store[l].svo;
+            if (b->red_count == 2) {
+                stats->ssvdag_nodes[l] = b->red[b->opts.no_symmetry].store[l].n;
+                stats->svdag_nodes[l] = b->red[!b->opts.no_symmetry].store[l].n;
+            }
+        }
+    }
+    /* The colour buffer is not needed past the encoder's copy; the pending
+       buffer is empty now. */
+    voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *b->pend_code);
+    voxdagi_free(&b->mem, b->pend_rgb, b->opts.colors ? b->pend_cap * sizeof *b->pend_rgb : 0);
+    b->pend_code = NULL;
+    b->pend_rgb = NULL;
+    b->pend_cap = 0;
+    st = voxdagi_builder_encode(b, out, err);
+    if (stats) stats->peak_memory = b->mem.peak;
+    if (b->opts.progress) b->opts.progress(b->opts.progress_user, "encode", 1.0);
+    /* The DAG's memory came from the builder's allocator; keep it out of the
+       builder's accounting so freeing the builder balances. */
+    if (*out) b->mem.used -= sizeof(voxdag) + (*out)->owned_size;
+    voxdag_builder_free(b);
+    if (st == VOXDAG_OK) voxdagi_ok(err);
+    return st;
+}
+
+// -- Colours
+
+VOXDAG_API voxdag_color_kind voxdag_colors(const voxdag *dag, const void **payload, size_t *size) {
+    if (payload) *payload = dag->color;
+    if (size) *size = (size_t)dag->color_size;
+    return dag->color_kind;
+}
+
+VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]) {
+    if (dag->color_kind != VOXDAG_COLORS_RGB8 || index >= dag->voxels) return 0;
+    memcpy(rgb, dag->color + 3 * index, 3);
+    return 1;
+}
+
+VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind kind,
+                                            const void *payload, size_t size, voxdag **out,
+                                            voxdag_error *err) {
+    static const uint32_t copied[] = {VOXDAG_SECTION_LEVELS, VOXDAG_SECTION_NODES, VOXDAG_SECTION_BRICKS};
+    voxdagi_layout lay;
+    voxdagi_mem m;
+    voxdag *d;
+    uint8_t *img;
+    const uint8_t *parts[3];
+    uint64_t sizes[3];
+    voxdag_status st;
+    unsigned i;
+    if (!src || !out || (size && !payload) || kind > VOXDAG_COLORS_VOXCOLOR)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "bad argument");
+    *out = NULL;
+    if (kind == VOXDAG_COLORS_RGB8 && (src->voxels > UINT64_MAX / 3 || size != 3 * src->voxels))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "RGB8 colours need 3 bytes per voxel");
+    parts[0] = src->image + VOXDAG_FILE_HEADER_SIZE; /* placeholder, replaced below */
+    sizes[0] = (uint64_t)(src->levels - 2) * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
+    parts[1] = src->level[0].data ? src->level[0].data : NULL;
+    sizes[1] = src->node_bytes + VOXDAG_FILE_NODE_PADDING;
+    parts[2] = src->bricks;
+    sizes[2] = 8 * src->brick_count;
+    {   /* the level table and node section start where the source's do */
+        uint32_t k, count = (uint32_t)voxdagi_le(src->image + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
+        for (k = 0; k < count; k++) {
+            const uint8_t *e = src->image + VOXDAG_FILE_HEADER_SIZE + k * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+            uint32_t type = (uint32_t)voxdagi_le(e, 4);
+            if (type == VOXDAG_SECTION_LEVELS) parts[0] = src->image + voxdagi_le(e + 8, 8);
+            if (type == VOXDAG_SECTION_NODES) parts[1] = src->image + voxdagi_le(e + 8, 8);
+        }
+    }
+    memset(&lay, 0, sizeof lay);
+    for (i = 0; i < 3; i++) voxdagi_layout_add(&lay, copied[i], 0, sizes[i]);
+    if (kind != VOXDAG_COLORS_NONE)
+        voxdagi_layout_add(&lay, kind == VOXDAG_COLORS_RGB8 ? VOXDAG_SECTION_COLORS_RGB8 : VOXDAG_SECTION_COLORS_VOXCOLOR,
+                           0, size);
+    if (src->has_bounds) voxdagi_layout_add(&lay, VOXDAG_SECTION_BOUNDS, 0, 48);
+    voxdagi_mem_init(&m, &src->alloc, 0);
+    st = voxdagi_new_dag(&m, &d);
+    img = st != VOXDAG_OK || !voxdagi_layout_place(&lay) ? NULL : (uint8_t *)voxdagi_alloc(&m, (size_t)lay.total);
+    if (!img) {
+        if (d) voxdag_free(d);
+        voxdagi_mem_destroy(&m);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file image");
+    }
+    memset(img, 0, (size_t)lay.total);
+    for (i = 0; i < 3; i++)
+        if (sizes[i]) memcpy(img + lay.offset[i], parts[i], (size_t)sizes[i]);
+    if (kind != VOXDAG_COLORS_NONE && size) memcpy(img + lay.offset[3], payload, size);
+    if (src->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), src->bounds);
+    voxdagi_layout_seal(img, &lay, src->flags, src->levels, src->root_mirror, src->voxels);
+    d->owned = img;
+    d->owned_size = (size_t)lay.total;
+    st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &m, err);
+    voxdagi_mem_destroy(&m);
+    if (st != VOXDAG_OK) {
+        voxdag_free(d);
+        return st;
+    }
+    *out = d;
+    return voxdagi_ok(err);
+}
+
+// -- Queries
+
+VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
+    uint32_t l, B = dag->levels - 2;
+    memset(info, 0, sizeof *info);
+    info->levels = dag->levels;
+    info->symmetric = (dag->flags & VOXDAG_FILE_FLAG_SYMMETRIC) != 0;
+    info->voxels = dag->voxels;
+    for (l = 0; l < B; l++) {
+        info->nodes[l] = dag->level[l].nodes;
+        info->level_bytes[l] = dag->level[l].size;
+    }
+    info->nodes[B] = dag->brick_count;
+    info->level_bytes[B] = 8 * dag->brick_count;
+    info->file_bytes = dag->image_size;
+    info->node_bytes = dag->node_bytes;
+    info->brick_bytes = 8 * dag->brick_count;
+    info->color_bytes = dag->color_size;
+    info->color_kind = dag->color_kind;
+    info->has_bounds = dag->has_bounds;
+    memcpy(info->bounds, dag->bounds, sizeof info->bounds);
+}
+
+/* Voxel index during descent (DESIGN 3.5): at a node reached with mirror M,
+   world octant w is stored in octant w ^ M; the stored children j with
+   (j ^ M) < w precede it in world order, so their counts are added. */
+VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z, uint64_t *index) {
+    uint32_t L = dag->levels, B = L - 2, l;
+    unsigned M = dag->root_mirror, p, sp;
+    uint64_t at = 0, idx = 0, mask;
+    if (!dag->voxels || (x | y | z) >> L) return 0;
+    for (l = 0; l < B; l++) {
+        const voxdagi_level *lv = &dag->level[l];
+        const uint8_t *rec = lv->data + at;
+        unsigned header = (unsigned)voxdagi_le(rec, 2), sh = L - 1 - l, j, v;
+        unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
+        uint64_t ptr;
+        if (index)
+            for (j = 0; j < 8; j++)
+                if ((header >> (2 * j) & 3) && (j ^ M) < w)
+                    idx += voxdagi_node_count(dag, l + 1, voxdagi_child(lv, rec, header, j) >> 3);
+        v = w ^ M;
+        if (!(header >> (2 * v) & 3)) return 0;
+        ptr = voxdagi_child(lv, rec, header, v);
+        M ^= (unsigned)(ptr & 7);
+        at = ptr >> 3;
+    }
+    mask = voxdagi_brick(dag, at);
+    p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
+    sp = p ^ (M | M << 3);
+    if (!(mask >> sp & 1)) return 0;
+    if (index) {
+        mask = voxdagi_reflect_brick(mask, M);
+        *index = idx + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
+    }
+    return 1;
+}
+
+/* Depth-first walk in world Morton order with an explicit stack. */
+VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn, void *user) {
+    struct frame {
+        uint64_t at;
+        uint32_t x, y, z;
+        unsigned mirror, next;
+    } stack[VOXDAG_MAX_LEVELS];
+    uint32_t L = dag->levels, B = L - 2;
+    uint64_t index = 0;
+    int depth = 0;
+    if (!dag->voxels) return 0;
+    stack[0].at = 0;
+    stack[0].x = stack[0].y = stack[0].z = 0;
+    stack[0].mirror = dag->root_mirror;
+    stack[0].next = 0;
+    while (depth >= 0) {
+        struct frame *f = &stack[depth];
+        if ((uint32_t)depth == B) { /* a brick */
+            uint64_t mask = voxdagi_reflect_brick(voxdagi_brick(dag, f->at), f->mirror);
+            while (mask) {
+                unsigned p = (unsigned)voxdagi_popcount64((mask & (0 - mask)) - 1);
+                uint32_t bx, by, bz;
+                voxdag_morton_decode(p, &bx, &by, &bz);
+                if (fn && fn(user, f->x + bx, f->y + by, f->z + bz, index)) return index + 1;
+                index++;
+                mask &= mask - 1;
+            }
+            depth--;
+            continue;
+        }
+        {
+            const voxdagi_level *lv = &dag->level[depth];
+            const uint8_t *rec = lv->data + f->at;
+            unsigned header = (unsigned)voxdagi_le(rec, 2);
+            uint32_t half = 1u << (L - 1 - depth);
+            while (f->next < 8 && !(header >> (2 * (f->next ^ f->mirror)) & 3)) f->next++;
+            if (f->next == 8) {
+                depth--;
+                continue;
+            }
+            {
+                unsigned w = f->next++;
+                uint64_t ptr = voxdagi_child(lv, rec, header, w ^ f->mirror);
+                struct frame *c = &stack[depth + 1];
+                c->at = ptr >> 3;
+                c->mirror = f->mirror ^ (unsigned)(ptr & 7);
+                c->x = f->x + (w & 1 ? half : 0);
+                c->y = f->y + (w & 2 ? half : 0);
+                c->z = f->z + (w & 4 ? half : 0);
+                c->next = 0;
+                depth++;
+            }
+        }
+    }
+    return index;
+}
+
+// -- Files
+
+#ifndef VOXDAG_NO_STDIO
+VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_opts *opts,
+                                          voxdag **out, voxdag_error *err) {
+    voxdag_load_opts o;
+    voxdagi_mem m;
+    FILE *f;
+    long len;
+    uint8_t *buf;
+    voxdag_status st;
+    if (!path || !out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "path or out is NULL");
+    *out = NULL;
+    memset(&o, 0, sizeof o);
+    if (opts) o = *opts;
+    if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
+    f = fopen(path, "rb");
+    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot open the file");
+    if (fseek(f, 0, SEEK_END) || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
+        fclose(f);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot size the file");
+    }
+    if (o.max_input_bytes && (uint64_t)len > o.max_input_bytes) {
+        fclose(f);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "input larger than max_input_bytes");
+    }
+    voxdagi_mem_init(&m, &o.allocator, 0);
+    buf = (uint8_t *)voxdagi_alloc(&m, (size_t)len);
+    if (!buf) {
+        fclose(f);
+        voxdagi_mem_destroy(&m);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file buffer");
+    }
+    if (len && fread(buf, 1, (size_t)len, f) != (size_t)len) {
+        fclose(f);
+        voxdagi_free(&m, buf, (size_t)len);
+        voxdagi_mem_destroy(&m);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot read the file");
+    }
+    fclose(f);
+    o.copy = 0;
+    st = voxdag_load_memory(buf, (size_t)len, &o, out, err);
+    if (st != VOXDAG_OK) {
+        voxdagi_free(&m, buf, (size_t)len);
+    } else {
+        (*out)->owned = buf; /* the DAG takes the buffer */
+        (*out)->owned_size = (size_t)len;
+    }
+    voxdagi_mem_destroy(&m);
+    return st;
+}
+
+VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path, voxdag_error *err) {
+    FILE *f;
+    int ok;
+    if (!dag || !path) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "dag or path is NULL");
+    f = fopen(path, "wb");
+    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot create the file");
+    ok = fwrite(dag->image, 1, dag->image_size, f) == dag->image_size;
+    ok = (fclose(f) == 0) && ok;
+    if (!ok) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot write the file");
+    return voxdagi_ok(err);
+}
+#endif
+
+#endif /* VOXDAG_IMPLEMENTED */
+#endif /* VOXDAG_IMPLEMENTATION */
+
+/*
+MIT License. Copyright (c) 2026 The voxdag authors.
+Permission is hereby granted, free of charge, to any person obtaining a copy of
+this software and associated documentation files (the "Software"), to deal in
+the Software without restriction, including without limitation the rights to
+use, copy, modify, merge, publish, distribute, sublicense, and/or sell copies of
+the Software, and to permit persons to whom the Software is furnished to do so,
+subject to the following conditions: The above copyright notice and this
+permission notice shall be included in all copies or substantial portions of
+the Software. THE SOFTWARE IS PROVIDED "AS IS", WITHOUT WARRANTY OF ANY KIND,
+EXPRESS OR IMPLIED. IN NO EVENT SHALL THE AUTHORS OR COPYRIGHT HOLDERS BE LIABLE
+FOR ANY CLAIM, DAMAGES OR OTHER LIABILITY ARISING FROM THE SOFTWARE.
+*/

@@ -1,9 +1,612 @@
+/* Oracle tests of the builder and the queries: every result is compared with
+   a brute-force answer computed here from a dense grid, independently of the
+   library's own logic (raster-order subtree contents, sorting, rank). */
 #include "test.h"
 #include "voxdag.h"
 
-static void test_version(void) { CHECK(VOXDAG_VERSION_MAJOR == 0); }
+// -- Scenes on a dense grid
+
+typedef struct scene {
+    uint32_t levels, n; /* n = 2^levels */
+    uint8_t *full;      /* n^3, index x + n*(y + n*z) */
+    uint8_t *rgb;       /* 3 per grid cell */
+} scene;
+
+static size_t cell(const scene *s, uint32_t x, uint32_t y, uint32_t z) {
+    return (size_t)x + (size_t)s->n * ((size_t)y + (size_t)s->n * z);
+}
+
+static scene scene_new(uint32_t levels, uint64_t seed) {
+    scene s;
+    size_t i, cells;
+    s.levels = levels;
+    s.n = 1u << levels;
+    cells = (size_t)s.n * s.n * s.n;
+    s.full = (uint8_t *)calloc(cells, 1);
+    s.rgb = (uint8_t *)malloc(cells * 3);
+    for (i = 0; i < cells * 3; i++) s.rgb[i] = (uint8_t)test_rand(&seed);
+    return s;
+}
+
+static void scene_free(scene *s) {
+    free(s->full);
+    free(s->rgb);
+}
+
+enum { SC_EMPTY, SC_ONE, SC_FULL, SC_NOISE_SPARSE, SC_NOISE_DENSE, SC_SPHERE, SC_PLANE,
+       SC_HEIGHT, SC_MIRRORED_BLOB, SC_CORNERS, SC_COUNT };
+static const char *const scene_names[SC_COUNT] = {"empty", "one voxel", "full", "sparse noise",
+    "dense noise", "sphere", "tilted plane", "heightfield", "mirrored blob", "corners"};
+
+static scene make_scene(int kind, uint32_t levels, uint64_t seed) {
+    scene s = scene_new(levels, seed);
+    uint32_t n = s.n, x, y, z;
+    uint64_t r = seed * 7919 + 17;
+    size_t i, cells = (size_t)n * n * n;
+    switch (kind) {
+    case SC_EMPTY: break;
+    case SC_ONE: s.full[cell(&s, test_rand_below(&r, n), test_rand_below(&r, n), test_rand_below(&r, n))] = 1; break;
+    case SC_FULL: memset(s.full, 1, cells); break;
+    case SC_NOISE_SPARSE:
+        for (i = 0; i < cells / 50 + 1; i++) s.full[test_rand(&r) % cells] = 1;
+        break;
+    case SC_NOISE_DENSE:
+        for (i = 0; i < cells; i++) s.full[i] = (test_rand(&r) & 1) != 0;
+        break;
+    case SC_SPHERE: {
+        double c = n / 2.0 - 0.3, rad = n * 0.37;
+        for (z = 0; z < n; z++)
+            for (y = 0; y < n; y++)
+                for (x = 0; x < n; x++) {
+                    double dx = x + 0.5 - c, dy = y + 0.5 - c, dz = z + 0.5 - c;
+                    double d = dx * dx + dy * dy + dz * dz;
+                    s.full[cell(&s, x, y, z)] = d <= rad * rad && d >= (rad - 1.5) * (rad - 1.5);
+                }
+        break;
+    }
+    case SC_PLANE:
+        for (z = 0; z < n; z++)
+            for (y = 0; y < n; y++)
+                for (x = 0; x < n; x++) s.full[cell(&s, x, y, z)] = (x + 2 * y + 3 * z) / 3 == n / 2;
+        break;
+    case SC_HEIGHT:
+        for (y = 0; y < n; y++)
+            for (x = 0; x < n; x++) {
+                uint32_t h = (uint32_t)(n / 3 + (n / 5) * ((x * 7 + y * 3) % 11) / 11 + ((x ^ y) & 1));
+                for (z = 0; z <= h && z < n; z++) s.full[cell(&s, x, y, z)] = 1;
+            }
+        break;
+    case SC_MIRRORED_BLOB: {
+        /* a random blob in the lower octant, reflected into all 8 octants */
+        uint32_t h = n / 2, m;
+        for (i = 0; i < (size_t)h * h * h / 3 + 1; i++) {
+            uint32_t bx = test_rand_below(&r, h), by = test_rand_below(&r, h), bz = test_rand_below(&r, h);
+            for (m = 0; m < 8; m++)
+                s.full[cell(&s, m & 1 ? n - 1 - bx : bx, m & 2 ? n - 1 - by : by, m & 4 ? n - 1 - bz : bz)] = 1;
+        }
+        break;
+    }
+    case SC_CORNERS:
+        for (i = 0; i < 8; i++) s.full[cell(&s, i & 1 ? n - 1 : 0, i & 2 ? n - 1 : 0, i & 4 ? n - 1 : 0)] = 1;
+        break;
+    }
+    return s;
+}
+
+/* The full voxels as coordinate triples in raster order, with colours. */
+static size_t scene_voxels(const scene *s, uint32_t **xyz, uint8_t **rgb) {
+    size_t count = 0, k = 0, i;
+    uint32_t x, y, z;
+    for (i = 0; i < (size_t)s->n * s->n * s->n; i++) count += s->full[i];
+    *xyz = (uint32_t *)malloc(3 * count * sizeof **xyz + 1);
+    *rgb = (uint8_t *)malloc(3 * count + 1);
+    for (z = 0; z < s->n; z++)
+        for (y = 0; y < s->n; y++)
+            for (x = 0; x < s->n; x++) {
+                size_t c = cell(s, x, y, z);
+                if (!s->full[c]) continue;
+                (*xyz)[3 * k] = x;
+                (*xyz)[3 * k + 1] = y;
+                (*xyz)[3 * k + 2] = z;
+                memcpy(*rgb + 3 * k, s->rgb + 3 * c, 3);
+                k++;
+            }
+    return count;
+}
+
+// -- Brute-force node counts: distinct subtree contents per level
+
+static size_t key_bytes_global;
+static int key_cmp(const void *a, const void *b) { return memcmp(a, b, key_bytes_global); }
+
+/* Content of the cell of size SIZE at (cx,cy,cz) seen through reflection M,
+   as raster-order bits. Returns 1 when the cell is not empty. */
+static int cell_key(const scene *s, uint32_t size, uint32_t cx, uint32_t cy, uint32_t cz, unsigned m, uint8_t *key) {
+    uint32_t x, y, z, bit = 0;
+    int any = 0;
+    memset(key, 0, (size_t)size * size * size / 8);
+    for (z = 0; z < size; z++)
+        for (y = 0; y < size; y++)
+            for (x = 0; x < size; x++, bit++) {
+                uint32_t sx = m & 1 ? size - 1 - x : x, sy = m & 2 ? size - 1 - y : y, sz = m & 4 ? size - 1 - z : z;
+                if (s->full[cell(s, cx * size + sx, cy * size + sy, cz * size + sz)]) {
+                    key[bit >> 3] |= (uint8_t)(1u << (bit & 7));
+                    any = 1;
+                }
+            }
+    return any;
+}
+
+/* Counts per level 0..L-2 of: nonempty cells (SVO), distinct contents (SVDAG),
+   and distinct contents up to the 8 reflections (SSVDAG). */
+static void brute_counts(const scene *s, uint64_t *svo, uint64_t *svdag, uint64_t *ssvdag) {
+    uint32_t l;
+    for (l = 0; l + 1 < s->levels; l++) {
+        uint32_t size = s->n >> l, cells = 1u << l, cx, cy, cz;
+        size_t kb = (size_t)size * size * size / 8, count = 0, i;
+        uint8_t *keys = (uint8_t *)malloc(kb * (size_t)cells * cells * cells);
+        uint8_t *sym = (uint8_t *)malloc(kb * (size_t)cells * cells * cells);
+        uint8_t *tmp = (uint8_t *)malloc(kb);
+        for (cz = 0; cz < cells; cz++)
+            for (cy = 0; cy < cells; cy++)
+                for (cx = 0; cx < cells; cx++) {
+                    unsigned m;
+                    if (!cell_key(s, size, cx, cy, cz, 0, keys + count * kb)) continue;
+                    memcpy(sym + count * kb, keys + count * kb, kb);
+                    for (m = 1; m < 8; m++) {
+                        cell_key(s, size, cx, cy, cz, m, tmp);
+                        if (memcmp(tmp, sym + count * kb, kb) < 0) memcpy(sym + count * kb, tmp, kb);
+                    }
+                    count++;
+                }
+        key_bytes_global = kb;
+        qsort(keys, count, kb, key_cmp);
+        qsort(sym, count, kb, key_cmp);
+        svo[l] = count;
+        svdag[l] = ssvdag[l] = 0;
+        for (i = 0; i < count; i++) {
+            if (i == 0 || memcmp(keys + i * kb, keys + (i - 1) * kb, kb)) svdag[l]++;
+            if (i == 0 || memcmp(sym + i * kb, sym + (i - 1) * kb, kb)) ssvdag[l]++;
+        }
+        free(keys);
+        free(sym);
+        free(tmp);
+    }
+}
+
+// -- Building helpers
+
+static voxdag *build(const scene *s, int symmetric, uint32_t threads, int compare, voxdag_build_stats *stats) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    uint32_t *xyz;
+    uint8_t *rgb;
+    size_t n = scene_voxels(s, &xyz, &rgb);
+    memset(&o, 0, sizeof o);
+    o.levels = s->levels;
+    o.no_symmetry = !symmetric;
+    o.colors = 1;
+    o.threads = threads;
+    o.compare_structures = compare;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add(b, xyz, rgb, n, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, stats, NULL) == VOXDAG_OK);
+    free(xyz);
+    free(rgb);
+    return d;
+}
+
+typedef struct morton_voxel {
+    uint64_t code;
+    size_t cell;
+} morton_voxel;
+
+static int morton_cmp(const void *a, const void *b) {
+    uint64_t x = ((const morton_voxel *)a)->code, y = ((const morton_voxel *)b)->code;
+    return x < y ? -1 : x > y;
+}
+
+/* Morton code computed bit by bit (independent of voxdag_morton_encode). */
+static uint64_t slow_morton(uint32_t x, uint32_t y, uint32_t z, uint32_t levels) {
+    uint64_t c = 0;
+    uint32_t l;
+    for (l = levels; l-- > 0;) c = c << 3 | (x >> l & 1) | (y >> l & 1) << 1 | (z >> l & 1) << 2;
+    return c;
+}
+
+/* Full voxels sorted by Morton code: position = expected voxel index. */
+static size_t sorted_voxels(const scene *s, morton_voxel **out) {
+    size_t count = 0, cells = (size_t)s->n * s->n * s->n, i;
+    uint32_t x, y, z;
+    for (i = 0; i < cells; i++) count += s->full[i];
+    *out = (morton_voxel *)malloc(count * sizeof **out + 1);
+    count = 0;
+    for (z = 0; z < s->n; z++)
+        for (y = 0; y < s->n; y++)
+            for (x = 0; x < s->n; x++)
+                if (s->full[cell(s, x, y, z)]) {
+                    (*out)[count].code = slow_morton(x, y, z, s->levels);
+                    (*out)[count].cell = cell(s, x, y, z);
+                    count++;
+                }
+    qsort(*out, count, sizeof **out, morton_cmp);
+    return count;
+}
+
+typedef struct export_check {
+    const scene *s;
+    const morton_voxel *sorted;
+    size_t count, seen;
+    int bad;
+} export_check;
+
+static int export_cb(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    export_check *e = (export_check *)user;
+    if (index != e->seen || e->seen >= e->count || e->sorted[e->seen].cell != cell(e->s, x, y, z)) e->bad++;
+    e->seen++;
+    return 0;
+}
+
+/* Every query of D against the dense grid and the sorted voxel list. */
+static void check_queries(const scene *s, const voxdag *d, const char *what) {
+    morton_voxel *sorted;
+    size_t count = sorted_voxels(s, &sorted), i, cells = (size_t)s->n * s->n * s->n;
+    size_t step = cells > 300000 ? 7 : 1, bad_lookup = 0, bad_index = 0, bad_color = 0;
+    uint64_t *rank = (uint64_t *)malloc(cells * sizeof *rank);
+    voxdag_info info;
+    export_check e;
+    uint32_t x, y, z;
+    for (i = 0; i < count; i++) rank[sorted[i].cell] = i;
+    voxdag_get_info(d, &info);
+    CHECK_MSG(info.voxels == count, "%s: %llu voxels, expected %llu", what,
+              (unsigned long long)info.voxels, (unsigned long long)count);
+    for (i = 0; i < cells; i += step) {
+        uint64_t index = UINT64_MAX;
+        uint8_t c[3];
+        int hit;
+        x = (uint32_t)(i % s->n);
+        y = (uint32_t)(i / s->n % s->n);
+        z = (uint32_t)(i / s->n / s->n);
+        hit = voxdag_lookup(d, x, y, z, &index);
+        if (hit != s->full[i]) bad_lookup++;
+        if (!hit) continue;
+        if (index != rank[i]) bad_index++;
+        if (!voxdag_color(d, index, c) || memcmp(c, s->rgb + 3 * i, 3)) bad_color++;
+    }
+    /* every full voxel, when the sweep above was sampled */
+    for (i = 0; step > 1 && i < count; i++) {
+        uint64_t index = UINT64_MAX;
+        size_t c = sorted[i].cell;
+        if (!voxdag_lookup(d, (uint32_t)(c % s->n), (uint32_t)(c / s->n % s->n), (uint32_t)(c / s->n / s->n), &index) ||
+            index != i)
+            bad_index++;
+    }
+    CHECK_MSG(!bad_lookup && !bad_index && !bad_color, "%s: %zu lookups, %zu indices, %zu colours wrong", what,
+              bad_lookup, bad_index, bad_color);
+    CHECK(voxdag_lookup(d, s->n, 0, 0, NULL) == 0);
+    CHECK(voxdag_lookup(d, 0, 0, UINT32_MAX, NULL) == 0);
+    e.s = s;
+    e.sorted = sorted;
+    e.count = count;
+    e.seen = 0;
+    e.bad = 0;
+    CHECK(voxdag_for_each_voxel(d, export_cb, &e) == count);
+    CHECK_MSG(!e.bad && e.seen == count, "%s: export differs from the Morton-sorted voxels", what);
+    free(rank);
+    free(sorted);
+}
+
+static void check_counts(const scene *s, const voxdag_build_stats *st, int symmetric, const uint64_t *svo,
+                         const uint64_t *svdag, const uint64_t *ssvdag, const char *what) {
+    uint32_t l;
+    for (l = 0; l + 1 < s->levels; l++) {
+        uint64_t want = symmetric ? ssvdag[l] : svdag[l];
+        CHECK_MSG(st->nodes[l] == want, "%s level %u: %llu nodes, brute force %llu", what, l,
+                  (unsigned long long)st->nodes[l], (unsigned long long)want);
+        CHECK_MSG(st->svo_nodes[l] == svo[l], "%s level %u: %llu SVO nodes, brute force %llu", what, l,
+                  (unsigned long long)st->svo_nodes[l], (unsigned long long)svo[l]);
+        CHECK(st->svdag_nodes[l] == svdag[l]);
+        CHECK(st->ssvdag_nodes[l] == ssvdag[l]);
+    }
+}
+
+// -- Test cases
+
+/* Every scene kind at L = 2..6, the larger ones at L = 7 and 8: node counts
+   per level equal brute-force distinct contents, with and without symmetry;
+   every query agrees with the grid. */
+static int oracle_wanted(int kind, uint32_t levels) {
+    if (levels <= 6) return 1;
+    if (levels == 7) return kind == SC_SPHERE || kind == SC_MIRRORED_BLOB || kind == SC_HEIGHT || kind == SC_NOISE_SPARSE;
+    return kind == SC_SPHERE || kind == SC_MIRRORED_BLOB;
+}
+
+static void test_oracle_scenes(void) {
+    uint32_t levels;
+    int kind;
+    for (levels = 2; levels <= 8; levels++)
+        for (kind = 0; kind < SC_COUNT; kind++) {
+            uint64_t svo[VOXDAG_MAX_LEVELS], svdag[VOXDAG_MAX_LEVELS], ssvdag[VOXDAG_MAX_LEVELS];
+            scene s;
+            int sym;
+            if (!oracle_wanted(kind, levels)) continue;
+            s = make_scene(kind, levels, 1000 + levels * 31 + (uint64_t)kind);
+            brute_counts(&s, svo, svdag, ssvdag);
+            for (sym = 0; sym < 2; sym++) {
+                voxdag_build_stats st;
+                char what[96];
+                voxdag *d = build(&s, sym, 1 + (levels & 1), 1, &st);
+                snprintf(what, sizeof what, "%s L=%u %s", scene_names[kind], levels, sym ? "symmetric" : "plain");
+                if (!d) continue;
+                check_counts(&s, &st, sym, svo, svdag, ssvdag, what);
+                check_queries(&s, d, what);
+                voxdag_free(d);
+            }
+            scene_free(&s);
+        }
+}
+
+/* The mirrored blob must merge across octants: the root's 8 children are one
+   node with symmetry on. */
+static void test_mirrored_blob_merges(void) {
+    scene s = make_scene(SC_MIRRORED_BLOB, 6, 77);
+    voxdag_build_stats st;
+    voxdag *d = build(&s, 1, 1, 1, &st);
+    CHECK(st.nodes[1] == 1);
+    CHECK(st.svdag_nodes[1] == 8);
+    voxdag_free(d);
+    scene_free(&s);
+}
+
+/* The same voxels give byte-identical files whatever the order of input,
+   the chunking and the thread count. */
+static void test_determinism(void) {
+    int kind;
+    for (kind = 0; kind < SC_COUNT; kind++) {
+        scene s = make_scene(kind, 7, 4242 + (uint64_t)kind);
+        uint32_t *xyz;
+        uint8_t *rgb;
+        size_t n = scene_voxels(&s, &xyz, &rgb), i, size0, size1;
+        voxdag *ref = build(&s, 1, 1, 0, NULL);
+        const void *img0 = voxdag_image(ref, &size0);
+        uint32_t threads;
+        uint64_t seed = 99;
+        for (threads = 1; threads <= 4; threads++) {
+            voxdag_build_opts o;
+            voxdag_builder *b;
+            voxdag *d = NULL;
+            memset(&o, 0, sizeof o);
+            o.levels = 7;
+            o.colors = 1;
+            o.threads = threads;
+            /* shuffled input, added in pieces, with a duplicate of every 5th voxel */
+            for (i = n; i > 1; i--) {
+                size_t j = test_rand(&seed) % i;
+                uint32_t t[3];
+                uint8_t c[3];
+                memcpy(t, xyz + 3 * (i - 1), sizeof t);
+                memcpy(xyz + 3 * (i - 1), xyz + 3 * j, sizeof t);
+                memcpy(xyz + 3 * j, t, sizeof t);
+                memcpy(c, rgb + 3 * (i - 1), 3);
+                memcpy(rgb + 3 * (i - 1), rgb + 3 * j, 3);
+                memcpy(rgb + 3 * j, c, 3);
+            }
+            CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+            for (i = 0; i < n; i += 1000) {
+                size_t k = n - i < 1000 ? n - i : 1000;
+                CHECK(voxdag_builder_add(b, xyz + 3 * i, rgb + 3 * i, k, NULL) == VOXDAG_OK);
+            }
+            for (i = 0; i < n; i += 5) CHECK(voxdag_builder_add(b, xyz + 3 * i, rgb + 3 * i, 1, NULL) == VOXDAG_OK);
+            CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+            if (d) {
+                const void *img1 = voxdag_image(d, &size1);
+                CHECK_MSG(size0 == size1 && !memcmp(img0, img1, size0), "%s: image differs with %u threads",
+                          scene_names[kind], threads);
+            }
+            voxdag_free(d);
+        }
+        voxdag_free(ref);
+        free(xyz);
+        free(rgb);
+        scene_free(&s);
+    }
+}
+
+/* Streaming: Morton-ordered chunks flushed one by one (subtrees of 16^3) give
+   the same file as one batch; a voxel before a flushed one is refused. */
+static void test_streaming_chunks(void) {
+    scene s = make_scene(SC_SPHERE, 7, 5);
+    morton_voxel *sorted;
+    size_t count = sorted_voxels(&s, &sorted), i, size0, size1;
+    voxdag *ref = build(&s, 1, 2, 0, NULL), *d = NULL;
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    uint32_t xyz[3];
+    voxdag_error err;
+    memset(&o, 0, sizeof o);
+    o.levels = 7;
+    o.colors = 1;
+    o.threads = 2;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    for (i = 0; i < count; i++) {
+        size_t c = sorted[i].cell;
+        xyz[0] = (uint32_t)(c % s.n);
+        xyz[1] = (uint32_t)(c / s.n % s.n);
+        xyz[2] = (uint32_t)(c / s.n / s.n);
+        CHECK(voxdag_builder_add(b, xyz, s.rgb + 3 * c, 1, NULL) == VOXDAG_OK);
+        if (i + 1 < count && sorted[i].code >> 12 != sorted[i + 1].code >> 12) CHECK(voxdag_builder_flush(b, NULL) == VOXDAG_OK);
+    }
+    /* the first voxel again precedes the flushed ones */
+    xyz[0] = (uint32_t)(sorted[0].cell % s.n);
+    xyz[1] = (uint32_t)(sorted[0].cell / s.n % s.n);
+    xyz[2] = (uint32_t)(sorted[0].cell / s.n / s.n);
+    CHECK(voxdag_builder_add(b, xyz, s.rgb, 1, &err) == VOXDAG_ERR_ORDER && err.status == VOXDAG_ERR_ORDER);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    if (d) {
+        const void *a = voxdag_image(ref, &size0), *c = voxdag_image(d, &size1);
+        CHECK(size0 == size1 && !memcmp(a, c, size0));
+    }
+    voxdag_free(d);
+    voxdag_free(ref);
+    free(sorted);
+    scene_free(&s);
+}
+
+/* Build -> image -> load (validated) -> the same answers. */
+static void test_load_roundtrip(void) {
+    int kind;
+    for (kind = 0; kind < SC_COUNT; kind++) {
+        scene s = make_scene(kind, 6, 300 + (uint64_t)kind);
+        voxdag *d = build(&s, 1, 1, 0, NULL), *e = NULL;
+        size_t size;
+        const void *img = voxdag_image(d, &size);
+        voxdag_error err;
+        CHECK_MSG(voxdag_load_memory(img, size, NULL, &e, &err) == VOXDAG_OK, "%s: %s at %llu", scene_names[kind],
+                  err.message, (unsigned long long)err.byte_offset);
+        if (e) {
+            check_queries(&s, e, scene_names[kind]);
+            voxdag_free(e);
+        }
+        voxdag_free(d);
+        scene_free(&s);
+    }
+}
+
+static void test_bad_arguments(void) {
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag_error err;
+    uint32_t xyz[3] = {0, 0, 64};
+    memset(&o, 0, sizeof o);
+    o.levels = 1;
+    CHECK(voxdag_builder_create(&o, &b, &err) == VOXDAG_ERR_LIMIT && !b);
+    o.levels = VOXDAG_MAX_LEVELS + 1;
+    CHECK(voxdag_builder_create(&o, &b, &err) == VOXDAG_ERR_LIMIT && !b);
+    o.levels = 6;
+    o.zero_end = 1;
+    CHECK(voxdag_builder_create(&o, &b, &err) == VOXDAG_ERR_INVALID_ARGUMENT && !b);
+    o.zero_end = 0;
+    CHECK(voxdag_builder_create(&o, &b, &err) == VOXDAG_OK);
+    CHECK(voxdag_builder_add(b, xyz, NULL, 1, &err) == VOXDAG_ERR_COORDINATE && err.node == 0);
+    xyz[2] = 63;
+    CHECK(voxdag_builder_add(b, xyz, NULL, 1, &err) == VOXDAG_OK);
+    voxdag_builder_free(b);
+    CHECK(strcmp(voxdag_status_string(VOXDAG_ERR_CORRUPT), "corrupt data") == 0);
+}
+
+// -- Allocation failure: a counting allocator that fails at call N
+
+typedef struct counting_alloc {
+    long calls, fail_at;
+    size_t held;
+} counting_alloc;
+
+static void *ca_alloc(void *user, size_t size) {
+    counting_alloc *a = (counting_alloc *)user;
+    void *p;
+    if (a->fail_at >= 0 && a->calls++ == a->fail_at) return NULL;
+    p = malloc(size + 16);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof size);
+    a->held += size;
+    return (char *)p + 16;
+}
+
+static void ca_free(void *user, void *ptr, size_t size) {
+    counting_alloc *a = (counting_alloc *)user;
+    size_t stored;
+    memcpy(&stored, (char *)ptr - 16, sizeof stored);
+    if (stored != size) a->held += 1u << 30; /* size mismatch shows as a leak */
+    a->held -= size;
+    free((char *)ptr - 16);
+}
+
+static void test_allocation_failures(void) {
+    scene s = make_scene(SC_SPHERE, 6, 8);
+    uint32_t *xyz;
+    uint8_t *rgb;
+    size_t n = scene_voxels(&s, &xyz, &rgb);
+    long fail_at;
+    int succeeded = 0;
+    for (fail_at = 0; !succeeded && fail_at < 100000; fail_at++) {
+        counting_alloc ca = {0, 0, 0};
+        voxdag_build_opts o;
+        voxdag_builder *b = NULL;
+        voxdag *d = NULL;
+        voxdag_status st;
+        ca.fail_at = fail_at;
+        memset(&o, 0, sizeof o);
+        o.levels = 6;
+        o.colors = 1;
+        o.threads = (fail_at & 1) + 1;
+        o.allocator.alloc = ca_alloc;
+        o.allocator.free = ca_free;
+        o.allocator.user = &ca;
+        st = voxdag_builder_create(&o, &b, NULL);
+        if (st == VOXDAG_OK) st = voxdag_builder_add(b, xyz, rgb, n, NULL);
+        if (st == VOXDAG_OK) st = voxdag_builder_finish(b, &d, NULL, NULL);
+        else voxdag_builder_free(b);
+        CHECK(st == VOXDAG_OK || st == VOXDAG_ERR_OUT_OF_MEMORY);
+        if (st == VOXDAG_OK) {
+            succeeded = 1;
+            check_queries(&s, d, "after allocation failures");
+        }
+        voxdag_free(d);
+        CHECK_MSG(ca.held == 0, "%zu bytes held after failing allocation %ld", ca.held, fail_at);
+    }
+    CHECK(succeeded);
+    free(xyz);
+    free(rgb);
+    scene_free(&s);
+}
+
+/* Every single-byte change of a small image is rejected or, when it only
+   touches ignored padding, still loads; never a crash (ASan checks). Every
+   truncation is rejected. */
+static void test_mutations_rejected(void) {
+    scene s = make_scene(SC_MIRRORED_BLOB, 5, 21);
+    voxdag *d = build(&s, 1, 1, 0, NULL);
+    size_t size, i;
+    const uint8_t *img = (const uint8_t *)voxdag_image(d, &size);
+    uint8_t *copy = (uint8_t *)malloc(size);
+    int accepted = 0;
+    for (i = 0; i < size; i++) {
+        static const int delta[4] = {1, -1, 0x100, 0x1FF}; /* +1, -1, set 0, set 0xff */
+        int k;
+        for (k = 0; k < 4; k++) {
+            voxdag *e = NULL;
+            uint8_t v = delta[k] == 0x100 ? 0 : delta[k] == 0x1FF ? 0xFF : (uint8_t)(img[i] + delta[k]);
+            if (v == img[i]) continue;
+            memcpy(copy, img, size);
+            copy[i] = v;
+            if (voxdag_load_memory(copy, size, NULL, &e, NULL) == VOXDAG_OK) {
+                accepted++;
+                voxdag_free(e);
+            }
+        }
+    }
+    CHECK_MSG(accepted == 0, "%d mutated images accepted", accepted);
+    for (i = 0; i < size; i++) {
+        voxdag *e = NULL;
+        uint8_t *cut = (uint8_t *)malloc(i + 1);
+        memcpy(cut, img, i);
+        CHECK(voxdag_load_memory(cut, i, NULL, &e, NULL) != VOXDAG_OK && !e);
+        free(cut);
+    }
+    free(copy);
+    voxdag_free(d);
+    scene_free(&s);
+}
 
 const test_case test_core_cases[] = {
-    {"core/version", test_version},
+    {"core/oracle_scenes", test_oracle_scenes},
+    {"core/mirrored_blob_merges", test_mirrored_blob_merges},
+    {"core/determinism", test_determinism},
+    {"core/streaming_chunks", test_streaming_chunks},
+    {"core/load_roundtrip", test_load_roundtrip},
+    {"core/bad_arguments", test_bad_arguments},
+    {"core/allocation_failures", test_allocation_failures},
+    {"core/mutations_rejected", test_mutations_rejected},
     {NULL, NULL},
 };
