@@ -14,27 +14,66 @@ THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 HEADERS := voxdag.h voxcolor.h
 
-VDAG_SRC := examples/vdag.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c
+VDAG_SRC := examples/vdag.c examples/import.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c examples/import.c
 
-.PHONY: all test deps demo bench clean
+# Texture decoding (examples/image.h): OpenImageIO when installed, compiled
+# with $(CXX) and linked with the C++ driver; else a stub. These are expanded
+# when a recipe runs, so `make test` sees what `make deps` just installed.
+OIIO       = $(shell pkg-config --exists OpenImageIO 2>/dev/null && echo 1)
+IMAGE_CC   = $(if $(OIIO),$(CXX) -std=c++14 $(shell pkg-config --cflags OpenImageIO) examples/image_oiio.cpp,$(CC) $(CSTD) examples/image_none.c)
+IMAGE_LIBS = $(if $(OIIO),$(shell pkg-config --libs OpenImageIO))
+LINK       = $(if $(OIIO),$(CXX),$(CC))
+IMAGE_DEPS := examples/image.h examples/image_oiio.cpp examples/image_none.c
+
+# Importer fuzzing: libFuzzer (clang) for `make fuzz-import`; `make test`
+# replays the committed corpus with the same entry point.
+FUZZ_IMPORT_SRC  := tests/fuzz_import.c examples/import.c examples/image_none.c
+FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=4194304
+FUZZ_SECONDS     ?= 120
+
+.PHONY: all test deps demo bench clean fuzz-import
 
 all: $(BUILD)/vdag
 
 $(BUILD):
 	@mkdir -p $(BUILD)
 
-$(BUILD)/vdag: $(VDAG_SRC) $(wildcard examples/*.h) $(HEADERS) | $(BUILD)
-	$(CC) $(CSTD) $(WARN) $(OPT) -I. -o $@ $(VDAG_SRC) $(THREADS) -lm
+# Objects: $(BUILD)/opt for the tool, $(BUILD)/san (sanitizers) for tests.
+$(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
+$(BUILD)/san/%.o: %.c tests/test.h $(wildcard examples/*.h) $(HEADERS)
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
+$(BUILD)/opt/image.o: $(IMAGE_DEPS)
+	@mkdir -p $(@D)
+	$(IMAGE_CC) $(WARN) $(OPT) -c -o $@
+$(BUILD)/san/image.o: $(IMAGE_DEPS)
+	@mkdir -p $(@D)
+	$(IMAGE_CC) $(WARN) -O1 -g $(SAN) -c -o $@
+
+$(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
+	$(LINK) $(OPT) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
 # Tests run with AddressSanitizer and UndefinedBehaviorSanitizer.
-$(BUILD)/test: $(TEST_SRC) tests/test.h $(HEADERS) | $(BUILD)
-	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ $(TEST_SRC) $(THREADS) -lm
+$(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
+	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
+
+$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import.h examples/image.h | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(FUZZ_IMPORT_DEFS) -I. -o $@ $(FUZZ_IMPORT_SRC) -lm
+
+fuzz-import: | $(BUILD)
+	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVDAG_LIBFUZZER \
+	    $(FUZZ_IMPORT_DEFS) -I. -o $(BUILD)/fuzz_import_libfuzzer $(FUZZ_IMPORT_SRC) -lm
+	@mkdir -p $(BUILD)/fuzz_import_corpus
+	$(BUILD)/fuzz_import_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/import.dict \
+	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_import_corpus tests/data/fuzz/import
 
 deps:
 	@sh tests/deps.sh
 
-test: deps $(BUILD)/test $(BUILD)/vdag
+test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import
 	@sh tests/run.sh $(BUILD)
 
 clean:

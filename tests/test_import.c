@@ -1,0 +1,1129 @@
+/* Scene importer tests: each format round-trips files written here from
+   random scenes (the expected scene is what the test generated), and broken
+   files (cut at every length, patched bytes, huge counts, NaN, indices out of
+   range, bad headers) fail with a one-line message. */
+#define _POSIX_C_SOURCE 200809L
+#include "test.h"
+#include "examples/import.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+// -- Helpers: a growing byte buffer, imports, checks
+
+typedef struct bytes {
+    uint8_t *p;
+    size_t n, cap;
+} bytes;
+
+static void put(bytes *b, const void *data, size_t n) {
+    if (!n) return;
+    if (b->n + n > b->cap) {
+        b->cap = (b->n + n) * 2 + 64;
+        b->p = (uint8_t *)realloc(b->p, b->cap);
+    }
+    memcpy(b->p + b->n, data, n);
+    b->n += n;
+}
+
+static void putf(bytes *b, const char *fmt, ...) {
+    char line[1024];
+    va_list ap;
+    int n;
+    va_start(ap, fmt);
+    n = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    put(b, line, (size_t)n);
+}
+
+/* An unsigned integer of N bytes in either byte order. */
+static void put_uint(bytes *b, uint64_t v, int n, int big_endian) {
+    uint8_t tmp[8];
+    int i;
+    for (i = 0; i < n; i++) tmp[big_endian ? n - 1 - i : i] = (uint8_t)(v >> (8 * i));
+    put(b, tmp, (size_t)n);
+}
+
+static void put_le32(bytes *b, int64_t v) { put_uint(b, (uint64_t)v, 4, 0); }
+
+/* Imports DATA; a failure must leave a one-line message and an empty scene. */
+static int import(const char *ext, const bytes *data, vdag_scene *s, char *err, size_t err_size) {
+    int ok = vdag_import_memory(ext, data->p, data->n, NULL, s, err, err_size);
+    if (!ok) {
+        CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
+        CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);
+    }
+    return ok;
+}
+
+/* Imports DATA expecting a failure whose message contains WANT. */
+static void expect_error(const char *ext, const bytes *data, const char *want) {
+    vdag_scene s;
+    char err[256];
+    if (import(ext, data, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s file accepted; expected an error with \"%s\"", ext, want);
+        vdag_scene_free(&s);
+        return;
+    }
+    CHECK_MSG(strstr(err, want) != NULL, "message \"%s\" lacks \"%s\"", err, want);
+}
+
+static void expect_error_text(const char *ext, const char *text, const char *want) {
+    bytes b = {NULL, 0, 0};
+    put(&b, text, strlen(text));
+    expect_error(ext, &b, want);
+    free(b.p);
+}
+
+/* Every proper prefix of a file fails (STRICT) or at least returns cleanly;
+   every byte patched to 0, 0xff, +1 and -1 returns cleanly. */
+static void sweep(const char *ext, const bytes *data, int strict) {
+    static const int patches[] = {0, 0xff, 1, -1};
+    bytes cut = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    size_t n, i, k;
+    for (n = 0; n < data->n; n++) {
+        cut.n = 0;
+        put(&cut, data->p, n); /* an exact-size copy, so ASan sees over-reads */
+        if (import(ext, &cut, &s, err, sizeof err)) {
+            CHECK_MSG(!strict, "%s cut to %zu of %zu bytes accepted", ext, n, data->n);
+            vdag_scene_free(&s);
+        }
+    }
+    for (i = 0; i < data->n; i++)
+        for (k = 0; k < 4; k++) {
+            cut.n = 0;
+            put(&cut, data->p, data->n);
+            cut.p[i] = (uint8_t)(k < 2 ? patches[k] : cut.p[i] + patches[k]);
+            if (import(ext, &cut, &s, err, sizeof err)) vdag_scene_free(&s);
+        }
+    free(cut.p);
+}
+
+// -- A random mesh (the expected scene of mesh round trips)
+
+typedef struct mesh {
+    size_t nv, npoly;
+    double pos[64][3];
+    uint8_t rgb[64][3];
+    float uv[64][2];
+    size_t poly_size[32];
+    uint32_t poly[32][6];
+} mesh;
+
+/* Coordinates are multiples of 1/8 (exact in every PLY type but integers,
+   for which INTEGRAL makes them whole). */
+static void random_mesh(mesh *m, uint64_t *seed, size_t nv, size_t npoly, int integral) {
+    size_t i, j;
+    m->nv = nv;
+    m->npoly = npoly;
+    for (i = 0; i < nv; i++) {
+        for (j = 0; j < 3; j++) {
+            m->pos[i][j] = ((double)test_rand_below(seed, 2001) - 1000) / (integral ? 1 : 8);
+            m->rgb[i][j] = (uint8_t)test_rand_below(seed, 256);
+        }
+        m->uv[i][0] = (float)test_rand_below(seed, 64) / 16;
+        m->uv[i][1] = (float)test_rand_below(seed, 64) / 16;
+    }
+    for (i = 0; i < npoly; i++) {
+        m->poly_size[i] = 3 + test_rand_below(seed, 4);
+        for (j = 0; j < m->poly_size[i]; j++) m->poly[i][j] = test_rand_below(seed, (uint32_t)nv);
+    }
+}
+
+/* Triangle T of the fan triangulation of M's polygons, as vertex numbers. */
+static size_t fan(const mesh *m, uint32_t tris[][3]) {
+    size_t i, j, n = 0;
+    for (i = 0; i < m->npoly; i++)
+        for (j = 1; j + 1 < m->poly_size[i]; j++) {
+            tris[n][0] = m->poly[i][0];
+            tris[n][1] = m->poly[i][j];
+            tris[n][2] = m->poly[i][j + 1];
+            n++;
+        }
+    return n;
+}
+
+/* Checks that S holds M's triangles with positions (and colours and texture
+   coordinates when asked), comparing corner by corner. */
+static void check_mesh(const vdag_scene *s, const mesh *m, int rgb, int uv) {
+    uint32_t tris[32 * 4][3];
+    size_t n = fan(m, tris), t, k, a;
+    CHECK(s->point_count == 0);
+    CHECK((s->vertex_rgb != NULL) == rgb);
+    CHECK((s->uv != NULL) == uv);
+    CHECK_MSG(s->triangle_count == n, "%zu triangles, expected %zu", s->triangle_count, n);
+    if (s->triangle_count != n) return;
+    for (t = 0; t < n; t++)
+        for (k = 0; k < 3; k++) {
+            uint32_t got = s->indices[3 * t + k], want = tris[t][k];
+            CHECK(got < s->vertex_count);
+            if (got >= s->vertex_count) return;
+            for (a = 0; a < 3; a++) {
+                CHECK(s->positions[3 * got + a] == m->pos[want][a]);
+                if (rgb) CHECK(s->vertex_rgb[3 * got + a] == m->rgb[want][a]);
+            }
+            if (uv) CHECK(s->uv[2 * got] == m->uv[want][0] && s->uv[2 * got + 1] == m->uv[want][1]);
+        }
+}
+
+// -- .xyz
+
+static void test_xyz_roundtrip(void) {
+    uint64_t seed = 1;
+    int colours;
+    for (colours = 0; colours < 2; colours++) {
+        bytes b = {NULL, 0, 0};
+        uint32_t v[100][6];
+        vdag_scene s;
+        char err[256];
+        size_t i, j;
+        putf(&b, "# voxels\n\n");
+        for (i = 0; i < 100; i++) {
+            for (j = 0; j < 6; j++) v[i][j] = test_rand_below(&seed, j < 3 ? 100000 : 256);
+            putf(&b, "%s%u %u\t%u", i % 7 ? "" : "  ", v[i][0], v[i][1], v[i][2]);
+            if (colours) putf(&b, " %u %u %u", v[i][3], v[i][4], v[i][5]);
+            putf(&b, i % 5 ? "\n" : " # comment\r\n");
+        }
+        if (!import("xyz", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            CHECK(s.points_are_voxels == 1 && s.point_count == 100 && s.triangle_count == 0);
+            CHECK((s.point_rgb != NULL) == colours);
+            for (i = 0; i < 100 && s.point_count == 100; i++)
+                for (j = 0; j < 3; j++) {
+                    CHECK(s.points[3 * i + j] == v[i][j]);
+                    if (colours) CHECK(s.point_rgb[3 * i + j] == v[i][3 + j]);
+                }
+            vdag_scene_free(&s);
+        }
+        sweep("xyz", &b, 0);
+        free(b.p);
+    }
+}
+
+static void test_xyz_errors(void) {
+    expect_error_text("xyz", "1 2 -3\n", "line 1: coordinate outside");
+    expect_error_text("xyz", "1 2 3\n1.5 2 3\n", "line 2: value 1 is not an integer");
+    expect_error_text("xyz", "1 2 3\n4 5 6 7 8 9\n", "line 2: 6 values, but line 1 has 3");
+    expect_error_text("xyz", "1 2 3 4 5 256\n", "colour outside 0..255");
+    expect_error_text("xyz", "1 2 3 4\n", "expected \"x y z\"");
+    expect_error_text("xyz", "1 2 3 4 5 6 7\n", "expected \"x y z\"");
+    expect_error_text("xyz", "nan 2 3\n", "not an integer");
+    expect_error_text("xyz", "4294967296 0 0\n", "coordinate outside");
+    expect_error_text("xyz", "99999999999999999999 0 0\n", "not an integer");
+}
+
+// -- .ply
+
+typedef struct ply_style {
+    const char *format; /* ascii, binary_little_endian, binary_big_endian */
+    const char *coord, *colour, *count, *index;
+} ply_style;
+
+/* Writes value V as PLY TYPE. */
+static void ply_put(bytes *b, const ply_style *st, const char *type, double v) {
+    int big = !strcmp(st->format, "binary_big_endian");
+    if (!strcmp(st->format, "ascii")) {
+        putf(b, "%.17g ", v);
+    } else if (!strcmp(type, "float")) {
+        float f = (float)v;
+        uint32_t u;
+        memcpy(&u, &f, 4);
+        put_uint(b, u, 4, big);
+    } else if (!strcmp(type, "double")) {
+        uint64_t u;
+        memcpy(&u, &v, 8);
+        put_uint(b, u, 8, big);
+    } else {
+        int n = !strcmp(type, "uchar") || !strcmp(type, "char") ? 1 : !strcmp(type, "ushort") || !strcmp(type, "short") ? 2 : 4;
+        put_uint(b, (uint64_t)(int64_t)v, n, big);
+    }
+}
+
+static void ply_newline(bytes *b, const ply_style *st) {
+    if (!strcmp(st->format, "ascii")) putf(b, "\n");
+}
+
+/* M as PLY in style ST, with unknown elements and properties around the
+   known ones (including lists) that the reader must skip. */
+static void write_ply(bytes *b, const mesh *m, const ply_style *st, int faces) {
+    size_t i, j;
+    putf(b, "ply\r\nformat %s 1.0\ncomment made by the tests\n", st->format);
+    putf(b, "element material 2\nproperty list uchar int junk\nproperty float shine\n");
+    putf(b, "element vertex %zu\nproperty %s x\nproperty %s y\nproperty %s z\nproperty float nx\n", m->nv, st->coord,
+         st->coord, st->coord);
+    putf(b, "property %s red\nproperty %s green\nproperty %s blue\nproperty uchar alpha\n", st->colour, st->colour,
+         st->colour);
+    putf(b, "property list uchar short extra\nproperty float s\nproperty float t\n");
+    if (faces)
+        putf(b, "element face %zu\nproperty int flags\nproperty list %s %s vertex_indices\n"
+                "property list uchar float texcoord\n",
+             m->npoly, st->count, st->index);
+    putf(b, "element edge 3\nproperty int a\nproperty int b\nend_header\n");
+    for (i = 0; i < 2; i++) {
+        ply_put(b, st, "uchar", (double)i + 1);
+        for (j = 0; j <= i; j++) ply_put(b, st, "int", 7);
+        ply_put(b, st, "float", 0.5);
+        ply_newline(b, st);
+    }
+    for (i = 0; i < m->nv; i++) {
+        for (j = 0; j < 3; j++) ply_put(b, st, st->coord, m->pos[i][j]);
+        ply_put(b, st, "float", 1);
+        for (j = 0; j < 3; j++)
+            ply_put(b, st, st->colour, !strcmp(st->colour, "float") ? m->rgb[i][j] / 255.0 : m->rgb[i][j]);
+        ply_put(b, st, "uchar", 255);
+        ply_put(b, st, "uchar", (double)(i % 3));
+        for (j = 0; j < i % 3; j++) ply_put(b, st, "short", -5);
+        ply_put(b, st, "float", m->uv[i][0]);
+        ply_put(b, st, "float", m->uv[i][1]);
+        ply_newline(b, st);
+    }
+    for (i = 0; faces && i < m->npoly; i++) {
+        ply_put(b, st, "int", -1);
+        ply_put(b, st, st->count, (double)m->poly_size[i]);
+        for (j = 0; j < m->poly_size[i]; j++) ply_put(b, st, st->index, m->poly[i][j]);
+        ply_put(b, st, "uchar", 2);
+        ply_put(b, st, "float", 0);
+        ply_put(b, st, "float", 1);
+        ply_newline(b, st);
+    }
+    for (i = 0; i < 3; i++) {
+        ply_put(b, st, "int", 1);
+        ply_put(b, st, "int", 2);
+        ply_newline(b, st);
+    }
+}
+
+static void test_ply_roundtrip(void) {
+    static const char *const formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
+    static const char *const coords[] = {"float", "double", "int", "short"};
+    static const char *const colours[] = {"uchar", "float"};
+    static const char *const lists[][2] = {{"uchar", "int"}, {"ushort", "uint"}, {"uint", "ushort"}, {"char", "uchar"}};
+    uint64_t seed = 2;
+    size_t f, c, k, l;
+    for (f = 0; f < 3; f++)
+        for (c = 0; c < 4; c++)
+            for (k = 0; k < 2; k++)
+                for (l = 0; l < 4; l++) {
+                    ply_style st;
+                    mesh m;
+                    bytes b = {NULL, 0, 0};
+                    vdag_scene s;
+                    char err[256];
+                    st.format = formats[f];
+                    st.coord = coords[c];
+                    st.colour = colours[k];
+                    st.count = lists[l][0];
+                    st.index = lists[l][1];
+                    random_mesh(&m, &seed, 5 + test_rand_below(&seed, 40), 1 + test_rand_below(&seed, 20), c >= 2);
+                    write_ply(&b, &m, &st, 1);
+                    if (!import("ply", &b, &s, err, sizeof err)) {
+                        CHECK_MSG(0, "%s %s %s %s: %s", st.format, st.coord, st.colour, st.count, err);
+                    } else {
+                        CHECK(s.vertex_count == m.nv);
+                        check_mesh(&s, &m, 1, 1);
+                        vdag_scene_free(&s);
+                    }
+                    free(b.p);
+                }
+}
+
+static void test_ply_points(void) {
+    ply_style st = {"binary_little_endian", "float", "uchar", "uchar", "int"};
+    uint64_t seed = 3;
+    mesh m;
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    size_t i, j;
+    random_mesh(&m, &seed, 30, 0, 0);
+    write_ply(&b, &m, &st, 0);
+    if (!import("ply", &b, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.points_are_voxels == 0 && s.point_count == 30 && s.point_rgb && !s.positions && !s.uv);
+        for (i = 0; i < 30 && s.point_count == 30; i++)
+            for (j = 0; j < 3; j++) CHECK(s.points[3 * i + j] == m.pos[i][j] && s.point_rgb[3 * i + j] == m.rgb[i][j]);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+}
+
+/* Cuts and patches of small files in each PLY encoding. */
+static void test_ply_sweep(void) {
+    static const char *const formats[] = {"ascii", "binary_little_endian", "binary_big_endian"};
+    uint64_t seed = 4;
+    size_t f;
+    for (f = 0; f < 3; f++) {
+        ply_style st = {formats[f], "float", "uchar", "uchar", "int"};
+        mesh m;
+        bytes b = {NULL, 0, 0};
+        random_mesh(&m, &seed, 4, 2, 0);
+        write_ply(&b, &m, &st, 1);
+        sweep("ply", &b, f > 0); /* an ASCII number cut short is still a number */
+        free(b.p);
+    }
+}
+
+static void test_ply_errors(void) {
+    const char *head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n";
+    char text[1024];
+    bytes b = {NULL, 0, 0};
+    expect_error_text("ply", "plx\nformat ascii 1.0\nend_header\n", "not a PLY file");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex 1\n", "no end_header");
+    expect_error_text("ply", "ply\nformat binary_middle_endian 1.0\nend_header\n", "unknown format");
+    expect_error_text("ply", "ply\nelement vertex 1\nproperty float x\nend_header\n0\n", "no format line");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty quad x\nend_header\n", "unknown property type");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty list float int x\nend_header\n",
+                      "list length type");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nproperty float x\nend_header\n", "property before any element");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n",
+                      "lacks scalar x, y or z");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+                             "property float z\nend_header\n",
+                      "more vertices than the file holds");
+    expect_error_text("ply", "ply\nformat ascii 1.0\nelement vertex -1\nend_header\n", "element NAME COUNT");
+    expect_error_text("ply", "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n"
+                             "property float x\nproperty float y\nproperty float z\nend_header\n",
+                      "element NAME COUNT");
+    expect_error_text("ply", "ply\nformat binary_little_endian 1.0\nelement vertex 4611686018427387904\n"
+                             "property float x\nproperty float y\nproperty float z\nend_header\n",
+                      "more vertices than the file holds");
+    snprintf(text, sizeof text, "%send_header\n0 0 0\n1 nan 0\n0 1 0\n", head);
+    expect_error_text("ply", text, "vertex 1: coordinate is not finite");
+    snprintf(text, sizeof text, "%send_header\n0 0 0\n1 0 0\n0 1 1e999\n", head);
+    expect_error_text("ply", text, "vertex 2: coordinate is not finite");
+    snprintf(text, sizeof text, "%selement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", head);
+    expect_error_text("ply", text, "line 13: vertex index out of range");
+    snprintf(text, sizeof text, "%selement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 -1\n", head);
+    expect_error_text("ply", text, "vertex index out of range");
+    snprintf(text, sizeof text, "%selement face 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n", head);
+    expect_error_text("ply", text, "bad list length");
+    snprintf(text, sizeof text, "%selement face 1\nproperty list int int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n2000000000 0 1 2\n", head);
+    expect_error_text("ply", text, "file ends early");
+    snprintf(text, sizeof text, "%selement face 1\nproperty int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3\n", head);
+    expect_error_text("ply", text, "no vertex_indices list");
+    snprintf(text, sizeof text, "%send_header\n0 0 0\n1 0 x\n0 1 0\n", head);
+    expect_error_text("ply", text, "line 9: not a number");
+    /* A binary NaN, and a skipped element far larger than the file. */
+    putf(&b, "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n");
+    put_le32(&b, 0);
+    put_le32(&b, 0x7fc00000);
+    put_le32(&b, 0);
+    expect_error("ply", &b, "vertex 0: coordinate is not finite");
+    b.n = 0;
+    putf(&b, "ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\n"
+             "property float z\nelement junk 4000000000000\nproperty double a\nend_header\n");
+    expect_error("ply", &b, "file ends early");
+    free(b.p);
+}
+
+// -- .off
+
+static void write_off(bytes *b, const mesh *m, int coff, int counts_on_header) {
+    size_t i, j;
+    putf(b, "# a comment first\n%s", coff ? "COFF" : "OFF");
+    putf(b, counts_on_header ? " " : "\n\n# counts\n");
+    putf(b, "%zu %zu 0\n", m->nv, m->npoly);
+    for (i = 0; i < m->nv; i++) {
+        putf(b, "%.17g %.17g %.17g", m->pos[i][0], m->pos[i][1], m->pos[i][2]);
+        if (coff && i % 2) putf(b, " %.17g %.17g %.17g 1.0", m->rgb[i][0] / 255.0, m->rgb[i][1] / 255.0, m->rgb[i][2] / 255.0);
+        else if (coff) putf(b, " %u %u %u 255", m->rgb[i][0], m->rgb[i][1], m->rgb[i][2]);
+        putf(b, i % 4 ? "\n" : " # vertex\n");
+    }
+    for (i = 0; i < m->npoly; i++) {
+        putf(b, "%zu", m->poly_size[i]);
+        for (j = 0; j < m->poly_size[i]; j++) putf(b, " %u", m->poly[i][j]);
+        putf(b, i % 2 ? " 255 0 0\n" : "\n"); /* a face colour, ignored */
+    }
+}
+
+static void test_off_roundtrip(void) {
+    uint64_t seed = 5;
+    int coff, header;
+    for (coff = 0; coff < 2; coff++)
+        for (header = 0; header < 2; header++) {
+            mesh m;
+            bytes b = {NULL, 0, 0};
+            vdag_scene s;
+            char err[256];
+            random_mesh(&m, &seed, 3 + test_rand_below(&seed, 50), 1 + test_rand_below(&seed, 30), 0);
+            write_off(&b, &m, coff, header);
+            if (!import("off", &b, &s, err, sizeof err)) {
+                CHECK_MSG(0, "%s", err);
+            } else {
+                check_mesh(&s, &m, coff, 0);
+                vdag_scene_free(&s);
+            }
+            free(b.p);
+        }
+}
+
+static void test_off_points_and_sweep(void) {
+    uint64_t seed = 6;
+    mesh m;
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    random_mesh(&m, &seed, 10, 0, 0);
+    write_off(&b, &m, 1, 0);
+    if (!import("off", &b, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.point_count == 10 && s.points_are_voxels == 0 && s.point_rgb && s.points[3] == m.pos[1][0]);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+    b.p = NULL;
+    b.n = b.cap = 0;
+    random_mesh(&m, &seed, 4, 2, 0);
+    write_off(&b, &m, 1, 1);
+    sweep("off", &b, 0);
+    free(b.p);
+}
+
+static void test_off_errors(void) {
+    expect_error_text("off", "", "empty file");
+    expect_error_text("off", "PLY\n", "not an OFF file");
+    expect_error_text("off", "4OFF\n1 0 0\n", "not an OFF file");
+    expect_error_text("off", "OFF BINARY\n", "binary OFF");
+    expect_error_text("off", "OFF\n3\n", "expected vertex and face counts");
+    expect_error_text("off", "OFF\n-1 0 0\n", "expected vertex and face counts");
+    expect_error_text("off", "OFF\n1000000 0 0\n0 0 0\n", "more vertices than the file holds");
+    expect_error_text("off", "OFF\n2 0 0\n0 0 0\n# padding\n", "file ends after 1 of 2 vertices");
+    expect_error_text("off", "OFF\n1 0 0\n0 nan 0\n", "line 3: coordinate is not finite");
+    expect_error_text("off", "OFF\n1 0 0\n0 inf 0\n", "coordinate is not finite");
+    expect_error_text("off", "OFF\n1 0 0\n0 0\n# padding\n", "line 3: expected x y z");
+    expect_error_text("off", "COFF\n1 0 0\n0 0 0 1\n", "expected a colour");
+    expect_error_text("off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n", "line 6: missing or out-of-range");
+    expect_error_text("off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4 0 1 2\n", "missing or out-of-range");
+    expect_error_text("off", "OFF\n3 2 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "file ends after 1 of 2 faces");
+    expect_error_text("off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n-3 0 1 2\n", "bad corner count");
+}
+
+// -- .obj and .mtl
+
+/* M as OBJ: colours on odd vertices, every corner form, relative indices on
+   some faces, and polygons switching between three materials. */
+static void write_obj(bytes *b, const mesh *m, int32_t *material_of_poly) {
+    size_t i, j;
+    putf(b, "# made by the tests\nmtllib lib.mtl\no thing\n");
+    for (i = 0; i < m->nv; i++) {
+        putf(b, "v %.17g %.17g %.17g", m->pos[i][0], m->pos[i][1], m->pos[i][2]);
+        if (i % 2) putf(b, " %.17g %.17g %.17g", m->rgb[i][0] / 255.0, m->rgb[i][1] / 255.0, m->rgb[i][2] / 255.0);
+        putf(b, "\nvt %.9g %.9g\nvn 0 0 1\n", m->uv[i][0], m->uv[i][1]);
+    }
+    for (i = 0; i < m->npoly; i++) {
+        static const char *const names[] = {"red", "green paint", "blue"};
+        int32_t mat = (int32_t)(i % 4 == 3 ? 1 : i % 3);
+        putf(b, "usemtl %s\nf", names[mat]);
+        material_of_poly[i] = mat;
+        for (j = 0; j < m->poly_size[i]; j++) {
+            long v = (long)m->poly[i][j] + 1;
+            if (i % 2) v -= (long)m->nv + 1; /* relative to the end */
+            putf(b, j % 2 ? " %ld/%ld" : " %ld/%ld/1", v, v);
+        }
+        putf(b, "\ns off\n");
+    }
+}
+
+static void test_obj_roundtrip(void) {
+    uint64_t seed = 7;
+    int round;
+    for (round = 0; round < 10; round++) {
+        mesh m;
+        int32_t mat[32];
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        size_t i, j, t;
+        random_mesh(&m, &seed, 3 + test_rand_below(&seed, 60), 1 + test_rand_below(&seed, 30), 0);
+        for (i = 0; i < m.nv; i++) /* even vertices have no colour: white */
+            if (i % 2 == 0) m.rgb[i][0] = m.rgb[i][1] = m.rgb[i][2] = 255;
+        write_obj(&b, &m, mat);
+        if (!import("obj", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            uint32_t first_use[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX}, used = 0;
+            check_mesh(&s, &m, m.nv > 1, 1);
+            CHECK(s.triangle_material != NULL);
+            /* Materials are numbered by first use, white without a library. */
+            for (i = t = 0; s.triangle_material && i < m.npoly; i++) {
+                if (first_use[mat[i]] == UINT32_MAX) first_use[mat[i]] = used++;
+                for (j = 2; j < m.poly_size[i]; j++, t++)
+                    CHECK(t < s.triangle_count && s.triangle_material[t] == (int32_t)first_use[mat[i]]);
+            }
+            CHECK(s.material_count == used);
+            for (i = 0; i < s.material_count; i++)
+                CHECK(s.materials[i].image == -1 && s.materials[i].rgb[0] == 255 && s.materials[i].rgb[2] == 255);
+            vdag_scene_free(&s);
+        }
+        if (round == 0) sweep("obj", &b, 0);
+        free(b.p);
+    }
+}
+
+static void test_obj_points(void) {
+    const char *text = "v 1 2 3\nv 4 5 6 0 1 0.5\nvt 0 0\nl 1 2\nf 1 2\n";
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    put(&b, text, strlen(text));
+    if (!import("obj", &b, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.point_count == 2 && s.points_are_voxels == 0 && s.points[3] == 4 && s.point_rgb);
+        CHECK(s.point_rgb && s.point_rgb[0] == 255 && s.point_rgb[3] == 0 && s.point_rgb[4] == 255 && s.point_rgb[5] == 128);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+}
+
+static void test_obj_errors(void) {
+    expect_error_text("obj", "v 1 2\n", "line 1: v needs x y z");
+    expect_error_text("obj", "v 1 2 x\n", "line 1: not a number");
+    expect_error_text("obj", "v 1 nan 3\n", "coordinate is not finite");
+    expect_error_text("obj", "v 1 2 3 nan 0 0\n", "colour is NaN");
+    expect_error_text("obj", "vt inf 0\n", "texture coordinate is not finite");
+    expect_error_text("obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n", "a face uses vertex 4 of 3");
+    expect_error_text("obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 -4\n", "line 4: bad face corner");
+    expect_error_text("obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n", "line 4: bad face corner");
+    expect_error_text("obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n", "texture coordinate 2 of 1");
+    expect_error_text("obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3/x\n", "bad face corner");
+    expect_error_text("obj", "v 0 0 0\nf 1 1 99999999999999999999\n", "bad face corner");
+    expect_error_text("mtl", "Kd 1 1 1\n", "line 1: Kd before newmtl");
+    expect_error_text("mtl", "newmtl a\nKd 1 1\n", "line 2: Kd needs 1 or 3 numbers");
+    expect_error_text("mtl", "newmtl a\nKd 1 nan 1\n", "Kd needs 1 or 3 numbers");
+    expect_error_text("mtl", "newmtl a\nmap_Kd -s 1 1 1\n", "line 2: map_Kd has no file");
+}
+
+/* A 3x2 binary PPM, for the texture of the file test. */
+static const uint8_t test_pixels[18] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30, 40, 50, 60, 70, 80, 90};
+
+static int write_file(const char *path, const void *data, size_t n) {
+    FILE *f = fopen(path, "wb");
+    size_t put_n;
+    if (!f) return 0;
+    put_n = fwrite(data, 1, n, f);
+    return fclose(f) == 0 && put_n == n;
+}
+
+/* .obj from a file: the .mtl beside it gives colours and a texture whose
+   name has spaces and options before it. */
+static void test_obj_file(void) {
+    char dir[] = "/tmp/vdag-import-XXXXXX", path[256], sub[256], tex[256], err[512];
+    const char *obj = "mtllib lib.mtl missing.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                      "usemtl plain\nf 1 2 3\nusemtl painted\nf 1/1 2/2 3/3\nusemtl unknown\nf 3 2 1\n";
+    const char *mtl = "newmtl unused\nKd 0 0 0\nnewmtl plain\nKd 0.2 0.4 1\n"
+                      "newmtl painted\nKd 0.5\nmap_Kd -s 1 1 1 -o 0.5 -bm 0.2 -clamp on tex dir\\my tex.ppm\n";
+    bytes ppm = {NULL, 0, 0};
+    vdag_scene s;
+    vdag_image probe;
+    int decodes;
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/scene.OBJ", dir);
+    CHECK(write_file(path, obj, strlen(obj)));
+    snprintf(path, sizeof path, "%s/lib.mtl", dir);
+    CHECK(write_file(path, mtl, strlen(mtl)));
+    snprintf(sub, sizeof sub, "%s/tex dir", dir);
+    CHECK(mkdir(sub, 0700) == 0);
+    snprintf(tex, sizeof tex, "%s/tex dir/my tex.ppm", dir);
+    putf(&ppm, "P6\n3 2\n255\n");
+    put(&ppm, test_pixels, sizeof test_pixels);
+    CHECK(write_file(tex, ppm.p, ppm.n));
+    decodes = vdag_image_load(tex, &probe, err, sizeof err);
+    if (!decodes) CHECK_MSG(strstr(err, "texture decoding not built in") != NULL, "%s", err);
+    vdag_image_free(&probe);
+
+    snprintf(path, sizeof path, "%s/scene.OBJ", dir);
+    if (!vdag_import_file(path, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.triangle_count == 3 && s.material_count == 3 && s.uv != NULL);
+        CHECK(s.triangle_material && s.triangle_material[0] == 0 && s.triangle_material[1] == 1 &&
+              s.triangle_material[2] == 2);
+        CHECK(s.materials[0].rgb[0] == 51 && s.materials[0].rgb[1] == 102 && s.materials[0].rgb[2] == 255);
+        CHECK(s.materials[0].image == -1);
+        CHECK(s.materials[1].rgb[0] == 128 && s.materials[1].rgb[1] == 128 && s.materials[1].rgb[2] == 128);
+        CHECK(s.materials[2].rgb[0] == 255 && s.materials[2].image == -1);
+        if (decodes) {
+            CHECK(s.image_count == 1 && s.materials[1].image == 0);
+            CHECK(s.image_count == 1 && s.images[0].width == 3 && s.images[0].height == 2 &&
+                  !memcmp(s.images[0].rgb, test_pixels, sizeof test_pixels));
+        } else {
+            CHECK(s.image_count == 0 && s.materials[1].image == -1);
+        }
+        vdag_scene_free(&s);
+    }
+    remove(tex);
+    rmdir(sub);
+    snprintf(path, sizeof path, "%s/lib.mtl", dir);
+    remove(path);
+    snprintf(path, sizeof path, "%s/scene.OBJ", dir);
+    remove(path);
+    rmdir(dir);
+    free(ppm.p);
+}
+
+static void test_file_errors(void) {
+    vdag_scene s;
+    char err[256];
+    CHECK(!vdag_import_file("/nonexistent/scene.ply", &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "/nonexistent/scene.ply: cannot open") == err, "%s", err);
+    CHECK(!vdag_import_file("tests/test_import.c", &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "unknown format") != NULL, "%s", err);
+    CHECK(!vdag_import_memory("stl", "", 0, NULL, &s, err, sizeof err));
+    CHECK_MSG(!strcmp(err, "stl: unknown format (expected .xyz, .ply, .obj, .off, .vox or .mtl)"), "%s", err);
+    CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, err, 8)); /* the message is cut, not overflowed */
+    CHECK(strlen(err) == 7);
+    CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, NULL, 0));
+}
+
+// -- .vox
+
+typedef struct vox_model {
+    uint32_t size[3];
+    size_t n;
+    uint8_t v[40][4]; /* x, y, z, colour index */
+} vox_model;
+
+static void random_model(vox_model *m, uint64_t *seed) {
+    size_t i, a;
+    for (a = 0; a < 3; a++) m->size[a] = 1 + test_rand_below(seed, 12);
+    m->n = 1 + test_rand_below(seed, 40);
+    for (i = 0; i < m->n; i++) {
+        for (a = 0; a < 3; a++) m->v[i][a] = (uint8_t)test_rand_below(seed, m->size[a]);
+        m->v[i][3] = (uint8_t)(1 + test_rand_below(seed, 255));
+    }
+}
+
+static void vox_chunk(bytes *b, const char *id, const bytes *content, uint32_t children) {
+    put(b, id, 4);
+    put_le32(b, (int64_t)content->n);
+    put_le32(b, children);
+    put(b, content->p, content->n);
+}
+
+static void vox_string(bytes *b, const char *s) {
+    put_le32(b, (int64_t)strlen(s));
+    put(b, s, strlen(s));
+}
+
+/* A DICT of N key/value pairs given as strings. */
+static void vox_dict(bytes *b, int n, ...) {
+    va_list ap;
+    int i;
+    put_le32(b, n);
+    va_start(ap, n);
+    for (i = 0; i < 2 * n; i++) vox_string(b, va_arg(ap, const char *));
+    va_end(ap);
+}
+
+static void vox_models(bytes *b, const vox_model *models, size_t count) {
+    bytes c = {NULL, 0, 0};
+    size_t i, k;
+    for (i = 0; i < count; i++) {
+        c.n = 0;
+        for (k = 0; k < 3; k++) put_le32(&c, models[i].size[k]);
+        vox_chunk(b, "SIZE", &c, 0);
+        c.n = 0;
+        put_le32(&c, (int64_t)models[i].n);
+        put(&c, models[i].v, 4 * models[i].n);
+        vox_chunk(b, "XYZI", &c, 0);
+    }
+    free(c.p);
+}
+
+/* Wraps CHILDREN in a MAIN chunk after the file header. */
+static void vox_file(bytes *file, const bytes *children, int version) {
+    put(file, "VOX ", 4);
+    put_le32(file, version);
+    put(file, "MAIN", 4);
+    put_le32(file, 0);
+    put_le32(file, (int64_t)children->n);
+    put(file, children->p, children->n);
+}
+
+static void vox_transform(bytes *b, int32_t id, int32_t child, const char *r, const char *t) {
+    bytes c = {NULL, 0, 0};
+    put_le32(&c, id);
+    vox_dict(&c, 1, "_name", "node");
+    put_le32(&c, child);
+    put_le32(&c, -1);
+    put_le32(&c, 0);
+    put_le32(&c, 1);
+    if (r && t) vox_dict(&c, 2, "_r", r, "_t", t);
+    else if (t) vox_dict(&c, 1, "_t", t);
+    else vox_dict(&c, 0);
+    vox_chunk(b, "nTRN", &c, 0);
+    free(c.p);
+}
+
+static void vox_group(bytes *b, int32_t id, const int32_t *children, size_t n) {
+    bytes c = {NULL, 0, 0};
+    size_t i;
+    put_le32(&c, id);
+    vox_dict(&c, 0);
+    put_le32(&c, (int64_t)n);
+    for (i = 0; i < n; i++) put_le32(&c, children[i]);
+    vox_chunk(b, "nGRP", &c, 0);
+    free(c.p);
+}
+
+static void vox_shape(bytes *b, int32_t id, int32_t model) {
+    bytes c = {NULL, 0, 0};
+    put_le32(&c, id);
+    vox_dict(&c, 0);
+    put_le32(&c, 1);
+    put_le32(&c, model);
+    vox_dict(&c, 1, "_f", "0");
+    vox_chunk(b, "nSHP", &c, 0);
+    free(c.p);
+}
+
+/* Voxels as (x, y, z, r, g, b) rows, sorted, so sets can be compared. */
+typedef struct voxel {
+    int64_t p[3];
+    uint8_t rgb[3];
+} voxel;
+
+static int voxel_order(const void *a, const void *b) {
+    const voxel *x = (const voxel *)a, *y = (const voxel *)b;
+    int i;
+    for (i = 0; i < 3; i++)
+        if (x->p[i] != y->p[i]) return x->p[i] < y->p[i] ? -1 : 1;
+    return memcmp(x->rgb, y->rgb, 3);
+}
+
+/* Puts WANT (MagicaVoxel world coordinates, z up) into the importer's frame:
+   y up, (x, y, z) -> (x, z, -y), shifted so each axis starts at 0; then
+   compares it with the scene's voxels. */
+static void check_voxels(const vdag_scene *s, voxel *want, size_t n) {
+    voxel *got;
+    int64_t lo[3];
+    size_t i, a;
+    CHECK(s->points_are_voxels == 1 && s->point_rgb != NULL && s->triangle_count == 0);
+    CHECK_MSG(s->point_count == n, "%zu voxels, expected %zu", s->point_count, n);
+    if (s->point_count != n || !n) return;
+    for (i = 0; i < n; i++) {
+        int64_t y = want[i].p[1];
+        want[i].p[1] = want[i].p[2];
+        want[i].p[2] = -y;
+        for (a = 0; a < 3; a++)
+            if (!i || want[i].p[a] < lo[a]) lo[a] = want[i].p[a];
+    }
+    got = (voxel *)calloc(n, sizeof *got);
+    for (i = 0; i < n; i++) {
+        for (a = 0; a < 3; a++) {
+            want[i].p[a] -= lo[a];
+            got[i].p[a] = (int64_t)s->points[3 * i + a];
+            CHECK(s->points[3 * i + a] == (double)got[i].p[a]);
+        }
+        memcpy(got[i].rgb, &s->point_rgb[3 * i], 3);
+    }
+    qsort(want, n, sizeof *want, voxel_order);
+    qsort(got, n, sizeof *got, voxel_order);
+    for (i = 0; i < n; i++) CHECK(!voxel_order(&want[i], &got[i]));
+    free(got);
+}
+
+/* Two models, no scene graph: voxels keep their model coordinates. */
+static void test_vox_models(void) {
+    uint64_t seed = 8;
+    vox_model m[2];
+    uint8_t palette[1024];
+    voxel want[80];
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    size_t i, k, n = 0;
+    for (i = 0; i < sizeof palette; i++) palette[i] = (uint8_t)test_rand_below(&seed, 256);
+    put_le32(&c, 2);
+    vox_chunk(&body, "PACK", &c, 0);
+    random_model(&m[0], &seed);
+    random_model(&m[1], &seed);
+    m[1].v[0][3] = 0; /* colour index 0: no voxel */
+    vox_models(&body, m, 2);
+    c.n = 0;
+    put(&c, palette, sizeof palette);
+    vox_chunk(&body, "RGBA", &c, 0);
+    vox_file(&file, &body, 150);
+    for (i = 0; i < 2; i++)
+        for (k = 0; k < m[i].n; k++) {
+            if (!m[i].v[k][3]) continue;
+            want[n].p[0] = m[i].v[k][0];
+            want[n].p[1] = m[i].v[k][1];
+            want[n].p[2] = m[i].v[k][2];
+            memcpy(want[n].rgb, &palette[4 * (m[i].v[k][3] - 1)], 3); /* index i is entry i - 1 */
+            n++;
+        }
+    if (!import("vox", &file, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        check_voxels(&s, want, n);
+        vdag_scene_free(&s);
+    }
+    sweep("vox", &file, 1);
+    free(body.p);
+    free(file.p);
+    free(c.p);
+}
+
+/* Without an RGBA chunk, colours come from MagicaVoxel's default palette;
+   the expected values are entries of its published table. */
+static void test_vox_default_palette(void) {
+    static const struct {
+        uint8_t index, rgb[3];
+    } table[] = {
+        {1, {0xff, 0xff, 0xff}},   {2, {0xff, 0xff, 0xcc}},   {7, {0xff, 0xcc, 0xff}},   {37, {0xcc, 0xff, 0xff}},
+        {215, {0x00, 0x00, 0x33}}, {216, {0xee, 0x00, 0x00}}, {225, {0x11, 0x00, 0x00}}, {226, {0x00, 0xee, 0x00}},
+        {236, {0x00, 0x00, 0xee}}, {246, {0xee, 0xee, 0xee}}, {255, {0x11, 0x11, 0x11}},
+    };
+    const size_t n = sizeof table / sizeof table[0];
+    vox_model m;
+    voxel want[16];
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    size_t i;
+    m.size[0] = (uint32_t)n;
+    m.size[1] = m.size[2] = 1;
+    m.n = n;
+    for (i = 0; i < n; i++) {
+        m.v[i][0] = (uint8_t)i;
+        m.v[i][1] = m.v[i][2] = 0;
+        m.v[i][3] = table[i].index;
+        want[i].p[0] = (int64_t)i;
+        want[i].p[1] = want[i].p[2] = 0;
+        memcpy(want[i].rgb, table[i].rgb, 3);
+    }
+    vox_models(&body, &m, 1);
+    vox_file(&file, &body, 150);
+    if (!import("vox", &file, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        check_voxels(&s, want, n);
+        vdag_scene_free(&s);
+    }
+    free(body.p);
+    free(file.p);
+}
+
+/* A rotation byte: rows 0 and 1 take their non-zero entry from columns C0
+   and C1, row 2 from the third; SIGNS bits 0-2 negate rows 0-2. */
+static int rotation_byte(int c0, int c1, int signs) { return c0 | c1 << 2 | signs << 4; }
+
+/* Scene graph: root transform -> group -> three transforms -> shapes, one
+   model shown twice; plus chunks the importer does not use. The expected
+   voxel is floor(R_root (R (v + 1/2 - size/2) + t) + t_root), in doubles. */
+static void test_vox_scene_graph(void) {
+    uint64_t seed = 9;
+    int round;
+    for (round = 0; round < 20; round++) {
+        vox_model m[2];
+        int rot[4][3][3], perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+        int64_t t[4][3];
+        char rs[4][8], ts[4][64];
+        const int32_t group_children[3] = {2, 4, 6};
+        const int shown[3] = {0, 1, 0};
+        voxel want[120];
+        bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        size_t i, k, n = 0;
+        int j, a, b;
+        random_model(&m[0], &seed);
+        random_model(&m[1], &seed);
+        for (j = 0; j < 4; j++) {
+            const int *p = perm[test_rand_below(&seed, 6)];
+            int signs = (int)test_rand_below(&seed, 8);
+            memset(rot[j], 0, sizeof rot[j]);
+            for (a = 0; a < 3; a++) rot[j][a][p[a]] = signs >> a & 1 ? -1 : 1;
+            snprintf(rs[j], sizeof rs[j], "%d", rotation_byte(p[0], p[1], signs));
+            for (a = 0; a < 3; a++) t[j][a] = (int64_t)test_rand_below(&seed, 200) - 100;
+            snprintf(ts[j], sizeof ts[j], "%ld %ld %ld", (long)t[j][0], (long)t[j][1], (long)t[j][2]);
+        }
+        vox_models(&body, m, 2);
+        c.n = 0;
+        putf(&c, "anything");
+        vox_chunk(&body, "NOTE", &c, 0);
+        vox_transform(&body, 0, 1, rs[3], ts[3]);
+        vox_group(&body, 1, group_children, 3);
+        for (j = 0; j < 3; j++) {
+            vox_transform(&body, 2 + 2 * j, 3 + 2 * j, rs[j], ts[j]);
+            vox_shape(&body, 3 + 2 * j, shown[j]);
+        }
+        c.n = 0;
+        put_le32(&c, 0);
+        vox_dict(&c, 1, "_hidden", "0");
+        put_le32(&c, -1);
+        vox_chunk(&body, "LAYR", &c, 0);
+        c.n = 0;
+        putf(&c, "unknown chunk with children");
+        vox_chunk(&body, "ZZZZ", &c, 12);
+        c.n = 0;
+        vox_chunk(&body, "ZZZY", &c, 0); /* its child */
+        vox_file(&file, &body, 200);
+        for (j = 0; j < 3; j++) {
+            const vox_model *model = &m[shown[j]];
+            for (k = 0; k < model->n; k++) {
+                double local[3], mid[3], world;
+                for (a = 0; a < 3; a++) local[a] = model->v[k][a] + 0.5 - model->size[a] / 2.0;
+                for (a = 0; a < 3; a++) {
+                    mid[a] = (double)t[j][a];
+                    for (b = 0; b < 3; b++) mid[a] += rot[j][a][b] * local[b];
+                }
+                for (a = 0; a < 3; a++) {
+                    world = (double)t[3][a];
+                    for (b = 0; b < 3; b++) world += rot[3][a][b] * mid[b];
+                    want[n].p[a] = (int64_t)floor(world);
+                }
+                for (a = 0; a < 3; a++) want[n].rgb[a] = 0; /* colours are not compared here */
+                n++;
+            }
+        }
+        if (!import("vox", &file, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            for (i = 0; i < s.point_count; i++) s.point_rgb[3 * i] = s.point_rgb[3 * i + 1] = s.point_rgb[3 * i + 2] = 0;
+            check_voxels(&s, want, n);
+            vdag_scene_free(&s);
+        }
+        if (round == 0) sweep("vox", &file, 1);
+        free(body.p);
+        free(file.p);
+        free(c.p);
+    }
+}
+
+/* A one-voxel model followed by scene graph chunks written by FILL. */
+static void vox_error(void (*fill)(bytes *), const char *want) {
+    vox_model m = {{2, 2, 2}, 1, {{1, 1, 1, 5}}};
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0};
+    vox_models(&body, &m, 1);
+    fill(&body);
+    vox_file(&file, &body, 200);
+    expect_error("vox", &file, want);
+    free(body.p);
+    free(file.p);
+}
+
+static void graph_missing_node(bytes *b) { vox_transform(b, 0, 99, NULL, NULL); }
+static void graph_missing_model(bytes *b) {
+    vox_transform(b, 0, 1, NULL, NULL);
+    vox_shape(b, 1, 1);
+}
+static void graph_cycle(bytes *b) {
+    const int32_t back[1] = {0};
+    vox_transform(b, 0, 1, NULL, "1 1 1");
+    vox_group(b, 1, back, 1);
+}
+static void graph_duplicate(bytes *b) {
+    vox_transform(b, 0, 1, NULL, NULL);
+    vox_shape(b, 0, 0);
+}
+static void graph_bad_rotation(bytes *b) { vox_transform(b, 0, 1, "3", "0 0 0"); }
+static void graph_same_columns(bytes *b) { vox_transform(b, 0, 1, "5", "0 0 0"); }
+static void graph_bad_translation(bytes *b) { vox_transform(b, 0, 1, NULL, "1 2"); }
+static void graph_huge_translation(bytes *b) { vox_transform(b, 0, 1, NULL, "0 0 4294967296"); }
+/* Groups 1..40, each listing the next twice: 2^40 paths to one shape. */
+static void graph_explosion(bytes *b) {
+    int32_t i;
+    vox_transform(b, 0, 1, NULL, NULL);
+    for (i = 1; i <= 40; i++) {
+        int32_t next[2];
+        next[0] = next[1] = i + 1;
+        vox_group(b, i, next, 2);
+    }
+    vox_shape(b, 41, 0);
+}
+static void graph_outside(bytes *b) {
+    bytes c = {NULL, 0, 0};
+    int i;
+    for (i = 0; i < 3; i++) put_le32(&c, 2);
+    vox_chunk(b, "SIZE", &c, 0);
+    c.n = 0;
+    put_le32(&c, 1);
+    put(&c, "\x01\x02\x01\x07", 4);
+    vox_chunk(b, "XYZI", &c, 0);
+    free(c.p);
+}
+static void graph_xyzi_only(bytes *b) {
+    bytes c = {NULL, 0, 0};
+    put_le32(&c, 0);
+    vox_chunk(b, "XYZI", &c, 0);
+    free(c.p);
+}
+static void graph_xyzi_short(bytes *b) {
+    bytes c = {NULL, 0, 0};
+    int i;
+    for (i = 0; i < 3; i++) put_le32(&c, 2);
+    vox_chunk(b, "SIZE", &c, 0);
+    c.n = 0;
+    put_le32(&c, 1000000000);
+    put(&c, "\x01\x01\x01\x07", 4);
+    vox_chunk(b, "XYZI", &c, 0);
+    free(c.p);
+}
+static void graph_short_palette(bytes *b) {
+    bytes c = {NULL, 0, 0};
+    put(&c, "\x01\x02\x03\x04", 4);
+    vox_chunk(b, "RGBA", &c, 0);
+    free(c.p);
+}
+static void graph_chunk_overrun(bytes *b) {
+    put(b, "nTRN", 4);
+    put_le32(b, 1000);
+    put_le32(b, 0);
+}
+
+static void test_vox_errors(void) {
+    bytes b = {NULL, 0, 0};
+    expect_error_text("vox", "VOX", "not a MagicaVoxel file");
+    expect_error_text("vox", "RIFF\x96\0\0\0MAIN", "not a MagicaVoxel file");
+    expect_error_text("vox", "VOX \x96\0\0\0MIAN\0\0\0\0\0\0\0\0", "no MAIN chunk");
+    put(&b, "VOX \x96\0\0\0MAIN\0\0\0\0\xff\xff\xff\xff", 20);
+    expect_error("vox", &b, "MAIN chunk runs past the end");
+    vox_error(graph_missing_node, "missing node 99");
+    vox_error(graph_missing_model, "shows missing model 1");
+    vox_error(graph_cycle, "cycle");
+    vox_error(graph_duplicate, "two scene graph nodes have the id 0");
+    vox_error(graph_bad_rotation, "malformed nTRN chunk");
+    vox_error(graph_same_columns, "malformed nTRN chunk");
+    vox_error(graph_bad_translation, "malformed nTRN chunk");
+    vox_error(graph_huge_translation, "malformed nTRN chunk");
+    vox_error(graph_explosion, "scene graph expands to more than");
+    vox_error(graph_outside, "outside its model's size");
+    vox_error(graph_xyzi_only, "XYZI chunk without a SIZE chunk");
+    vox_error(graph_xyzi_short, "fewer voxels than it declares");
+    vox_error(graph_short_palette, "RGBA chunk too short");
+    vox_error(graph_chunk_overrun, "chunk runs past the end of MAIN");
+    free(b.p);
+}
+
+const test_case test_import_cases[] = {
+    {"import/xyz roundtrip", test_xyz_roundtrip},
+    {"import/xyz errors", test_xyz_errors},
+    {"import/ply roundtrip", test_ply_roundtrip},
+    {"import/ply points", test_ply_points},
+    {"import/ply sweep", test_ply_sweep},
+    {"import/ply errors", test_ply_errors},
+    {"import/off roundtrip", test_off_roundtrip},
+    {"import/off points and sweep", test_off_points_and_sweep},
+    {"import/off errors", test_off_errors},
+    {"import/obj roundtrip", test_obj_roundtrip},
+    {"import/obj points", test_obj_points},
+    {"import/obj errors", test_obj_errors},
+    {"import/obj file with mtl and texture", test_obj_file},
+    {"import/file errors", test_file_errors},
+    {"import/vox models", test_vox_models},
+    {"import/vox default palette", test_vox_default_palette},
+    {"import/vox scene graph", test_vox_scene_graph},
+    {"import/vox errors", test_vox_errors},
+    {NULL, NULL},
+};
