@@ -14,7 +14,7 @@ THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 HEADERS := voxdag.h voxcolor.h
 
-VDAG_SRC := examples/vdag.c examples/import.c
+VDAG_SRC := examples/vdag.c examples/import.c examples/render.c
 TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c examples/import.c
 
 # Texture decoding (examples/image.h): OpenImageIO when installed, compiled

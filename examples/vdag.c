@@ -1,8 +1,492 @@
-/* vdag: build, inspect, query and render .vdag files. */
+/* vdag: build, inspect, query and render .vdag files.
+
+   vdag build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E]
+              [--color-bits W|auto] [--threads T] [--stats]
+   vdag info FILE [--json]
+   vdag validate FILE
+   vdag lookup FILE x y z
+   vdag rays FILE            (rays on stdin)
+   vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] [--fov deg] [--threads T]
+   vdag export-voxels FILE
+   vdag gen SCENE OUT.xyz [--levels L]   (built-in scenes: demo)
+
+   Progress and diagnostics go to stderr; stdout carries only documented
+   output. Exit status 0 on success, 1 with a one-line message otherwise. */
+#define _POSIX_C_SOURCE 200809L
+#define VOXDAG_IMPLEMENTATION
+#include "voxdag.h"
+#define VOXCOLOR_IMPLEMENTATION
+#include "voxcolor.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "import.h"
+
+// -- Shared helpers (cli.h)
+
+int vdag_fail(const char *fmt, ...) {
+    va_list ap;
+    fputs("vdag: ", stderr);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
+    return 1;
+}
+
+unsigned vdag_cpu_count(void) {
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 64 ? 64 : (unsigned)n;
+}
+
+int vdag_open(const char *path, vdag_file *f) {
+    voxdag_error err;
+    const void *payload;
+    size_t size;
+    memset(f, 0, sizeof *f);
+    if (voxdag_load_file(path, NULL, &f->dag, &err) != VOXDAG_OK) {
+        if (err.byte_offset != UINT64_MAX)
+            return !vdag_fail("%s: %s (%s at byte %llu)", path, voxdag_status_string(err.status), err.message,
+                              (unsigned long long)err.byte_offset);
+        return !vdag_fail("%s: %s (%s)", path, voxdag_status_string(err.status), err.message);
+    }
+    switch (voxdag_colors(f->dag, &payload, &size)) {
+    case VOXDAG_COLORS_RGB8: f->has_colors = 1; break;
+    case VOXDAG_COLORS_VOXCOLOR: {
+        voxdag_info info;
+        voxcolor_status st = voxcolor_view_init(&f->colors, payload, size);
+        voxdag_get_info(f->dag, &info);
+        if (st != VOXCOLOR_OK || f->colors.count != info.voxels) {
+            vdag_close(f);
+            return !vdag_fail("%s: corrupt colour section (%s)", path,
+                              st != VOXCOLOR_OK ? voxcolor_status_string(st) : "colour count differs from voxel count");
+        }
+        f->has_colors = 1;
+        break;
+    }
+    default: break;
+    }
+    return 1;
+}
+
+void vdag_close(vdag_file *f) {
+    voxdag_free(f->dag);
+    memset(f, 0, sizeof *f);
+}
+
+void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]) {
+    if (f->colors.count) voxcolor_view_get(&f->colors, index, rgb);
+    else if (!voxdag_color(f->dag, index, rgb)) rgb[0] = rgb[1] = rgb[2] = 255;
+}
+
+static double now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+static int parse_u32(const char *s, uint32_t *out) {
+    char *end;
+    unsigned long v;
+    errno = 0;
+    v = strtoul(s, &end, 10);
+    if (errno || end == s || *end || v > 0xFFFFFFFFul || s[0] == '-') return 0;
+    *out = (uint32_t)v;
+    return 1;
+}
+
+static int parse_double(const char *s, double *out) {
+    char *end;
+    *out = strtod(s, &end);
+    return end != s && !*end && isfinite(*out);
+}
+
+// -- vdag build
+
+typedef struct build_args {
+    const char *in, *out;
+    uint32_t levels, threads;
+    int no_symmetry, stats, compress;
+    double color_error;
+    uint32_t color_bits; /* 0: auto */
+} build_args;
+
+static void progress(void *user, const char *stage, double fraction) {
+    (void)user;
+    fprintf(stderr, "vdag: %s %3.0f%%\n", stage, 100 * fraction);
+}
+
+/* Points to grid voxels: integer voxels as they are, point clouds and mesh
+   vertices fitted into the 2^L grid by their bounding box. */
+static int scene_to_grid(const vdag_scene *sc, build_args *a, uint32_t **xyz_out, double bounds[6]) {
+    size_t i;
+    int k;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, extent = 0, scale;
+    uint32_t *xyz, n;
+    for (i = 0; i < sc->point_count; i++)
+        for (k = 0; k < 3; k++) {
+            double v = sc->points[3 * i + k];
+            if (v < lo[k]) lo[k] = v;
+            if (v > hi[k]) hi[k] = v;
+        }
+    if (sc->points_are_voxels) {
+        double top = 0;
+        for (k = 0; k < 3; k++)
+            if (sc->point_count && hi[k] > top) top = hi[k];
+        if (!a->levels) {
+            a->levels = 2;
+            while (a->levels < VOXDAG_MAX_LEVELS && (double)(1u << a->levels) <= top) a->levels++;
+        }
+        if (top >= (double)(1u << a->levels))
+            return vdag_fail("%s: coordinate %.0f does not fit --levels %u", a->in, top, a->levels);
+    } else if (!a->levels) {
+        a->levels = 10;
+    }
+    n = 1u << a->levels;
+    for (k = 0; k < 3; k++) {
+        if (!sc->point_count) lo[k] = hi[k] = 0;
+        if (hi[k] - lo[k] > extent) extent = hi[k] - lo[k];
+    }
+    scale = extent > 0 ? n / extent : 1;
+    for (k = 0; k < 3; k++) {
+        bounds[k] = sc->points_are_voxels ? 0 : lo[k];
+        bounds[k + 3] = sc->points_are_voxels ? n : lo[k] + n / scale;
+    }
+    xyz = (uint32_t *)malloc(3 * sc->point_count * sizeof *xyz + 1);
+    if (!xyz) return vdag_fail("out of memory");
+    for (i = 0; i < 3 * sc->point_count; i++) {
+        double v = sc->points[i];
+        if (!sc->points_are_voxels) {
+            v = floor((v - lo[i % 3]) * scale);
+            if (v > n - 1) v = n - 1;
+        }
+        xyz[i] = (uint32_t)v;
+    }
+    *xyz_out = xyz;
+    return 0;
+}
+
+static void print_build_summary(const voxdag *dag, const voxdag_build_stats *st, double seconds) {
+    voxdag_info info;
+    uint32_t l;
+    voxdag_get_info(dag, &info);
+    fprintf(stderr, "vdag: %llu voxels, L=%u, %.2f s, peak %.1f MiB\n", (unsigned long long)info.voxels,
+            info.levels, seconds, st->peak_memory / 1048576.0);
+    fprintf(stderr, "vdag: level      nodes        svo%s\n", st->svdag_nodes[0] ? "      svdag     ssvdag" : "");
+    for (l = 0; l + 1 < info.levels; l++) {
+        fprintf(stderr, "vdag: %5u %10llu %10llu", l, (unsigned long long)st->nodes[l],
+                (unsigned long long)st->svo_nodes[l]);
+        if (st->svdag_nodes[0])
+            fprintf(stderr, " %10llu %10llu", (unsigned long long)st->svdag_nodes[l],
+                    (unsigned long long)st->ssvdag_nodes[l]);
+        fputc('\n', stderr);
+    }
+    fprintf(stderr, "vdag: geometry %llu bytes (%.3f bits/voxel), colours %llu bytes, file %llu bytes\n",
+            (unsigned long long)(info.node_bytes + info.brick_bytes),
+            info.voxels ? 8.0 * (double)(info.node_bytes + info.brick_bytes) / (double)info.voxels : 0.0,
+            (unsigned long long)info.color_bytes, (unsigned long long)info.file_bytes);
+}
+
+/* Replaces the RGB8 colour section of *DAG with a voxcolor stream. */
+static int compress_colors(voxdag **dag, const build_args *a) {
+    const void *rgb;
+    size_t size, bound, bytes;
+    voxcolor_encode_opts o;
+    uint8_t *buf;
+    voxdag *with = NULL;
+    voxdag_error err;
+    double t0 = now_seconds();
+    if (voxdag_colors(*dag, &rgb, &size) != VOXDAG_COLORS_RGB8) return 0;
+    memset(&o, 0, sizeof o);
+    o.max_error = a->color_error;
+    o.weight_bits = a->color_bits;
+    bound = voxcolor_encode_bound(size / 3);
+    buf = (uint8_t *)malloc(bound ? bound : 1);
+    if (!buf) return vdag_fail("out of memory");
+    bytes = voxcolor_encode(buf, bound, (const uint8_t *)rgb, size / 3, &o);
+    if (!bytes) {
+        free(buf);
+        return vdag_fail("colour compression failed");
+    }
+    if (voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, buf, bytes, &with, &err) != VOXDAG_OK) {
+        free(buf);
+        return vdag_fail("%s", err.message);
+    }
+    fprintf(stderr, "vdag: colours %zu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g) in %.2f s\n", size, bytes,
+            size ? 100.0 * (double)bytes / (double)size : 0.0, size ? 24.0 * (double)bytes / (double)size : 0.0,
+            a->color_error, now_seconds() - t0);
+    free(buf);
+    voxdag_free(*dag);
+    *dag = with;
+    return 0;
+}
+
+static int cmd_build(int argc, char **argv) {
+    build_args a;
+    vdag_scene sc;
+    char msg[256];
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *dag = NULL;
+    voxdag_build_stats st;
+    voxdag_error err;
+    uint32_t *xyz = NULL;
+    double bounds[6], t0 = now_seconds();
+    size_t i;
+    int k, rc;
+    memset(&a, 0, sizeof a);
+    a.threads = vdag_cpu_count();
+    for (k = 1; k < argc; k++) {
+        if (!strcmp(argv[k], "--levels") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.levels) || a.levels < 2 || a.levels > VOXDAG_MAX_LEVELS)
+                return vdag_fail("build: --levels takes 2..%d", VOXDAG_MAX_LEVELS);
+        } else if (!strcmp(argv[k], "--threads") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.threads) || !a.threads) return vdag_fail("build: --threads takes a count >= 1");
+        } else if (!strcmp(argv[k], "--no-symmetry")) {
+            a.no_symmetry = 1;
+        } else if (!strcmp(argv[k], "--stats")) {
+            a.stats = 1;
+        } else if (!strcmp(argv[k], "--color-error") && k + 1 < argc) {
+            if (!parse_double(argv[++k], &a.color_error) || a.color_error < 0)
+                return vdag_fail("build: --color-error takes a number >= 0");
+            a.compress = 1;
+        } else if (!strcmp(argv[k], "--color-bits") && k + 1 < argc) {
+            k++;
+            if (!strcmp(argv[k], "auto")) a.color_bits = 0;
+            else if (!parse_u32(argv[k], &a.color_bits) || a.color_bits < 1 || a.color_bits > 4)
+                return vdag_fail("build: --color-bits takes 1..4 or auto");
+            a.compress = 1;
+        } else if (argv[k][0] == '-' && argv[k][1]) {
+            return vdag_fail("build: unknown option %s", argv[k]);
+        } else if (!a.in) {
+            a.in = argv[k];
+        } else if (!a.out) {
+            a.out = argv[k];
+        } else {
+            return vdag_fail("build: too many arguments");
+        }
+    }
+    if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--no-symmetry] ...");
+    fprintf(stderr, "vdag: reading %s\n", a.in);
+    if (!vdag_import_file(a.in, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    if (sc.triangle_count && !sc.point_count) {
+        vdag_scene_free(&sc);
+        return vdag_fail("%s: triangle meshes are not supported by this build of vdag yet", a.in);
+    }
+    if (scene_to_grid(&sc, &a, &xyz, bounds)) {
+        vdag_scene_free(&sc);
+        return 1;
+    }
+    memset(&o, 0, sizeof o);
+    o.levels = a.levels;
+    o.no_symmetry = a.no_symmetry;
+    o.colors = sc.point_rgb != NULL;
+    o.compare_structures = a.stats;
+    o.threads = a.threads;
+    o.bounds = bounds;
+    o.progress = progress;
+    rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
+    for (i = 0; !rc && i < sc.point_count; i += 1u << 20) {
+        size_t n = sc.point_count - i < (1u << 20) ? sc.point_count - i : (1u << 20);
+        rc = voxdag_builder_add(b, xyz + 3 * i, sc.point_rgb ? sc.point_rgb + 3 * i : NULL, n, &err) != VOXDAG_OK;
+        if (rc) voxdag_builder_free(b);
+    }
+    free(xyz);
+    vdag_scene_free(&sc);
+    if (!rc) rc = voxdag_builder_finish(b, &dag, &st, &err) != VOXDAG_OK;
+    if (rc) return vdag_fail("build: %s (%s)", voxdag_status_string(err.status), err.message);
+    print_build_summary(dag, &st, now_seconds() - t0);
+    if (a.compress && compress_colors(&dag, &a)) {
+        voxdag_free(dag);
+        return 1;
+    }
+    rc = voxdag_save_file(dag, a.out, &err) != VOXDAG_OK;
+    voxdag_free(dag);
+    if (rc) return vdag_fail("%s: %s", a.out, err.message);
+    fprintf(stderr, "vdag: wrote %s\n", a.out);
+    return 0;
+}
+
+// -- vdag info / validate
+
+static const char *color_kind_name(voxdag_color_kind k) {
+    return k == VOXDAG_COLORS_RGB8 ? "rgb8" : k == VOXDAG_COLORS_VOXCOLOR ? "voxcolor" : "none";
+}
+
+static int cmd_info(int argc, char **argv) {
+    vdag_file f;
+    voxdag_info in;
+    int json = argc > 2 && !strcmp(argv[2], "--json");
+    uint32_t l;
+    double geo_bits;
+    if (argc < 2 || argc > 3 || (argc == 3 && !json)) return vdag_fail("usage: vdag info FILE [--json]");
+    if (!vdag_open(argv[1], &f)) return 1;
+    voxdag_get_info(f.dag, &in);
+    geo_bits = in.voxels ? 8.0 * (double)(in.node_bytes + in.brick_bytes) / (double)in.voxels : 0.0;
+    if (json) {
+        printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"nodes_per_level\": [", in.levels,
+               (unsigned long long)in.voxels, in.symmetric ? "true" : "false");
+        for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.nodes[l]);
+        printf("], \"bytes_per_level\": [");
+        for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.level_bytes[l]);
+        printf("], \"bytes\": {\"file\": %llu, \"nodes\": %llu, \"bricks\": %llu, \"colors\": %llu}, ",
+               (unsigned long long)in.file_bytes, (unsigned long long)in.node_bytes,
+               (unsigned long long)in.brick_bytes, (unsigned long long)in.color_bytes);
+        printf("\"bits_per_voxel\": %.6f, \"color_format\": \"%s\", \"color_bits_per_voxel\": %.6f", geo_bits,
+               color_kind_name(in.color_kind), in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
+        if (in.has_bounds)
+            printf(", \"bounds\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]", in.bounds[0], in.bounds[1],
+                   in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
+        printf("}\n");
+    } else {
+        printf("levels      %u (grid %u^3)\n", in.levels, 1u << in.levels);
+        printf("voxels      %llu\n", (unsigned long long)in.voxels);
+        printf("symmetric   %s\n", in.symmetric ? "yes" : "no");
+        printf("level       nodes        bytes\n");
+        for (l = 0; l + 1 < in.levels; l++)
+            printf("%5u %11llu %12llu%s\n", l, (unsigned long long)in.nodes[l],
+                   (unsigned long long)in.level_bytes[l], l + 2 == in.levels ? "  (4^3 bricks)" : "");
+        printf("geometry    %llu bytes (%.4f bits/voxel)\n", (unsigned long long)(in.node_bytes + in.brick_bytes),
+               geo_bits);
+        printf("colours     %s, %llu bytes (%.3f bits/voxel)\n", color_kind_name(in.color_kind),
+               (unsigned long long)in.color_bytes,
+               in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
+        printf("file        %llu bytes\n", (unsigned long long)in.file_bytes);
+        if (in.has_bounds)
+            printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0], in.bounds[1], in.bounds[2],
+                   in.bounds[3], in.bounds[4], in.bounds[5]);
+    }
+    vdag_close(&f);
+    return 0;
+}
+
+static int cmd_validate(int argc, char **argv) {
+    vdag_file f;
+    if (argc != 2) return vdag_fail("usage: vdag validate FILE");
+    if (!vdag_open(argv[1], &f)) return 1;
+    vdag_close(&f);
+    fprintf(stderr, "vdag: %s: valid\n", argv[1]);
+    return 0;
+}
+
+// -- vdag lookup / export-voxels
+
+static int cmd_lookup(int argc, char **argv) {
+    vdag_file f;
+    uint32_t c[3];
+    uint64_t index;
+    int k;
+    if (argc != 5) return vdag_fail("usage: vdag lookup FILE x y z");
+    for (k = 0; k < 3; k++)
+        if (!parse_u32(argv[2 + k], &c[k])) return vdag_fail("lookup: bad coordinate '%s'", argv[2 + k]);
+    if (!vdag_open(argv[1], &f)) return 1;
+    if (voxdag_lookup(f.dag, c[0], c[1], c[2], &index)) {
+        uint8_t rgb[3];
+        vdag_voxel_color(&f, index, rgb);
+        printf("1 %llu %u %u %u\n", (unsigned long long)index, rgb[0], rgb[1], rgb[2]);
+    } else {
+        printf("0\n");
+    }
+    vdag_close(&f);
+    return 0;
+}
+
+static int export_voxel(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    const vdag_file *f = (const vdag_file *)user;
+    uint8_t rgb[3];
+    vdag_voxel_color(f, index, rgb);
+    printf("%u %u %u %u %u %u\n", x, y, z, rgb[0], rgb[1], rgb[2]);
+    return 0;
+}
+
+static int cmd_export(int argc, char **argv) {
+    vdag_file f;
+    if (argc != 2) return vdag_fail("usage: vdag export-voxels FILE");
+    if (!vdag_open(argv[1], &f)) return 1;
+    voxdag_for_each_voxel(f.dag, export_voxel, &f);
+    vdag_close(&f);
+    return fflush(stdout) ? vdag_fail("export-voxels: write error") : 0;
+}
+
+// -- vdag gen: the built-in demo scene
+
+/* A coloured landscape: rolling terrain with grass and rock, a pond, and a
+   striped sphere floating above, all from closed-form functions. */
+static int cmd_gen(int argc, char **argv) {
+    uint32_t levels = 7, n, x, y, z;
+    FILE *out;
+    if (argc == 5 && !strcmp(argv[3], "--levels")) {
+        if (!parse_u32(argv[4], &levels) || levels < 4 || levels > 10) return vdag_fail("gen: --levels takes 4..10");
+    } else if (argc != 3) {
+        return vdag_fail("usage: vdag gen demo OUT.xyz [--levels L]");
+    }
+    if (strcmp(argv[1], "demo")) return vdag_fail("gen: unknown scene '%s' (known: demo)", argv[1]);
+    out = fopen(argv[2], "w");
+    if (!out) return vdag_fail("%s: %s", argv[2], strerror(errno));
+    n = 1u << levels;
+    fprintf(out, "# voxdag demo scene, %u^3\n", n);
+    for (z = 0; z < n; z++)
+        for (y = 0; y < n; y++)
+            for (x = 0; x < n; x++) {
+                double u = (x + 0.5) / n, v = (y + 0.5) / n, w = (z + 0.5) / n;
+                double ground = 0.22 + 0.08 * sin(6.3 * u) * cos(4.1 * v) + 0.05 * sin(17.0 * (u + v));
+                double dx = u - 0.5, dy = v - 0.52, dz = w - 0.62, r = sqrt(dx * dx + dy * dy + dz * dz);
+                int r8, g8, b8;
+                if (w <= ground && w > ground - 3.0 / n) { /* terrain surface */
+                    double shade = 0.75 + 0.25 * sin(40.0 * u * v);
+                    if (ground < 0.17) { r8 = 40; g8 = 90; b8 = 200; }                  /* pond */
+                    else if (ground > 0.31) { r8 = 130; g8 = 120; b8 = 110; }           /* rock */
+                    else { r8 = 60; g8 = 150; b8 = 50; }                                 /* grass */
+                    r8 = (int)(r8 * shade); g8 = (int)(g8 * shade); b8 = (int)(b8 * shade);
+                } else if (r <= 0.18 && r > 0.18 - 2.5 / n) { /* shell of the sphere */
+                    int band = (int)floor((dz / 0.18 + 1.0) * 4.0);
+                    r8 = band & 1 ? 230 : 250; g8 = band & 1 ? 70 : 200; b8 = band & 1 ? 60 : 40;
+                } else {
+                    continue;
+                }
+                fprintf(out, "%u %u %u %d %d %d\n", x, y, z, r8, g8, b8);
+            }
+    if (fclose(out)) return vdag_fail("%s: write error", argv[2]);
+    return 0;
+}
+
+// -- main
+
+static int usage(FILE *f) {
+    fputs("usage: vdag COMMAND ...\n"
+          "  build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E] [--color-bits W|auto]\n"
+          "                    [--threads T] [--stats]\n"
+          "  info FILE [--json]\n"
+          "  validate FILE\n"
+          "  lookup FILE x y z\n"
+          "  rays FILE                 (rays 'ox oy oz dx dy dz' on stdin)\n"
+          "  render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] [--fov deg] [--threads T]\n"
+          "  export-voxels FILE\n"
+          "  gen demo OUT.xyz [--levels L]\n",
+          f);
+    return f == stdout ? 0 : 1;
+}
+
 int main(int argc, char **argv) {
-    if (argc > 1 && !strcmp(argv[1], "--help")) { puts("usage: vdag COMMAND ..."); return 0; }
-    fprintf(stderr, "vdag: usage: vdag COMMAND ...\n");
-    return 2;
+    static const struct {
+        const char *name;
+        int (*fn)(int, char **);
+    } commands[] = {{"build", cmd_build},   {"info", cmd_info},         {"validate", cmd_validate},
+                    {"lookup", cmd_lookup}, {"rays", vdag_cmd_rays},    {"render", vdag_cmd_render},
+                    {"export-voxels", cmd_export}, {"gen", cmd_gen}};
+    size_t i;
+    if (argc < 2) return usage(stderr);
+    if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) return usage(stdout);
+    for (i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(argv[1], commands[i].name)) return commands[i].fn(argc - 1, argv + 1);
+    vdag_fail("unknown command '%s' (see vdag --help)", argv[1]);
+    return 1;
 }

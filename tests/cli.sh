@@ -1,11 +1,112 @@
 #!/bin/sh
-# Command-line contract tests for the vdag tool. Usage: tests/cli.sh VDAG
+# Command-line contract tests for the vdag tool (the forms of DESIGN section 7
+# as documented in README.md). Expected answers are computed here by an
+# independent script (python3), never taken from vdag itself.
+# Usage: tests/cli.sh VDAG
 set -u
 VDAG=${1:-build/vdag}
+T=$(mktemp -d)
+trap 'rm -rf "$T"' EXIT
 pass=0
 fail=0
 ok() { pass=$((pass + 1)); }
 ko() { fail=$((fail + 1)); echo "  FAIL: $*" >&2; }
-"$VDAG" --help >/dev/null 2>&1 && ok || ko "vdag --help"
+check() { # check DESCRIPTION COMMAND...: passes when COMMAND succeeds
+    d=$1; shift
+    if "$@"; then ok; else ko "$d"; fi
+}
+
+# -- usage and errors
+check "vdag --help exits 0" "$VDAG" --help >/dev/null
+check "unknown command fails" sh -c "! '$VDAG' frobnicate 2>/dev/null"
+check "missing file fails with one line" sh -c "! '$VDAG' info '$T/none.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
+
+# -- build from .xyz, then every query against a Morton-sorted oracle
+python3 - "$T" <<'EOF'
+import random, sys
+t = sys.argv[1]
+random.seed(7)
+n = 32
+vox = {}
+for _ in range(3000):
+    x, y, z = (random.randrange(n) for _ in range(3))
+    vox[(x, y, z)] = tuple(random.randrange(256) for _ in range(3))
+with open(t + "/in.xyz", "w") as f:
+    f.write("# random voxels\n")
+    for (x, y, z), c in vox.items():
+        f.write("%d %d %d %d %d %d\n" % (x, y, z, *c))
+def morton(x, y, z):
+    c = 0
+    for b in range(5, -1, -1):
+        c = c << 3 | (x >> b & 1) | (y >> b & 1) << 1 | (z >> b & 1) << 2
+    return c
+order = sorted(vox, key=lambda v: morton(*v))
+with open(t + "/expected_export", "w") as f:
+    for v in order:
+        f.write("%d %d %d %d %d %d\n" % (*v, *vox[v]))
+with open(t + "/queries", "w") as q, open(t + "/expected_lookup", "w") as e:
+    rank = {v: i for i, v in enumerate(order)}
+    for _ in range(60):
+        v = (random.randrange(n), random.randrange(n), random.randrange(n))
+        q.write("%d %d %d\n" % v)
+        e.write(("1 %d %d %d %d\n" % (rank[v], *vox[v])) if v in vox else "0\n")
+    for v in order[:40]:
+        q.write("%d %d %d\n" % v)
+        e.write("1 %d %d %d %d\n" % (rank[v], *vox[v]))
+print(len(vox), file=open(t + "/count", "w"))
+EOF
+check "build .xyz" "$VDAG" build "$T/in.xyz" "$T/a.vdag" --levels 5 2>/dev/null
+check "validate a built file" "$VDAG" validate "$T/a.vdag" 2>/dev/null
+"$VDAG" export-voxels "$T/a.vdag" >"$T/export" 2>/dev/null
+check "export-voxels = input in Morton order" cmp -s "$T/export" "$T/expected_export"
+: >"$T/lookup"
+while read -r x y z; do "$VDAG" lookup "$T/a.vdag" "$x" "$y" "$z" >>"$T/lookup"; done <"$T/queries"
+check "lookup prints 0 or '1 INDEX R G B' by Morton rank" cmp -s "$T/lookup" "$T/expected_lookup"
+"$VDAG" info "$T/a.vdag" --json >"$T/info.json" 2>/dev/null
+check "info --json has levels, voxels, nodes_per_level" python3 -c "
+import json, sys
+d = json.load(open('$T/info.json'))
+assert d['levels'] == 5 and d['voxels'] == int(open('$T/count').read())
+assert len(d['nodes_per_level']) == 4 and d['nodes_per_level'][0] == 1
+"
+
+# -- lossy colours stay within the bound; lossless colours are exact
+check "build with --color-error" "$VDAG" build "$T/in.xyz" "$T/c.vdag" --levels 5 --color-error 0.05 2>/dev/null
+"$VDAG" export-voxels "$T/c.vdag" >"$T/export_c" 2>/dev/null
+check "compressed colours within e_t" python3 -c "
+a = [l.split() for l in open('$T/expected_export')]
+b = [l.split() for l in open('$T/export_c')]
+assert len(a) == len(b)
+for p, q in zip(a, b):
+    assert p[:3] == q[:3]
+    d = sum((int(u) - int(v)) ** 2 for u, v in zip(p[3:], q[3:])) ** 0.5 / 255
+    assert d <= 0.05 + 1e-9, (p, q, d)
+"
+check "build with --color-error 0" "$VDAG" build "$T/in.xyz" "$T/l.vdag" --levels 5 --color-error 0 2>/dev/null
+"$VDAG" export-voxels "$T/l.vdag" >"$T/export_l" 2>/dev/null
+check "lossless colours exact" cmp -s "$T/export_l" "$T/expected_export"
+
+# -- symmetry off gives the same voxels; the same input gives the same bytes
+check "build --no-symmetry" "$VDAG" build "$T/in.xyz" "$T/n.vdag" --levels 5 --no-symmetry 2>/dev/null
+"$VDAG" export-voxels "$T/n.vdag" >"$T/export_n" 2>/dev/null
+check "plain SVDAG exports the same voxels" cmp -s "$T/export_n" "$T/expected_export"
+check "thread count does not change the file" sh -c "'$VDAG' build '$T/in.xyz' '$T/t1.vdag' --levels 5 --threads 1 2>/dev/null &&
+    '$VDAG' build '$T/in.xyz' '$T/t3.vdag' --levels 5 --threads 3 2>/dev/null && cmp -s '$T/t1.vdag' '$T/a.vdag' && cmp -s '$T/t3.vdag' '$T/a.vdag'"
+
+# -- bad inputs: clean one-line errors
+printf '1 2 3\n9 9 99\n' >"$T/big.xyz"
+check "coordinate beyond --levels is refused" sh -c "! '$VDAG' build '$T/big.xyz' '$T/x.vdag' --levels 4 2>/dev/null"
+head -c 100 "$T/a.vdag" >"$T/cut.vdag"
+check "truncated file is invalid" sh -c "! '$VDAG' validate '$T/cut.vdag' 2>/dev/null"
+python3 -c "
+b = bytearray(open('$T/a.vdag', 'rb').read()); b[len(b) // 2] ^= 0x40
+open('$T/flip.vdag', 'wb').write(b)"
+check "flipped byte is invalid, one-line reason" sh -c "! '$VDAG' validate '$T/flip.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
+check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1 2 x 2>/dev/null"
+
+# -- the demo scene generator
+check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
+check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
+
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]

@@ -1,0 +1,33 @@
+/* Shared pieces of the vdag tool's subcommands. */
+#ifndef VDAG_CLI_H
+#define VDAG_CLI_H
+
+#include <stdint.h>
+#include "voxdag.h"
+#include "voxcolor.h"
+
+/* A loaded .vdag file with its colour decoder. */
+typedef struct vdag_file {
+    voxdag *dag;
+    int has_colors;         /* RGB8 or voxcolor colours present */
+    voxcolor_view colors;   /* valid when the colour section is a voxcolor stream */
+} vdag_file;
+
+/* Loads and validates PATH. Returns 1, or 0 after printing a one-line reason. */
+int vdag_open(const char *path, vdag_file *f);
+void vdag_close(vdag_file *f);
+
+/* Colour of voxel INDEX (white when the file has no colours). Thread-safe. */
+void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]);
+
+/* Prints "vdag: MESSAGE" on stderr; returns 1 (the failing exit status). */
+int vdag_fail(const char *fmt, ...);
+
+/* Number of online processors (at least 1). */
+unsigned vdag_cpu_count(void);
+
+/* Subcommands implemented outside vdag.c. */
+int vdag_cmd_rays(int argc, char **argv);
+int vdag_cmd_render(int argc, char **argv);
+
+#endif
