@@ -70,10 +70,23 @@ fuzz-import: | $(BUILD)
 	$(BUILD)/fuzz_import_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/import.dict \
 	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_import_corpus tests/data/fuzz/import
 
+# Colour codec fuzzing: libFuzzer (clang) for `make fuzz-voxcolor`; `make test`
+# replays the committed corpus with the same entry point.
+.PHONY: fuzz-voxcolor
+$(BUILD)/fuzz_voxcolor: tests/fuzz_voxcolor.c voxcolor.h | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) -I. -o $@ tests/fuzz_voxcolor.c -lm
+
+fuzz-voxcolor: | $(BUILD)
+	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXCOLOR_LIBFUZZER \
+	    -I. -o $(BUILD)/fuzz_voxcolor_libfuzzer tests/fuzz_voxcolor.c -lm
+	@mkdir -p $(BUILD)/fuzz_voxcolor_corpus
+	$(BUILD)/fuzz_voxcolor_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/voxcolor.dict \
+	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_voxcolor_corpus tests/data/fuzz/voxcolor
+
 deps:
 	@sh tests/deps.sh
 
-test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import
+test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor
 	@sh tests/run.sh $(BUILD)
 
 clean:

@@ -72,7 +72,7 @@
 #define VOXCOLOR_HEADER_SIZE 24   /* then the page table, then the block data */
 
 #define VOXCOLOR_MIN_PAGE_SHIFT 4
-#define VOXCOLOR_MAX_PAGE_SHIFT 12
+#define VOXCOLOR_MAX_PAGE_SHIFT 10
 #define VOXCOLOR_DEFAULT_PAGE_SHIFT 8
 
 #ifndef VOXCOLOR_API
@@ -123,7 +123,7 @@ typedef struct voxcolor_encode_opts {
     uint32_t weight_bits;    /* 0: 0..4 bits per block (best fit); 1..4: blocks
                                 with weights all use this width (as in the
                                 paper's fixed-width format) */
-    uint32_t page_shift;     /* 0: 8; else 4..12. Larger: smaller stream,
+    uint32_t page_shift;     /* 0: 8; else 4..10. Larger: smaller stream,
                                 slower random lookup */
 } voxcolor_encode_opts;
 
@@ -216,9 +216,10 @@ VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t
 #endif
 
 // -- Block modes
-/* A block header is MODE (3 bits), PRECISION (1 bit: 0 RGB565, 1 RGB888
-   endpoints) and LENGTH - 1 (page_shift bits), followed by the endpoints and
-   the per-colour payload. Modes 0..4: weight width in bits (0 = one colour);
+/* A page is its block count - 1 (page_shift bits), a directory entry per
+   block: MODE (3 bits), PRECISION (1 bit: 0 RGB565, 1 RGB888 endpoints) and
+   LENGTH - 1 (page_shift bits), then each block's payload: its endpoints and
+   a weight per colour. Modes 0..4: weight width in bits (0 = one colour);
    mode 5: raw RGB888 colours. */
 #define VOXCOLORI_MODE_RAW 5u
 #define VOXCOLORI_MAX_WEIGHT_BITS 4u
@@ -233,16 +234,18 @@ static const uint8_t voxcolori_weights[5][16] = {
     {0, 4, 9, 13, 17, 21, 26, 30, 34, 38, 43, 47, 51, 55, 60, 64},
 };
 
-/* Bits per colour of the payload of each mode. */
-static unsigned voxcolori_payload_bits(unsigned mode) {
-    return mode == VOXCOLORI_MODE_RAW ? 24u : mode;
-}
+/* Endpoint bits of a block by mode | precision << 3: one colour for mode 0,
+   two for modes 1..4, none for raw. */
+static const uint8_t voxcolori_endpoint_table[16] = {16, 32, 32, 32, 32, 0, 0, 0,
+                                                     24, 48, 48, 48, 48, 0, 0, 0};
 
-/* Endpoint bits of a block: none for raw, one colour for mode 0, two else. */
+/* Bits per colour of each mode: the weight width, or 24 for raw. */
+static const uint8_t voxcolori_colour_table[8] = {0, 1, 2, 3, 4, 24, 0, 0};
+
+static unsigned voxcolori_payload_bits(unsigned mode) { return voxcolori_colour_table[mode & 7]; }
+
 static unsigned voxcolori_endpoint_bits(unsigned mode, unsigned precision) {
-    unsigned one = precision ? 24u : 16u;
-    if (mode == VOXCOLORI_MODE_RAW) return 0;
-    return mode == 0 ? one : 2 * one;
+    return voxcolori_endpoint_table[(mode & 7) | (precision & 1) << 3];
 }
 
 /* 8-bit value of a quantized channel with BITS bits (bit replication). */
@@ -255,6 +258,12 @@ static unsigned voxcolori_expand(unsigned q, unsigned bits) {
 static unsigned voxcolori_channel_bits(unsigned channel, unsigned precision) {
     if (precision) return 8;
     return channel == 1 ? 6u : 5u;
+}
+
+/* Position of a channel in a packed endpoint (red lowest). */
+static unsigned voxcolori_channel_shift(unsigned channel, unsigned precision) {
+    static const uint8_t shift565[3] = {0, 5, 11};
+    return precision ? 8 * channel : shift565[channel];
 }
 
 // -- Little-endian bytes
@@ -290,11 +299,10 @@ static uint64_t voxcolori_bits(const uint8_t *data, uint64_t pos, unsigned n) {
 static void voxcolori_read_endpoint(const uint8_t *data, uint64_t pos, unsigned precision,
                                     unsigned e[3]) {
     uint64_t v = voxcolori_bits(data, pos, precision ? 24u : 16u);
-    unsigned c, shift = 0;
+    unsigned c;
     for (c = 0; c < 3; c++) {
         unsigned b = voxcolori_channel_bits(c, precision);
-        e[c] = voxcolori_expand((unsigned)(v >> shift) & ((1u << b) - 1), b);
-        shift += b;
+        e[c] = voxcolori_expand((unsigned)(v >> voxcolori_channel_shift(c, precision)) & ((1u << b) - 1), b);
     }
 }
 
@@ -305,26 +313,16 @@ static void voxcolori_mix(const unsigned e0[3], const unsigned e1[3], unsigned w
     for (c = 0; c < 3; c++) out[c] = (uint8_t)((e0[c] * (64 - t) + e1[c] * t + 32) >> 6);
 }
 
+/* Bits of a block's payload: endpoints, then a weight or raw colour per colour. */
+static uint64_t voxcolori_block_bits(unsigned mode, unsigned precision, uint64_t length) {
+    return voxcolori_endpoint_bits(mode, precision) + length * voxcolori_payload_bits(mode);
+}
+
 typedef struct voxcolori_block {
     unsigned mode, precision;
     uint64_t length;
-    uint64_t payload; /* bit position after the header */
+    uint64_t payload; /* bit position of the endpoints */
 } voxcolori_block;
-
-static void voxcolori_read_header(const uint8_t *data, uint64_t pos, unsigned page_shift,
-                                  voxcolori_block *b) {
-    uint64_t h = voxcolori_bits(data, pos, 4 + page_shift);
-    b->mode = (unsigned)(h & 7);
-    b->precision = (unsigned)(h >> 3) & 1;
-    b->length = (h >> 4) + 1;
-    b->payload = pos + 4 + page_shift;
-}
-
-/* Bit position just after block B. */
-static uint64_t voxcolori_block_end(const voxcolori_block *b) {
-    return b->payload + voxcolori_endpoint_bits(b->mode, b->precision) +
-           b->length * voxcolori_payload_bits(b->mode);
-}
 
 /* Colour number I (< length) of block B. */
 static void voxcolori_block_color(const uint8_t *data, const voxcolori_block *b, uint64_t i,
@@ -373,30 +371,62 @@ static uint64_t voxcolori_page_offset(const voxcolor_view *v, uint64_t page) {
     return voxcolori_load_le(v->table + (size_t)(page * n), n);
 }
 
-/* Checks the blocks of every page: they must tile each page exactly, follow
-   each other without gaps, start where the page table says, and end before
-   the 8 zero bytes that close the data. DATA_SIZE >= 8. */
-static voxcolor_status voxcolori_check_blocks(const voxcolor_view *v, uint64_t data_size) {
+/* Walks the block directory of one page. */
+typedef struct voxcolori_page {
+    uint64_t entry;   /* bit position of the next directory entry */
+    uint64_t payload; /* bit position of that block's payload */
+    unsigned entry_bits;
+} voxcolori_page;
+
+/* Starts walking the page that begins at bit POS. Returns its block count. */
+static uint64_t voxcolori_page_open(const voxcolor_view *v, uint64_t pos, voxcolori_page *p) {
+    uint64_t blocks = voxcolori_bits(v->data, pos, v->page_shift) + 1;
+    p->entry_bits = 4 + v->page_shift;
+    p->entry = pos + v->page_shift;
+    p->payload = p->entry + blocks * p->entry_bits;
+    return blocks;
+}
+
+/* Reads the next directory entry into B. Entry positions do not depend on
+   the data, so the processor overlaps these reads. */
+static void voxcolori_page_next(const uint8_t *data, voxcolori_page *p, voxcolori_block *b) {
+    uint64_t h = voxcolori_bits(data, p->entry, p->entry_bits);
+    b->mode = (unsigned)(h & 7);
+    b->precision = (unsigned)(h >> 3) & 1;
+    b->length = (h >> 4) + 1;
+    b->payload = p->payload;
+    p->entry += p->entry_bits;
+    p->payload += voxcolori_block_bits(b->mode, b->precision, b->length);
+}
+
+/* Checks every page: its directory and blocks must tile it exactly, pages
+   must follow each other without gaps where the page table says, and the
+   data must end with the 8 zero bytes. DATA_SIZE >= 8. */
+static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t data_size) {
     uint64_t limit = (data_size - 8) * 8, pos = 0, page, pages;
     uint64_t page_size = 1ull << v->page_shift;
     size_t i;
     pages = v->count ? ((v->count - 1) >> v->page_shift) + 1 : 0;
     for (page = 0; page < pages; page++) {
-        uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size;
-        if (voxcolori_page_offset(v, page) != pos / 8) return VOXCOLOR_ERR_CORRUPT;
-        while (left) {
+        uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size, blocks;
+        voxcolori_page p;
+        if (voxcolori_page_offset(v, page) != pos / 8 || limit - pos < v->page_shift)
+            return VOXCOLOR_ERR_CORRUPT;
+        blocks = voxcolori_page_open(v, pos, &p);
+        if (blocks > left || (limit - p.entry) / p.entry_bits < blocks) return VOXCOLOR_ERR_CORRUPT;
+        while (blocks--) {
             voxcolori_block b;
-            if (limit - pos < 4 + v->page_shift) return VOXCOLOR_ERR_CORRUPT;
-            voxcolori_read_header(v->data, pos, v->page_shift, &b);
+            voxcolori_page_next(v->data, &p, &b);
             if (b.mode > VOXCOLORI_MODE_RAW || (b.mode == VOXCOLORI_MODE_RAW && b.precision) ||
                 b.length > left)
                 return VOXCOLOR_ERR_CORRUPT;
-            /* length <= 4096 and payload <= limit: no overflow below. */
-            if (voxcolori_block_end(&b) > limit) return VOXCOLOR_ERR_CORRUPT;
-            pos = voxcolori_block_end(&b);
             left -= b.length;
+            /* A block has at most 1024 * 24 bits: no overflow before this. */
+            if (p.payload > limit) return VOXCOLOR_ERR_CORRUPT;
         }
+        if (left) return VOXCOLOR_ERR_CORRUPT;
         /* Pages start on a byte; the bits up to it must be zero. */
+        pos = p.payload;
         if (pos & 7) {
             if (voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7))) return VOXCOLOR_ERR_CORRUPT;
             pos += 8 - (pos & 7);
@@ -439,55 +469,55 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
     if (data_size < 8 || data_size > UINT64_MAX / 8) return VOXCOLOR_ERR_CORRUPT;
     v.table = p + VOXCOLOR_HEADER_SIZE;
     v.data = v.table + (size_t)(pages * entry);
-    st = voxcolori_check_blocks(&v, data_size);
+    st = voxcolori_check_pages(&v, data_size);
     if (st == VOXCOLOR_OK) *view = v;
     return st;
 }
 
-/* Finds the block holding colour INDEX; *LOCAL receives its place in it. */
-static void voxcolori_find(const voxcolor_view *v, uint64_t index, voxcolori_block *b,
-                           uint64_t *local) {
-    uint64_t page = index >> v->page_shift;
-    uint64_t i = index & ((1ull << v->page_shift) - 1);
-    uint64_t pos = voxcolori_page_offset(v, page) * 8;
-    for (;;) {
-        voxcolori_read_header(v->data, pos, v->page_shift, b);
-        if (i < b->length) break;
-        i -= b->length;
-        pos = voxcolori_block_end(b);
-    }
-    *local = i;
-}
-
 VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
                                     uint8_t rgb_out[3]) {
+    voxcolori_page p;
     voxcolori_block b;
-    uint64_t i;
+    uint64_t i, h, length;
     VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
-    voxcolori_find(view, index, &b, &i);
+    i = index & ((1ull << view->page_shift) - 1);
+    voxcolori_page_open(view, voxcolori_page_offset(view, index >> view->page_shift) * 8, &p);
+    /* voxcolori_page_next, with only what the walk needs. */
+    for (;; p.entry += p.entry_bits) {
+        h = voxcolori_bits(view->data, p.entry, p.entry_bits);
+        length = (h >> 4) + 1;
+        if (i < length) break;
+        i -= length;
+        p.payload += voxcolori_endpoint_table[h & 15] + length * voxcolori_colour_table[h & 7];
+    }
+    b.mode = (unsigned)(h & 7);
+    b.precision = (unsigned)(h >> 3) & 1;
+    b.length = length;
+    b.payload = p.payload;
     voxcolori_block_color(view->data, &b, i, rgb_out);
 }
 
 VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t first,
                                           size_t n, uint8_t *rgb_out) {
-    voxcolori_block b;
-    uint64_t i, start;
+    uint64_t page, i;
     VOXCOLOR_ASSERT(view && (rgb_out || !n) && first <= view->count &&
                     n <= view->count - first);
-    if (!n) return;
-    voxcolori_find(view, first, &b, &i);
-    start = first - i;
-    for (;;) {
-        uint64_t end;
-        for (; i < b.length && n; i++, n--, rgb_out += 3)
-            voxcolori_block_color(view->data, &b, i, rgb_out);
-        if (!n) return;
-        /* Blocks follow each other; a new page starts on the next byte. */
-        end = voxcolori_block_end(&b);
-        start += b.length;
-        if ((start & ((1ull << view->page_shift) - 1)) == 0) end = (end + 7) & ~7ull;
-        voxcolori_read_header(view->data, end, view->page_shift, &b);
-        i = 0;
+    page = first >> view->page_shift;
+    i = first & ((1ull << view->page_shift) - 1);
+    while (n) {
+        voxcolori_page p;
+        uint64_t blocks = voxcolori_page_open(view, voxcolori_page_offset(view, page++) * 8, &p);
+        while (blocks-- && n) {
+            voxcolori_block b;
+            voxcolori_page_next(view->data, &p, &b);
+            if (i >= b.length) {
+                i -= b.length;
+                continue;
+            }
+            for (; i < b.length && n; i++, n--, rgb_out += 3)
+                voxcolori_block_color(view->data, &b, i, rgb_out);
+            i = 0;
+        }
     }
 }
 
@@ -605,19 +635,26 @@ static void voxcolori_quantize(const double v[3], unsigned precision, unsigned q
     }
 }
 
-/* The weight index decoding closest (in RGB) to C, and that decoded colour. */
-static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8_t out[3]) {
-    unsigned top = (1u << f->mode) - 1, k, lo, hi, best = 0, i;
-    int d[3], dd = 0, dot = 0;
-    uint32_t best_err = UINT32_MAX;
+/* The weight index whose interpolation point is nearest to C's projection
+   onto the endpoint segment. */
+static unsigned voxcolori_project(const voxcolori_fit *f, const uint8_t c[3]) {
+    unsigned top = (1u << f->mode) - 1, i;
+    int d, dd = 0, dot = 0;
     for (i = 0; i < 3; i++) {
-        d[i] = (int)f->e1[i] - (int)f->e0[i];
-        dd += d[i] * d[i];
-        dot += ((int)c[i] - (int)f->e0[i]) * d[i];
+        d = (int)f->e1[i] - (int)f->e0[i];
+        dd += d * d;
+        dot += ((int)c[i] - (int)f->e0[i]) * d;
     }
-    if (dd == 0 || dot <= 0) k = 0;
-    else if (dot >= dd) k = top;
-    else k = (unsigned)((2 * dot * (int)top + dd) / (2 * dd));
+    if (dd == 0 || dot <= 0) return 0;
+    if (dot >= dd) return top;
+    return (unsigned)((2 * dot * (int)top + dd) / (2 * dd));
+}
+
+/* The weight index decoding closest (in RGB) to C, and that decoded colour:
+   the projection or a neighbour (the 64ths are not evenly spaced). */
+static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8_t out[3]) {
+    unsigned top = (1u << f->mode) - 1, k = voxcolori_project(f, c), lo, hi, best = 0;
+    uint32_t best_err = UINT32_MAX;
     lo = k ? k - 1 : 0;
     hi = k < top ? k + 1 : top;
     for (k = lo; k <= hi; k++) {
@@ -637,9 +674,14 @@ static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const 
         d[0] = (uint8_t)f->e0[0];
         d[1] = (uint8_t)f->e0[1];
         d[2] = (uint8_t)f->e0[2];
-    } else {
-        voxcolori_pick(f, c, d);
+        return voxcolori_close(e, c, d);
     }
+    /* In RGB the pick errs at most as much as the projection: try that first. */
+    if (!e->lab) {
+        voxcolori_mix(f->e0, f->e1, f->mode, voxcolori_project(f, c), d);
+        if (voxcolori_dist2(c, d) <= e->thr2) return 1;
+    }
+    voxcolori_pick(f, c, d);
     return voxcolori_close(e, c, d);
 }
 
@@ -759,43 +801,32 @@ static void voxcolori_put(voxcolori_writer *w, uint64_t v, unsigned bits) {
 }
 
 static void voxcolori_put_endpoint(voxcolori_writer *w, const unsigned q[3], unsigned precision) {
-    if (precision) voxcolori_put(w, q[0] | q[1] << 8 | q[2] << 16, 24);
-    else voxcolori_put(w, q[0] | q[1] << 5 | q[2] << 11, 16);
+    unsigned k, v = 0;
+    for (k = 0; k < 3; k++) v |= q[k] << voxcolori_channel_shift(k, precision);
+    voxcolori_put(w, v, precision ? 24u : 16u);
 }
 
-static void voxcolori_put_header(voxcolori_writer *w, unsigned mode, unsigned precision,
-                                 size_t length, unsigned page_shift) {
-    voxcolori_put(w, mode | precision << 3 | (uint64_t)(length - 1) << 4, 4 + page_shift);
+/* A planned block: its directory entry (mode, precision, length - 1 from
+   bit 4) in bits 0..15, its endpoints as stored in bits 16..39 and 40..63. */
+static uint64_t voxcolori_plan(unsigned mode, const voxcolori_fit *f, size_t length) {
+    uint64_t v = mode | (uint64_t)(length - 1) << 4, c;
+    unsigned k;
+    if (!f) return v;
+    v |= (uint64_t)f->precision << 3;
+    for (k = 0, c = 0; k < 3; k++) c |= (uint64_t)f->q0[k] << voxcolori_channel_shift(k, f->precision);
+    v |= c << 16;
+    for (k = 0, c = 0; k < 3; k++) c |= (uint64_t)f->q1[k] << voxcolori_channel_shift(k, f->precision);
+    return v | c << 40;
 }
 
-static void voxcolori_put_raw(voxcolori_writer *w, const uint8_t *rgb, size_t n,
-                              unsigned page_shift) {
-    size_t i;
-    voxcolori_put_header(w, VOXCOLORI_MODE_RAW, 0, n, page_shift);
-    for (i = 0; i < n; i++)
-        voxcolori_put(w, rgb[3 * i] | (unsigned)rgb[3 * i + 1] << 8 | (unsigned)rgb[3 * i + 2] << 16, 24);
-}
-
-static void voxcolori_put_block(voxcolori_writer *w, const voxcolori_fit *f, const uint8_t *rgb,
-                                size_t n, unsigned page_shift) {
-    size_t i;
-    voxcolori_put_header(w, f->mode, f->precision, n, page_shift);
-    voxcolori_put_endpoint(w, f->q0, f->precision);
-    if (f->mode == 0) return;
-    voxcolori_put_endpoint(w, f->q1, f->precision);
-    for (i = 0; i < n; i++) {
-        uint8_t d[3];
-        voxcolori_put(w, voxcolori_pick(f, rgb + 3 * i, d), f->mode);
-    }
-}
-
-/* Encodes the N colours of one page greedily: at each position, the block
-   (of every mode and precision tried, as long as it fits) with the fewest
-   bits per colour; colours that no block stores in fewer than 24 bits go
-   into raw blocks. Takes at most 4 + page_shift + 24 N bits. */
-static void voxcolori_encode_page(const voxcolori_enc *e, voxcolori_writer *w,
-                                  const uint8_t *rgb, size_t n) {
-    size_t pos = 0, raw_start = 0, header = 4 + e->page_shift;
+/* Plans the N colours of one page greedily: at each position, the block (of
+   every mode and precision tried, as long as it fits) with the fewest bits
+   per colour; colours that no block stores in fewer than 24 bits go into raw
+   blocks. Writes the plan to PLAN and returns the number of blocks. The page
+   then takes at most as many bits as one raw block. */
+static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                                  uint64_t *plan) {
+    size_t pos = 0, raw_start = 0, blocks = 0, entry = 4 + e->page_shift;
     while (pos < n) {
         voxcolori_fit best, f;
         size_t best_len = 0, best_bits = 0, len;
@@ -810,7 +841,7 @@ static void voxcolori_encode_page(const voxcolori_enc *e, voxcolori_writer *w,
                 f.precision = e->precisions[p];
                 len = voxcolori_extend(e, rgb + 3 * pos, n - pos, &f);
                 if (!len) continue;
-                bits = header + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
+                bits = entry + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
                 if (!best_len || bits * best_len < best_bits * len ||
                     (bits * best_len == best_bits * len && len > best_len))
                     best = f, best_len = len, best_bits = bits;
@@ -818,24 +849,61 @@ static void voxcolori_encode_page(const voxcolori_enc *e, voxcolori_writer *w,
             /* No wider block can be longer than one reaching the page end. */
             if (best_len == n - pos) break;
         }
-        /* Worth it only if it also pays for closing a raw run before it:
-           then no page exceeds one raw block. */
-        if (!best_len || best_bits + header > 24 * best_len) {
+        /* Worth it only if it also pays for the entry of the raw block it may
+           interrupt. */
+        if (!best_len || best_bits + entry > 24 * best_len) {
             pos++;
             continue;
         }
-        if (raw_start < pos) voxcolori_put_raw(w, rgb + 3 * raw_start, pos - raw_start, e->page_shift);
-        voxcolori_put_block(w, &best, rgb + 3 * pos, best_len, e->page_shift);
+        if (raw_start < pos) plan[blocks++] = voxcolori_plan(VOXCOLORI_MODE_RAW, NULL, pos - raw_start);
+        plan[blocks++] = voxcolori_plan(best.mode, &best, best_len);
         pos += best_len;
         raw_start = pos;
     }
-    if (raw_start < n) voxcolori_put_raw(w, rgb + 3 * raw_start, n - raw_start, e->page_shift);
+    if (raw_start < n) plan[blocks++] = voxcolori_plan(VOXCOLORI_MODE_RAW, NULL, n - raw_start);
+    return blocks;
+}
+
+/* Writes a planned page: block count, directory, payloads. */
+static void voxcolori_write_page(voxcolori_writer *w, const uint8_t *rgb, const uint64_t *plan,
+                                 size_t blocks, unsigned page_shift) {
+    size_t b, i;
+    voxcolori_put(w, blocks - 1, page_shift);
+    for (b = 0; b < blocks; b++) voxcolori_put(w, plan[b] & 0xffff, 4 + page_shift);
+    for (b = 0; b < blocks; b++) {
+        unsigned mode = (unsigned)(plan[b] & 7), k;
+        size_t n = (size_t)((plan[b] >> 4) & 0xfff) + 1;
+        voxcolori_fit f;
+        if (mode == VOXCOLORI_MODE_RAW) {
+            for (i = 0; i < n; i++)
+                voxcolori_put(w, rgb[3 * i] | (unsigned)rgb[3 * i + 1] << 8 | (unsigned)rgb[3 * i + 2] << 16, 24);
+            rgb += 3 * n;
+            continue;
+        }
+        f.mode = mode;
+        f.precision = (unsigned)(plan[b] >> 3) & 1;
+        for (k = 0; k < 3; k++) {
+            unsigned bits = voxcolori_channel_bits(k, f.precision);
+            unsigned at = voxcolori_channel_shift(k, f.precision);
+            f.q0[k] = (unsigned)(plan[b] >> (16 + at)) & ((1u << bits) - 1);
+            f.q1[k] = (unsigned)(plan[b] >> (40 + at)) & ((1u << bits) - 1);
+            f.e0[k] = voxcolori_expand(f.q0[k], bits);
+            f.e1[k] = voxcolori_expand(f.q1[k], bits);
+        }
+        voxcolori_put_endpoint(w, f.q0, f.precision);
+        if (mode) voxcolori_put_endpoint(w, f.q1, f.precision);
+        for (i = 0; i < n && mode; i++) {
+            uint8_t d[3];
+            voxcolori_put(w, voxcolori_pick(&f, rgb + 3 * i, d), mode);
+        }
+        rgb += 3 * n;
+    }
 }
 
 VOXCOLOR_API size_t voxcolor_encode_bound(size_t count) {
     size_t pages = count / 16 + 1;
-    /* Header, 8-byte page entries, a raw block per page (at most 16 header
-       bits and one padding byte), 8 closing bytes. */
+    /* Header, 8-byte page entries, a raw block per page (at most 24 bits of
+       count and entry, one padding byte), 8 closing bytes. */
     if (count > ((size_t)-1 - 64) / 4) return 0;
     return VOXCOLOR_HEADER_SIZE + 8 + pages * 11 + 3 * count;
 }
@@ -846,7 +914,8 @@ VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t
     voxcolori_enc e;
     voxcolori_writer w;
     uint8_t *data;
-    size_t pages, entry, table, page, used, cap;
+    size_t pages, entry, table, page, used, cap, blocks;
+    uint64_t plan[1u << VOXCOLOR_MAX_PAGE_SHIFT]; /* 8 KiB */
     memset(&defaults, 0, sizeof defaults);
     if (!opts) opts = &defaults;
     VOXCOLOR_ASSERT(dst || !dst_size);
@@ -873,9 +942,10 @@ VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t
                                                                 : (size_t)1 << e.page_shift;
         used = (size_t)(w.p - data);
         /* A page never takes more than one raw block would. */
-        if (cap - used < (4 + e.page_shift + 24 * n + 7) / 8) return 0;
+        if (cap - used < (2 * e.page_shift + 4 + 24 * n + 7) / 8) return 0;
         voxcolori_store_le(dst + VOXCOLOR_HEADER_SIZE + page * entry, used, (unsigned)entry);
-        voxcolori_encode_page(&e, &w, rgb8 + 3 * first, n);
+        blocks = voxcolori_plan_page(&e, rgb8 + 3 * first, n, plan);
+        voxcolori_write_page(&w, rgb8 + 3 * first, plan, blocks, e.page_shift);
         if (w.n) voxcolori_put(&w, 0, 8 - w.n);
     }
     used = (size_t)(w.p - data);

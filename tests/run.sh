@@ -27,5 +27,6 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
 run unit "$build/test"
 run cli sh tests/cli.sh "$build/vdag"
 run fuzz-import "$build/fuzz_import" tests/data/fuzz/import
+run fuzz-voxcolor "$build/fuzz_voxcolor" tests/data/fuzz/voxcolor
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]

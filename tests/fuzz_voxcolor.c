@@ -1,0 +1,159 @@
+/* Fuzz target for voxcolor.h. The first input byte selects what the rest is:
+     bit 7 clear: an untrusted stream. It is validated; when accepted, every
+       colour (up to a cap) is decoded singly and by ranges, which must agree.
+     bit 7 set: RGB8 colours to encode with options from bits 0..6 (error
+       bound, metric, weight width, page size). The stream must validate and
+       every decoded colour must be within the bound.
+   Any violation aborts.
+
+   Built with -DVOXCOLOR_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
+   target (make fuzz-voxcolor). Otherwise main() replays the files and
+   folders given on the command line (make test replays the committed
+   corpus tests/data/fuzz/voxcolor) and prints "N passed, N failed". */
+#define VOXCOLOR_IMPLEMENTATION
+#include "voxcolor.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FUZZ_MAX_DECODE 65536
+
+static void require(int ok, const char *what) {
+    if (!ok) {
+        fprintf(stderr, "fuzz_voxcolor: %s\n", what);
+        abort();
+    }
+}
+
+static void fuzz_decode(const uint8_t *data, size_t size) {
+    voxcolor_view v;
+    uint8_t *all, one[3];
+    size_t n, i;
+    if (voxcolor_view_init(&v, data, size) != VOXCOLOR_OK) {
+        require(v.count == 0 && v.data == NULL, "rejected view not cleared");
+        return;
+    }
+    n = v.count < FUZZ_MAX_DECODE ? (size_t)v.count : FUZZ_MAX_DECODE;
+    all = (uint8_t *)malloc(3 * n + 3);
+    voxcolor_view_get_range(&v, 0, n, all);
+    for (i = 0; i < n; i++) {
+        voxcolor_view_get(&v, i, one);
+        require(memcmp(one, all + 3 * i, 3) == 0, "get and get_range differ");
+    }
+    /* The end of long streams too. */
+    if (v.count > n) {
+        voxcolor_view_get_range(&v, v.count - n, n, all);
+        voxcolor_view_get(&v, v.count - 1, one);
+        require(memcmp(one, all + 3 * (n - 1), 3) == 0, "last colour differs");
+    }
+    free(all);
+}
+
+static void lab_of(const uint8_t c[3], double lab[3]) {
+    double l[3], f[3], xyz[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        double s = c[k] / 255.0;
+        l[k] = s <= 0.04045 ? s / 12.92 : pow((s + 0.055) / 1.055, 2.4);
+    }
+    xyz[0] = (0.4124564 * l[0] + 0.3575761 * l[1] + 0.1804375 * l[2]) / 0.95047;
+    xyz[1] = 0.2126729 * l[0] + 0.7151522 * l[1] + 0.0721750 * l[2];
+    xyz[2] = (0.0193339 * l[0] + 0.1191920 * l[1] + 0.9503041 * l[2]) / 1.08883;
+    for (k = 0; k < 3; k++)
+        f[k] = xyz[k] > 216.0 / 24389.0 ? cbrt(xyz[k]) : xyz[k] * 841.0 / 108.0 + 4.0 / 29.0;
+    lab[0] = 116 * f[1] - 16;
+    lab[1] = 500 * (f[0] - f[1]);
+    lab[2] = 200 * (f[1] - f[2]);
+}
+
+static double distance(const uint8_t *a, const uint8_t *b, int lab) {
+    double x[3], y[3], s = 0;
+    int k;
+    for (k = 0; k < 3; k++) x[k] = a[k], y[k] = b[k];
+    if (lab) lab_of(a, x), lab_of(b, y);
+    for (k = 0; k < 3; k++) s += (x[k] - y[k]) * (x[k] - y[k]);
+    return lab ? sqrt(s) : sqrt(s) / 255.0;
+}
+
+static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
+    static const double bounds[8] = {0, 0.004, 0.01, 0.02, 0.04, 0.08, 0.2, 1.0};
+    voxcolor_encode_opts o;
+    voxcolor_view v;
+    size_t n = size / 3, cap = voxcolor_encode_bound(n), len, i;
+    uint8_t *s = (uint8_t *)malloc(cap), *d = (uint8_t *)malloc(3 * n + 3);
+    memset(&o, 0, sizeof o);
+    o.max_error = bounds[sel & 7];
+    o.metric = (sel >> 3) & 1 ? VOXCOLOR_METRIC_CIELAB : VOXCOLOR_METRIC_RGB;
+    if (o.metric == VOXCOLOR_METRIC_CIELAB) o.max_error *= 20; /* delta E units */
+    o.weight_bits = ((sel >> 4) & 3) == 3 ? 0 : (sel >> 4) & 3;
+    o.page_shift = (sel >> 6) & 1 ? 4 : 0;
+    len = voxcolor_encode(s, cap, rgb, n, &o);
+    require(len > 0 && len <= cap, "encode failed");
+    require(voxcolor_view_init(&v, s, len) == VOXCOLOR_OK, "own stream rejected");
+    require(v.count == n, "count");
+    voxcolor_view_get_range(&v, 0, n, d);
+    for (i = 0; i < n; i++)
+        require(distance(rgb + 3 * i, d + 3 * i, o.metric == VOXCOLOR_METRIC_CIELAB) <=
+                    o.max_error + 1e-9,
+                "colour over the error bound");
+    free(s);
+    free(d);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    if (size == 0) return 0;
+    if (data[0] & 0x80) fuzz_roundtrip(data[0], data + 1, size - 1);
+    else fuzz_decode(data + 1, size - 1);
+    return 0;
+}
+
+#ifndef VOXCOLOR_LIBFUZZER
+#include <dirent.h>
+
+static int replay_file(const char *path) {
+    FILE *f = fopen(path, "rb");
+    uint8_t *buf;
+    long size;
+    if (!f) return 0;
+    fseek(f, 0, SEEK_END);
+    size = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    buf = (uint8_t *)malloc(size > 0 ? (size_t)size : 1);
+    if (size < 0 || fread(buf, 1, (size_t)size, f) != (size_t)size) {
+        fclose(f);
+        free(buf);
+        return 0;
+    }
+    fclose(f);
+    LLVMFuzzerTestOneInput(buf, (size_t)size);
+    free(buf);
+    return 1;
+}
+
+int main(int argc, char **argv) {
+    int passed = 0, failed = 0, i;
+    for (i = 1; i < argc; i++) {
+        DIR *d = opendir(argv[i]);
+        struct dirent *e;
+        if (!d) {
+            if (replay_file(argv[i])) passed++;
+            else failed++, fprintf(stderr, "cannot read %s\n", argv[i]);
+            continue;
+        }
+        while ((e = readdir(d)) != NULL) {
+            char path[4096];
+            if (e->d_name[0] == '.') continue;
+            snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
+            if (replay_file(path)) passed++;
+            else failed++, fprintf(stderr, "cannot read %s\n", path);
+        }
+        closedir(d);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
+#endif
