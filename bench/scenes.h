@@ -1,0 +1,375 @@
+/* Benchmark scenes shared by bench_build.c and bench_geometry.c: voxel lists
+   (x, y, z as uint32) loaded from the fetched data (bench/fetch.sh) or
+   generated, plus timing and small helpers. Include after voxdag.h.
+
+   Scenes:
+   - vox:  a MagicaVoxel file through the vdag importer, voxels as stored.
+   - inr:  an INRIMAGE label volume (8-bit), voxels with label != 0 on the
+           image's own index grid (no correction of the anisotropic spacing).
+           At a finer level the solid is scaled by 2^k and only its shell is
+           kept: a fine voxel is kept when it lies on a face of its coarse
+           voxel whose 6-neighbour across that face is empty.
+   - mesh: a triangle mesh through the vdag importer, scaled uniformly so its
+           longest side spans the grid, voxelized by dense point sampling of
+           every triangle (barycentric lattice with at most half a voxel
+           between neighbouring samples); a voxel is full when a sample lands
+           in it. This approximates a surface voxelization; it is not
+           conservative for triangles thinner than half a voxel.
+   - terrain: a generated heightfield (value noise, 4 octaves), each column
+           filled from its lowest 4-neighbour height up to its own height, so
+           the surface is closed. */
+#ifndef BENCH_SCENES_H
+#define BENCH_SCENES_H
+
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "examples/import.h"
+
+typedef struct bscene {
+    char name[64];
+    char input[160]; /* how the voxels were made */
+    uint32_t levels;
+    size_t n;
+    uint32_t *xyz; /* 3 per voxel, distinct, Morton order */
+} bscene;
+
+static double bench_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void *bench_xmalloc(size_t n) {
+    void *p = malloc(n ? n : 1);
+    if (!p) {
+        fprintf(stderr, "bench: out of memory (%zu bytes)\n", n);
+        exit(1);
+    }
+    return p;
+}
+
+static void bscene_free(bscene *s) {
+    free(s->xyz);
+    memset(s, 0, sizeof *s);
+}
+
+// -- Morton-code sets: sort + unique, and a hash set for the voxelizer
+
+static void bench_sort_codes(uint64_t *c, size_t n) { /* LSD radix, 8-bit digits */
+    uint64_t *t = (uint64_t *)bench_xmalloc(n * sizeof *t), *a = c, *b = t, *x;
+    uint64_t maxv = 0;
+    unsigned shift;
+    size_t i;
+    for (i = 0; i < n; i++)
+        if (c[i] > maxv) maxv = c[i];
+    for (shift = 0; shift < 64 && (maxv >> shift); shift += 8) {
+        size_t cnt[256] = {0}, sum = 0, k;
+        for (i = 0; i < n; i++) cnt[(a[i] >> shift) & 255]++;
+        for (k = 0; k < 256; k++) { size_t v = cnt[k]; cnt[k] = sum; sum += v; }
+        for (i = 0; i < n; i++) b[cnt[(a[i] >> shift) & 255]++] = a[i];
+        x = a; a = b; b = x;
+    }
+    if (a != c) memcpy(c, a, n * sizeof *c);
+    free(t);
+}
+
+static size_t bench_unique(uint64_t *c, size_t n) {
+    size_t i, w = 0;
+    for (i = 0; i < n; i++)
+        if (!w || c[w - 1] != c[i]) c[w++] = c[i];
+    return w;
+}
+
+/* Fills S from N Morton codes (sorted and deduplicated here; freed). */
+static void bscene_from_codes(bscene *s, uint64_t *c, size_t n) {
+    size_t i;
+    bench_sort_codes(c, n);
+    n = bench_unique(c, n);
+    s->n = n;
+    s->xyz = (uint32_t *)bench_xmalloc(3 * n * sizeof *s->xyz);
+    for (i = 0; i < n; i++) voxdag_morton_decode(c[i], &s->xyz[3 * i], &s->xyz[3 * i + 1], &s->xyz[3 * i + 2]);
+    free(c);
+}
+
+typedef struct bench_set {
+    uint64_t *slot; /* code + 1; 0 = free */
+    size_t cap, n;
+} bench_set;
+
+static void bench_set_add(bench_set *h, uint64_t code) {
+    size_t i;
+    if ((h->n + 1) * 2 > h->cap) {
+        bench_set g;
+        g.cap = h->cap ? h->cap * 2 : (1u << 20);
+        g.n = 0;
+        g.slot = (uint64_t *)calloc(g.cap, sizeof *g.slot);
+        if (!g.slot) { fprintf(stderr, "bench: out of memory\n"); exit(1); }
+        for (i = 0; i < h->cap; i++)
+            if (h->slot[i]) bench_set_add(&g, h->slot[i] - 1);
+        free(h->slot);
+        *h = g;
+    }
+    for (i = (size_t)((code + 1) * 0x9E3779B97F4A7C15ull >> 20) & (h->cap - 1); h->slot[i]; i = (i + 1) & (h->cap - 1))
+        if (h->slot[i] == code + 1) return;
+    h->slot[i] = code + 1;
+    h->n++;
+}
+
+// -- MagicaVoxel through the importer
+
+static int bscene_vox(bscene *s, const char *path, const char *name) {
+    vdag_scene sc;
+    char err[256];
+    uint32_t maxc = 0, L = 2;
+    uint64_t *c;
+    size_t i;
+    memset(s, 0, sizeof *s);
+    memset(&sc, 0, sizeof sc);
+    if (!vdag_import_file(path, &sc, err, sizeof err)) {
+        fprintf(stderr, "bench: %s: %s\n", path, err);
+        return 0;
+    }
+    for (i = 0; i < 3 * sc.point_count; i++)
+        if (sc.points[i] > maxc) maxc = (uint32_t)sc.points[i];
+    while ((1u << L) <= maxc) L++;
+    c = (uint64_t *)bench_xmalloc((sc.point_count ? sc.point_count : 1) * sizeof *c);
+    for (i = 0; i < sc.point_count; i++)
+        c[i] = voxdag_morton_encode((uint32_t)sc.points[3 * i], (uint32_t)sc.points[3 * i + 1],
+                                    (uint32_t)sc.points[3 * i + 2]);
+    s->levels = L;
+    snprintf(s->name, sizeof s->name, "%s", name);
+    snprintf(s->input, sizeof s->input, "%.100s: %zu voxels as stored", path, sc.point_count);
+    bscene_from_codes(s, c, sc.point_count);
+    vdag_scene_free(&sc);
+    return 1;
+}
+
+// -- INRIMAGE label volume
+
+typedef struct bench_grid {
+    uint32_t dim[3];
+    uint8_t *full; /* dim[0]*dim[1]*dim[2], x fastest */
+} bench_grid;
+
+static int bench_grid_at(const bench_grid *g, long x, long y, long z) {
+    if (x < 0 || y < 0 || z < 0 || x >= (long)g->dim[0] || y >= (long)g->dim[1] || z >= (long)g->dim[2]) return 0;
+    return g->full[((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x];
+}
+
+static int bench_read_inr(const char *path, bench_grid *g) {
+    FILE *f = fopen(path, "rb");
+    char head[257], *p;
+    size_t n, i;
+    int vdim = 1;
+    memset(g, 0, sizeof *g);
+    if (!f || fread(head, 1, 256, f) != 256) {
+        fprintf(stderr, "bench: cannot read %s\n", path);
+        if (f) fclose(f);
+        return 0;
+    }
+    head[256] = 0;
+    if (strncmp(head, "#INRIMAGE-4#{", 13) || !strstr(head, "##}") ||
+        !(p = strstr(head, "XDIM=")) || sscanf(p, "XDIM=%u", &g->dim[0]) != 1 ||
+        !(p = strstr(head, "YDIM=")) || sscanf(p, "YDIM=%u", &g->dim[1]) != 1 ||
+        !(p = strstr(head, "ZDIM=")) || sscanf(p, "ZDIM=%u", &g->dim[2]) != 1 ||
+        !strstr(head, "PIXSIZE=8 bits") || ((p = strstr(head, "VDIM=")) && sscanf(p, "VDIM=%d", &vdim) == 1 && vdim != 1) ||
+        g->dim[0] - 1 >= 4096 || g->dim[1] - 1 >= 4096 || g->dim[2] - 1 >= 4096) {
+        fprintf(stderr, "bench: %s: not an 8-bit INRIMAGE with a 256-byte header\n", path);
+        fclose(f);
+        return 0;
+    }
+    n = (size_t)g->dim[0] * g->dim[1] * g->dim[2];
+    g->full = (uint8_t *)bench_xmalloc(n);
+    if (fread(g->full, 1, n, f) != n) {
+        fprintf(stderr, "bench: %s: truncated\n", path);
+        fclose(f);
+        free(g->full);
+        return 0;
+    }
+    fclose(f);
+    for (i = 0; i < n; i++) g->full[i] = g->full[i] != 0;
+    return 1;
+}
+
+/* Voxels of G scaled by 2^K: all of them (K = 0), or the shell (K > 0). */
+static void bscene_grid(bscene *s, const bench_grid *g, unsigned k, const char *name, const char *path) {
+    uint32_t maxd = g->dim[0], L = 2, S = 1u << k;
+    bench_set h = {0};
+    size_t i, cells = 0, cap = 0, n = 0;
+    uint64_t *c = NULL;
+    long x, y, z;
+    memset(s, 0, sizeof *s);
+    if (g->dim[1] > maxd) maxd = g->dim[1];
+    if (g->dim[2] > maxd) maxd = g->dim[2];
+    while ((1u << L) < (maxd << k)) L++;
+    (void)h;
+    for (z = 0; z < (long)g->dim[2]; z++)
+        for (y = 0; y < (long)g->dim[1]; y++)
+            for (x = 0; x < (long)g->dim[0]; x++) {
+                int open[6];
+                uint32_t a, b, d;
+                if (!bench_grid_at(g, x, y, z)) continue;
+                cells++;
+                if (!k) {
+                    if (n == cap) { cap = cap ? 2 * cap : 1 << 20; c = (uint64_t *)realloc(c, cap * sizeof *c); if (!c) exit(1); }
+                    c[n++] = voxdag_morton_encode((uint32_t)x, (uint32_t)y, (uint32_t)z);
+                    continue;
+                }
+                open[0] = !bench_grid_at(g, x - 1, y, z); open[1] = !bench_grid_at(g, x + 1, y, z);
+                open[2] = !bench_grid_at(g, x, y - 1, z); open[3] = !bench_grid_at(g, x, y + 1, z);
+                open[4] = !bench_grid_at(g, x, y, z - 1); open[5] = !bench_grid_at(g, x, y, z + 1);
+                if (!(open[0] | open[1] | open[2] | open[3] | open[4] | open[5])) continue;
+                for (d = 0; d < S; d++)
+                    for (b = 0; b < S; b++) {
+                        int edge_db = d == 0 || d == S - 1 || b == 0 || b == S - 1;
+                        for (a = 0; a < S; a = edge_db || a == S - 1 ? a + 1 : S - 1) {
+                            int keep = (a == 0 && open[0]) || (a == S - 1 && open[1]) || (b == 0 && open[2]) ||
+                                       (b == S - 1 && open[3]) || (d == 0 && open[4]) || (d == S - 1 && open[5]);
+                            if (!keep) continue;
+                            if (n == cap) { cap = cap ? 2 * cap : 1 << 20; c = (uint64_t *)realloc(c, cap * sizeof *c); if (!c) exit(1); }
+                            c[n++] = voxdag_morton_encode(((uint32_t)x << k) + a, ((uint32_t)y << k) + b,
+                                                          ((uint32_t)z << k) + d);
+                        }
+                    }
+            }
+    s->levels = L;
+    snprintf(s->name, sizeof s->name, "%s", name);
+    if (!k)
+        snprintf(s->input, sizeof s->input, "%s: %ux%ux%u labels, %zu voxels with label != 0", path,
+                 g->dim[0], g->dim[1], g->dim[2], cells);
+    else
+        snprintf(s->input, sizeof s->input, "%s: label != 0 scaled by %u, shell only", path, S);
+    (void)i;
+    bscene_from_codes(s, c, n);
+}
+
+// -- Triangle meshes through the importer, voxelized by dense sampling
+
+static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L) {
+    vdag_scene sc;
+    char err[256];
+    double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, ext = 0, scale;
+    double N = (double)(1u << L);
+    bench_set h = {0};
+    size_t t, i, n;
+    uint64_t *c;
+    memset(s, 0, sizeof *s);
+    memset(&sc, 0, sizeof sc);
+    if (!vdag_import_file(path, &sc, err, sizeof err)) {
+        fprintf(stderr, "bench: %s: %s\n", path, err);
+        return 0;
+    }
+    for (i = 0; i < sc.vertex_count; i++)
+        for (t = 0; t < 3; t++) {
+            double v = sc.positions[3 * i + t];
+            if (v < lo[t]) lo[t] = v;
+            if (v > hi[t]) hi[t] = v;
+        }
+    for (t = 0; t < 3; t++)
+        if (hi[t] - lo[t] > ext) ext = hi[t] - lo[t];
+    scale = (N - 1.0) / (ext > 0 ? ext : 1);
+    for (t = 0; t < sc.triangle_count; t++) {
+        double p[3][3], e = 0;
+        unsigned a, b, k, m;
+        for (k = 0; k < 3; k++)
+            for (m = 0; m < 3; m++) p[k][m] = (sc.positions[3 * (size_t)sc.indices[3 * t + k] + m] - lo[m]) * scale + 0.5;
+        for (k = 0; k < 3; k++) {
+            double dx = p[(k + 1) % 3][0] - p[k][0], dy = p[(k + 1) % 3][1] - p[k][1], dz = p[(k + 1) % 3][2] - p[k][2];
+            double len = sqrt(dx * dx + dy * dy + dz * dz);
+            if (len > e) e = len;
+        }
+        n = (size_t)ceil(2.0 * e);
+        if (n < 1) n = 1;
+        for (a = 0; a <= n; a++)
+            for (b = 0; a + b <= n; b++) {
+                double u = (double)a / (double)n, v = (double)b / (double)n, q[3];
+                for (m = 0; m < 3; m++) {
+                    q[m] = p[0][m] + (p[1][m] - p[0][m]) * u + (p[2][m] - p[0][m]) * v;
+                    if (q[m] < 0) q[m] = 0;
+                    if (q[m] > N - 1) q[m] = N - 1;
+                }
+                bench_set_add(&h, voxdag_morton_encode((uint32_t)q[0], (uint32_t)q[1], (uint32_t)q[2]));
+            }
+    }
+    c = (uint64_t *)bench_xmalloc((h.n ? h.n : 1) * sizeof *c);
+    for (i = 0, n = 0; i < h.cap; i++)
+        if (h.slot[i]) c[n++] = h.slot[i] - 1;
+    free(h.slot);
+    s->levels = L;
+    snprintf(s->name, sizeof s->name, "%s", name);
+    snprintf(s->input, sizeof s->input, "%.100s: %zu triangles, surface sampled at %u^3", path,
+             sc.triangle_count, 1u << L);
+    vdag_scene_free(&sc);
+    bscene_from_codes(s, c, n);
+    return 1;
+}
+
+// -- Generated terrain
+
+static double bench_lattice(uint32_t x, uint32_t z, uint32_t seed) {
+    uint64_t h = ((uint64_t)x * 0x9E3779B1u) ^ ((uint64_t)z * 0x85EBCA77u) ^ ((uint64_t)seed << 40);
+    h ^= h >> 29; h *= 0xBF58476D1CE4E5B9ull; h ^= h >> 32;
+    return (double)(h & 0xFFFFFF) / (double)0x1000000;
+}
+
+static double bench_noise(double x, double z, uint32_t seed) {
+    uint32_t xi = (uint32_t)x, zi = (uint32_t)z;
+    double fx = x - xi, fz = z - zi;
+    double a = bench_lattice(xi, zi, seed), b = bench_lattice(xi + 1, zi, seed);
+    double c = bench_lattice(xi, zi + 1, seed), d = bench_lattice(xi + 1, zi + 1, seed);
+    fx = fx * fx * (3 - 2 * fx);
+    fz = fz * fz * (3 - 2 * fz);
+    return (a + (b - a) * fx) * (1 - fz) + (c + (d - c) * fx) * fz;
+}
+
+static void bscene_terrain(bscene *s, uint32_t L) {
+    uint32_t N = 1u << L, x, z, y;
+    uint32_t *hgt = (uint32_t *)bench_xmalloc((size_t)N * N * sizeof *hgt);
+    size_t n = 0, cap = 0;
+    uint64_t *c = NULL;
+    memset(s, 0, sizeof *s);
+    for (z = 0; z < N; z++)
+        for (x = 0; x < N; x++) {
+            double v = 0, amp = 0.5, f = 8.0 / N;
+            unsigned o;
+            for (o = 0; o < 4; o++, amp *= 0.5, f *= 2) v += amp * bench_noise(x * f, z * f, o);
+            hgt[(size_t)z * N + x] = (uint32_t)(N / 16 + v * (N / 3));
+        }
+    for (z = 0; z < N; z++)
+        for (x = 0; x < N; x++) {
+            uint32_t h = hgt[(size_t)z * N + x], lo = h;
+            if (x && hgt[(size_t)z * N + x - 1] < lo) lo = hgt[(size_t)z * N + x - 1];
+            if (x + 1 < N && hgt[(size_t)z * N + x + 1] < lo) lo = hgt[(size_t)z * N + x + 1];
+            if (z && hgt[(size_t)(z - 1) * N + x] < lo) lo = hgt[(size_t)(z - 1) * N + x];
+            if (z + 1 < N && hgt[(size_t)(z + 1) * N + x] < lo) lo = hgt[(size_t)(z + 1) * N + x];
+            for (y = lo; y <= h; y++) {
+                if (n == cap) { cap = cap ? 2 * cap : 1 << 22; c = (uint64_t *)realloc(c, cap * sizeof *c); if (!c) exit(1); }
+                c[n++] = voxdag_morton_encode(x, y, z);
+            }
+        }
+    free(hgt);
+    s->levels = L;
+    snprintf(s->name, sizeof s->name, "terrain");
+    snprintf(s->input, sizeof s->input, "generated heightfield, 4 octaves of value noise, closed surface, %u^3", N);
+    bscene_from_codes(s, c, n);
+}
+
+/* Voxels with distinct Morton codes >> 3: the octree's nodes at level L-1
+   (2^3 cells), which voxdag_build_stats does not list. */
+static uint64_t bscene_cells2(const bscene *s) {
+    uint64_t prev = UINT64_MAX, n = 0;
+    size_t i;
+    for (i = 0; i < s->n; i++) {
+        uint64_t c = voxdag_morton_encode(s->xyz[3 * i], s->xyz[3 * i + 1], s->xyz[3 * i + 2]) >> 3;
+        if (c != prev) n++;
+        prev = c;
+    }
+    return n;
+}
+
+#endif
