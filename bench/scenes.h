@@ -30,6 +30,12 @@
 
 #include "examples/import.h"
 
+#if defined(__GNUC__) || defined(__clang__)
+#define BENCH_UNUSED __attribute__((unused))
+#else
+#define BENCH_UNUSED
+#endif
+
 typedef struct bscene {
     char name[64];
     char input[160]; /* how the voxels were made */
@@ -38,13 +44,13 @@ typedef struct bscene {
     uint32_t *xyz; /* 3 per voxel, distinct, Morton order */
 } bscene;
 
-static double bench_now(void) {
+BENCH_UNUSED static double bench_now(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static void *bench_xmalloc(size_t n) {
+BENCH_UNUSED static void *bench_xmalloc(size_t n) {
     void *p = malloc(n ? n : 1);
     if (!p) {
         fprintf(stderr, "bench: out of memory (%zu bytes)\n", n);
@@ -53,14 +59,14 @@ static void *bench_xmalloc(size_t n) {
     return p;
 }
 
-static void bscene_free(bscene *s) {
+BENCH_UNUSED static void bscene_free(bscene *s) {
     free(s->xyz);
     memset(s, 0, sizeof *s);
 }
 
 // -- Morton-code sets: sort + unique, and a hash set for the voxelizer
 
-static void bench_sort_codes(uint64_t *c, size_t n) { /* LSD radix, 8-bit digits */
+BENCH_UNUSED static void bench_sort_codes(uint64_t *c, size_t n) { /* LSD radix, 8-bit digits */
     uint64_t *t = (uint64_t *)bench_xmalloc(n * sizeof *t), *a = c, *b = t, *x;
     uint64_t maxv = 0;
     unsigned shift;
@@ -78,7 +84,7 @@ static void bench_sort_codes(uint64_t *c, size_t n) { /* LSD radix, 8-bit digits
     free(t);
 }
 
-static size_t bench_unique(uint64_t *c, size_t n) {
+BENCH_UNUSED static size_t bench_unique(uint64_t *c, size_t n) {
     size_t i, w = 0;
     for (i = 0; i < n; i++)
         if (!w || c[w - 1] != c[i]) c[w++] = c[i];
@@ -86,7 +92,7 @@ static size_t bench_unique(uint64_t *c, size_t n) {
 }
 
 /* Fills S from N Morton codes (sorted and deduplicated here; freed). */
-static void bscene_from_codes(bscene *s, uint64_t *c, size_t n) {
+BENCH_UNUSED static void bscene_from_codes(bscene *s, uint64_t *c, size_t n) {
     size_t i;
     bench_sort_codes(c, n);
     n = bench_unique(c, n);
@@ -101,7 +107,7 @@ typedef struct bench_set {
     size_t cap, n;
 } bench_set;
 
-static void bench_set_add(bench_set *h, uint64_t code) {
+BENCH_UNUSED static void bench_set_add(bench_set *h, uint64_t code) {
     size_t i;
     if ((h->n + 1) * 2 > h->cap) {
         bench_set g;
@@ -122,7 +128,7 @@ static void bench_set_add(bench_set *h, uint64_t code) {
 
 // -- MagicaVoxel through the importer
 
-static int bscene_vox(bscene *s, const char *path, const char *name) {
+BENCH_UNUSED static int bscene_vox(bscene *s, const char *path, const char *name) {
     vdag_scene sc;
     char err[256];
     uint32_t maxc = 0, L = 2;
@@ -156,12 +162,12 @@ typedef struct bench_grid {
     uint8_t *full; /* dim[0]*dim[1]*dim[2], x fastest */
 } bench_grid;
 
-static int bench_grid_at(const bench_grid *g, long x, long y, long z) {
+BENCH_UNUSED static int bench_grid_at(const bench_grid *g, long x, long y, long z) {
     if (x < 0 || y < 0 || z < 0 || x >= (long)g->dim[0] || y >= (long)g->dim[1] || z >= (long)g->dim[2]) return 0;
     return g->full[((size_t)z * g->dim[1] + (size_t)y) * g->dim[0] + (size_t)x];
 }
 
-static int bench_read_inr(const char *path, bench_grid *g) {
+BENCH_UNUSED static int bench_read_inr(const char *path, bench_grid *g) {
     FILE *f = fopen(path, "rb");
     char head[257], *p;
     size_t n, i;
@@ -197,7 +203,7 @@ static int bench_read_inr(const char *path, bench_grid *g) {
 }
 
 /* Voxels of G scaled by 2^K: all of them (K = 0), or the shell (K > 0). */
-static void bscene_grid(bscene *s, const bench_grid *g, unsigned k, const char *name, const char *path) {
+BENCH_UNUSED static void bscene_grid(bscene *s, const bench_grid *g, unsigned k, const char *name, const char *path) {
     uint32_t maxd = g->dim[0], L = 2, S = 1u << k;
     bench_set h = {0};
     size_t i, cells = 0, cap = 0, n = 0;
@@ -250,7 +256,7 @@ static void bscene_grid(bscene *s, const bench_grid *g, unsigned k, const char *
 
 // -- Triangle meshes through the importer, voxelized by dense sampling
 
-static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L) {
+BENCH_UNUSED static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L) {
     vdag_scene sc;
     char err[256];
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, ext = 0, scale;
@@ -311,13 +317,13 @@ static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L
 
 // -- Generated terrain
 
-static double bench_lattice(uint32_t x, uint32_t z, uint32_t seed) {
+BENCH_UNUSED static double bench_lattice(uint32_t x, uint32_t z, uint32_t seed) {
     uint64_t h = ((uint64_t)x * 0x9E3779B1u) ^ ((uint64_t)z * 0x85EBCA77u) ^ ((uint64_t)seed << 40);
     h ^= h >> 29; h *= 0xBF58476D1CE4E5B9ull; h ^= h >> 32;
     return (double)(h & 0xFFFFFF) / (double)0x1000000;
 }
 
-static double bench_noise(double x, double z, uint32_t seed) {
+BENCH_UNUSED static double bench_noise(double x, double z, uint32_t seed) {
     uint32_t xi = (uint32_t)x, zi = (uint32_t)z;
     double fx = x - xi, fz = z - zi;
     double a = bench_lattice(xi, zi, seed), b = bench_lattice(xi + 1, zi, seed);
@@ -327,7 +333,7 @@ static double bench_noise(double x, double z, uint32_t seed) {
     return (a + (b - a) * fx) * (1 - fz) + (c + (d - c) * fx) * fz;
 }
 
-static void bscene_terrain(bscene *s, uint32_t L) {
+BENCH_UNUSED static void bscene_terrain(bscene *s, uint32_t L) {
     uint32_t N = 1u << L, x, z, y;
     uint32_t *hgt = (uint32_t *)bench_xmalloc((size_t)N * N * sizeof *hgt);
     size_t n = 0, cap = 0;
@@ -361,7 +367,7 @@ static void bscene_terrain(bscene *s, uint32_t L) {
 
 /* Voxels with distinct Morton codes >> 3: the octree's nodes at level L-1
    (2^3 cells), which voxdag_build_stats does not list. */
-static uint64_t bscene_cells2(const bscene *s) {
+BENCH_UNUSED static uint64_t bscene_cells2(const bscene *s) {
     uint64_t prev = UINT64_MAX, n = 0;
     size_t i;
     for (i = 0; i < s->n; i++) {
