@@ -91,3 +91,31 @@ test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcol
 
 clean:
 	rm -rf $(BUILD)
+
+# Benchmarks: `make bench` fetches the scenes (bench/fetch.sh) and regenerates
+# BENCHMARKS.md with the full set (long); `make bench-quick` runs a smaller set
+# (under 5 minutes). bench-build / bench-geometry print one table set each.
+BENCH_CFLAGS := $(CSTD) $(WARN) -O2 -g $(THREADS) -I.
+BENCH_SUBMAKE := $(MAKE)
+BENCH_DEPS   := bench/scenes.h $(HEADERS) examples/import.c examples/import.h examples/image_none.c
+.PHONY: bench-quick bench-build bench-geometry bench-data
+
+$(BUILD)/bench/bench_build: bench/bench_build.c $(BENCH_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
+$(BUILD)/bench/bench_geometry: bench/bench_geometry.c $(BENCH_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
+
+bench-data:
+	@sh bench/fetch.sh bench/data >/dev/null
+
+bench-build: bench-data $(BUILD)/bench/bench_build
+	$(BUILD)/bench/bench_build bench/data $(BENCH_FLAGS)
+bench-geometry: bench-data $(BUILD)/bench/bench_geometry
+	$(BUILD)/bench/bench_geometry bench/data $(BENCH_FLAGS)
+
+bench: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry
+	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh full $(BUILD)
+bench-quick: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry
+	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh quick $(BUILD)
