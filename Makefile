@@ -83,10 +83,24 @@ fuzz-voxcolor: | $(BUILD)
 	$(BUILD)/fuzz_voxcolor_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/voxcolor.dict \
 	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_voxcolor_corpus tests/data/fuzz/voxcolor
 
+# Loader fuzzing: libFuzzer (clang) for `make fuzz-load`; `make test` replays
+# the committed corpus (seeds from `make_golden --seeds`, crash inputs).
+.PHONY: fuzz-load
+FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/golden.h voxdag.h
+$(BUILD)/fuzz_load: $(FUZZ_LOAD_DEPS) | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_load.c -lm
+
+fuzz-load: | $(BUILD)
+	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXDAG_LIBFUZZER $(THREADS) \
+	    -I. -o $(BUILD)/fuzz_load_libfuzzer tests/fuzz_load.c -lm
+	@mkdir -p $(BUILD)/fuzz_load_corpus
+	$(BUILD)/fuzz_load_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/load.dict \
+	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_load_corpus tests/data/fuzz/load
+
 deps:
 	@sh tests/deps.sh
 
-test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor
+test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load
 	@sh tests/run.sh $(BUILD)
 
 clean:

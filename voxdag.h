@@ -1774,7 +1774,7 @@ static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
    children's), every node and brick referenced, one root holding every voxel. */
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
     uint32_t B = d->levels - 2, l;
-    uint64_t base = (uint64_t)(d->level[0].data - d->image), i;
+    uint64_t base = B ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
     voxdagi_bitmaps child, cur;
     voxdag_status st = VOXDAG_OK;
     const char *msg = NULL;
@@ -1795,8 +1795,10 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "root brick does not match the voxel count");
         return VOXDAG_OK;
     }
-    if (!voxdagi_bitmaps_alloc(m, &child, d->brick_count))
+    if (!voxdagi_bitmaps_alloc(m, &child, d->brick_count)) {
+        voxdagi_bitmaps_free(m, &child); /* one of the two may have been allocated */
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
+    }
     for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.start, i); /* every brick starts a record */
     for (l = B; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];

@@ -28,5 +28,6 @@ run unit "$build/test"
 run cli sh tests/cli.sh "$build/vdag"
 run fuzz-import "$build/fuzz_import" tests/data/fuzz/import
 run fuzz-voxcolor "$build/fuzz_voxcolor" tests/data/fuzz/voxcolor
+run fuzz-load "$build/fuzz_load" tests/data/fuzz/load
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]

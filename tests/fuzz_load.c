@@ -1,0 +1,252 @@
+/* Fuzz target for loading .vdag files (voxdag_load_memory) and querying what
+   loaded. The first input byte selects the options, the rest is the file:
+     bit 0     copy the bytes (opts.copy)
+     bit 1     reseal: recompute every checksum before loading, so that the
+               fuzzer reaches the structural validation behind them
+     bits 2-3  a limit: 0 none, 1 max_nodes, 2 max_memory, 3 max_levels
+     bit 4     the allocator fails at allocation 3 * P
+     bits 5-7  P, the parameter of the limit and of the failing allocator
+   Every load uses a counting allocator: after voxdag_free no byte may be held,
+   and a load under max_memory never holds more. A loaded DAG must answer
+   queries consistently: voxdag_for_each_voxel (stopped early) visits voxels
+   in strictly increasing Morton order whose voxdag_lookup gives the same
+   index; lookups at coordinates taken from the input stay within the voxel
+   count; colours exist for every index. Any violation aborts.
+
+   Built with -DVOXDAG_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
+   target (make fuzz-load). Otherwise main() replays the files and folders
+   given on the command line (make test replays tests/data/fuzz/load) and
+   prints "N passed, N failed". */
+#define VOXDAG_IMPLEMENTATION
+#include "voxdag.h"
+#include "golden.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define FUZZ_MAX_VISIT 512 /* voxels walked by voxdag_for_each_voxel */
+
+static void require(int ok, const char *what) {
+    if (!ok) {
+        fprintf(stderr, "fuzz_load: %s\n", what);
+        abort();
+    }
+}
+
+// -- A counting allocator that can fail at allocation N
+
+typedef struct fuzz_alloc {
+    long calls, fail_at; /* fail_at < 0: never */
+    uint64_t held, peak;
+} fuzz_alloc;
+
+static void *fa_alloc(void *user, size_t size) {
+    fuzz_alloc *a = (fuzz_alloc *)user;
+    unsigned char *p;
+    if (a->fail_at >= 0 && a->calls++ == a->fail_at) return NULL;
+    p = (unsigned char *)malloc(size + 16);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof size);
+    a->held += size;
+    if (a->held > a->peak) a->peak = a->held;
+    return p + 16;
+}
+
+static void fa_free(void *user, void *ptr, size_t size) {
+    fuzz_alloc *a = (fuzz_alloc *)user;
+    size_t stored;
+    memcpy(&stored, (unsigned char *)ptr - 16, sizeof stored);
+    require(stored == size, "free with a size other than the allocation's");
+    require(a->held >= size, "more bytes freed than allocated");
+    a->held -= size;
+    free((unsigned char *)ptr - 16);
+}
+
+// -- Queries on a loaded DAG
+
+typedef struct walk {
+    const voxdag *dag;
+    uint32_t levels;
+    uint64_t visited, last_morton;
+    int color;
+} walk;
+
+static int visit(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    walk *w = (walk *)user;
+    uint64_t morton = voxdag_morton_encode(x, y, z), found = UINT64_MAX;
+    uint8_t rgb[3];
+    require(index == w->visited, "voxel indices not consecutive");
+    require(((x | y | z) >> w->levels) == 0, "voxel outside the grid");
+    require(w->visited == 0 || morton > w->last_morton, "voxels not in Morton order");
+    require(voxdag_lookup(w->dag, x, y, z, &found) == 1, "a visited voxel is empty to lookup");
+    require(found == index, "lookup and for_each_voxel disagree on an index");
+    if (w->color) require(voxdag_color(w->dag, index, rgb) == 1, "no colour for a visited voxel");
+    w->last_morton = morton;
+    w->visited++;
+    return w->visited >= FUZZ_MAX_VISIT;
+}
+
+static void query(const voxdag *d, const uint8_t *file, size_t size) {
+    voxdag_info info;
+    walk w;
+    uint64_t n, index;
+    uint8_t rgb[3];
+    size_t i, image_size;
+    const void *payload;
+    size_t payload_size;
+    voxdag_color_kind kind;
+    voxdag_get_info(d, &info);
+    require(info.levels >= 2 && info.levels <= VOXDAG_MAX_LEVELS, "levels out of range");
+    require(info.file_bytes == size, "file size differs from the input");
+    require(voxdag_image(d, &image_size) != NULL && image_size == size, "image size");
+    kind = voxdag_colors(d, &payload, &payload_size);
+    require(kind == info.color_kind && payload_size == info.color_bytes, "colour section");
+    require(kind != VOXDAG_COLORS_RGB8 || payload_size == 3 * info.voxels, "RGB8 size");
+    /* Lookups at coordinates taken from the input (its last bytes). */
+    for (i = 0; i < 4; i++) {
+        uint32_t c[3], k, mask = (1u << info.levels) - 1;
+        for (k = 0; k < 3; k++) {
+            size_t at = size - 1 - ((3 * i + k) % size);
+            c[k] = ((uint32_t)file[at] * 0x9E3779B1u >> 8) & mask;
+        }
+        if (voxdag_lookup(d, c[0], c[1], c[2], &index)) {
+            require(index < info.voxels, "lookup index past the voxel count");
+            require(voxdag_lookup(d, c[0], c[1], c[2], NULL) == 1, "lookup without index differs");
+            if (kind == VOXDAG_COLORS_RGB8) require(voxdag_color(d, index, rgb) == 1, "no colour");
+        }
+        require(voxdag_lookup(d, c[0] | (mask + 1), c[1], c[2], NULL) == 0, "voxel outside the grid");
+    }
+    require(voxdag_color(d, info.voxels, rgb) == 0, "colour past the last voxel");
+    /* Walk the first voxels (all of them in small scenes). */
+    memset(&w, 0, sizeof w);
+    w.dag = d;
+    w.levels = info.levels;
+    w.color = kind == VOXDAG_COLORS_RGB8;
+    n = voxdag_for_each_voxel(d, visit, &w);
+    require(n == w.visited, "for_each_voxel count");
+    require(n == (info.voxels < FUZZ_MAX_VISIT ? info.voxels : FUZZ_MAX_VISIT), "voxel count differs from the walk");
+}
+
+/* Rewrites the colour section of a loaded DAG; the result must load. */
+static void recolor(const voxdag *d, fuzz_alloc *fa) {
+    voxdag_info info;
+    voxdag *e = NULL, *f = NULL;
+    uint8_t *rgb;
+    voxdag_status st;
+    voxdag_get_info(d, &info);
+    if (info.voxels > 4096) return;
+    rgb = (uint8_t *)calloc(3 * (size_t)info.voxels + 1, 1);
+    st = voxdag_with_colors(d, VOXDAG_COLORS_RGB8, rgb, 3 * (size_t)info.voxels, &e, NULL);
+    require(st == VOXDAG_OK || (st == VOXDAG_ERR_OUT_OF_MEMORY && fa->fail_at >= 0), "with_colors failed");
+    if (e) {
+        size_t size;
+        const void *img = voxdag_image(e, &size);
+        require(voxdag_load_memory(img, size, NULL, &f, NULL) == VOXDAG_OK, "recoloured file rejected");
+        voxdag_free(f);
+        voxdag_free(e);
+    }
+    free(rgb);
+}
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
+
+int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    voxdag_load_opts o;
+    fuzz_alloc fa;
+    voxdag *d = NULL;
+    voxdag_error err;
+    voxdag_status st;
+    uint8_t *file;
+    unsigned sel, p;
+    if (size == 0) return 0;
+    sel = data[0];
+    p = sel >> 5;
+    size--;
+    /* An exact-size copy (the input itself stays read-only). */
+    file = (uint8_t *)malloc(size ? size : 1);
+    if (size) memcpy(file, data + 1, size);
+    if (sel & 2) golden_reseal(file, size);
+    memset(&fa, 0, sizeof fa);
+    fa.fail_at = sel & 16 ? 3 * (long)p : -1;
+    memset(&o, 0, sizeof o);
+    o.copy = sel & 1;
+    o.allocator.alloc = fa_alloc;
+    o.allocator.free = fa_free;
+    o.allocator.user = &fa;
+    switch (sel >> 2 & 3) {
+    case 1: o.max_nodes = 1 + p * p; break;
+    case 2: o.max_memory = (uint64_t)256 << p; break;
+    case 3: o.max_levels = 2 + p; break;
+    default: break;
+    }
+    st = voxdag_load_memory(file, size, &o, &d, &err);
+    require(st == err.status, "status and error disagree");
+    require(err.message != NULL, "no error message");
+    if (st == VOXDAG_OK) {
+        require(d != NULL, "no DAG");
+        require(!o.max_memory || fa.peak <= o.max_memory, "load held more than max_memory");
+        query(d, file, size);
+        recolor(d, &fa);
+        if (o.max_levels) {
+            voxdag_info info;
+            voxdag_get_info(d, &info);
+            require(info.levels <= o.max_levels, "levels above max_levels accepted");
+        }
+    } else {
+        require(d == NULL, "a DAG returned with an error");
+        require(st != VOXDAG_ERR_OUT_OF_MEMORY || fa.fail_at >= 0 || o.max_memory, "out of memory");
+    }
+    voxdag_free(d);
+    require(fa.held == 0, "bytes held after voxdag_free");
+    free(file);
+    return 0;
+}
+
+#ifndef VOXDAG_LIBFUZZER
+#include <dirent.h>
+
+static int replay_file(const char *path) {
+    FILE *f = fopen(path, "rb");
+    uint8_t *buf;
+    long size;
+    if (!f) return 0;
+    if (fseek(f, 0, SEEK_END) || (size = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
+        fclose(f);
+        return 0;
+    }
+    buf = (uint8_t *)malloc(size > 0 ? (size_t)size : 1);
+    if (fread(buf, 1, (size_t)size, f) != (size_t)size) {
+        fclose(f);
+        free(buf);
+        return 0;
+    }
+    fclose(f);
+    LLVMFuzzerTestOneInput(buf, (size_t)size);
+    free(buf);
+    return 1;
+}
+
+int main(int argc, char **argv) {
+    int passed = 0, failed = 0, i;
+    for (i = 1; i < argc; i++) {
+        DIR *d = opendir(argv[i]);
+        struct dirent *e;
+        if (!d) {
+            if (replay_file(argv[i])) passed++;
+            else failed++, fprintf(stderr, "cannot read %s\n", argv[i]);
+            continue;
+        }
+        while ((e = readdir(d)) != NULL) {
+            char path[4096];
+            if (e->d_name[0] == '.') continue;
+            snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
+            if (replay_file(path)) passed++;
+            else failed++, fprintf(stderr, "cannot read %s\n", path);
+        }
+        closedir(d);
+    }
+    printf("%d passed, %d failed\n", passed, failed);
+    return failed ? 1 : 0;
+}
+#endif
