@@ -1,6 +1,6 @@
 /* Build throughput and memory of the voxdag builder on real and generated
    scenes; prints Markdown tables on stdout (progress on stderr).
-     bench_build DATA_DIR [--quick] [--threads N]
+     bench_build DATA_DIR [--quick] [--threads N] [--profile SCENE]
    DATA_DIR holds what bench/fetch.sh fetched. Times are wall-clock seconds,
    the best of a few runs for small scenes. Peak memory is the builder's own
    accounting (voxdag_build_stats.peak_memory): the voxel buffer, the sort
@@ -104,6 +104,7 @@ static uint64_t sum(const uint64_t *a, uint32_t n) {
 int main(int argc, char **argv) {
     const char *dir = argc > 1 ? argv[1] : "bench/data";
     int quick = 0, i;
+    const char *profile = NULL; /* --profile NAME: only repeat NAME's sorted 1-thread build */
     unsigned threads = (unsigned)sysconf(_SC_NPROCESSORS_ONLN), tcount[2];
     char path[512];
     bscene scenes[16];
@@ -113,6 +114,7 @@ int main(int argc, char **argv) {
     for (i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = (unsigned)atoi(argv[++i]);
+        else if (!strcmp(argv[i], "--profile") && i + 1 < argc) profile = argv[++i];
     }
     if (threads < 1) threads = 1;
     tcount[0] = 1;
@@ -137,6 +139,15 @@ int main(int argc, char **argv) {
     }
     bscene_terrain(&scenes[ns++], quick ? 11 : 13);
 
+    if (profile) {
+        for (k = 0; k < ns; k++)
+            if (!strcmp(scenes[k].name, profile)) {
+                run u = build(&scenes[k], scenes[k].xyz, 1, 0, 10);
+                printf("%s: %.1f M voxels/s (best of 10, Morton-sorted, 1 thread)\n", profile,
+                       (double)scenes[k].n / u.total / 1e6);
+            }
+        return 0;
+    }
     for (k = 0; k < ns; k++) {
         bscene *s = &scenes[k];
         uint32_t *shuf;
