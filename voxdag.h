@@ -131,6 +131,8 @@ typedef struct voxdag_build_opts {
     int compare_structures;      /* 1: also count SVDAG and SSVDAG nodes (2x work) */
     uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
     uint64_t max_memory;         /* bytes the builder may hold; 0: no limit */
+    uint32_t chunk_levels;       /* meshes are voxelized in chunks of 2^chunk_levels
+                                    voxels per axis; 0 means 8 */
     const double *bounds;        /* optional world-space min xyz, max xyz (6) */
     voxdag_allocator allocator;
     voxdag_progress_fn progress; /* optional; called from the building thread */
@@ -161,6 +163,33 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
    the last one): this streams scenes larger than memory in Morton-ordered
    chunks (e.g. aligned subtrees), keeping only unique nodes. */
 VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *err);
+
+/* A triangle mesh to voxelize (DESIGN 3.1). Vertices are in grid units: the
+   grid spans [0, 2^L)^3 and voxel (x, y, z) is the closed box
+   [x, x+1] x [y, y+1] x [z, z+1]. */
+typedef struct voxdag_mesh {
+    const double *positions;   /* 3 per vertex */
+    size_t vertex_count;
+    const uint32_t *indices;   /* 3 per triangle */
+    size_t triangle_count;
+    /* Colour of the point with barycentric coordinates BARY on TRIANGLE
+       (required when the builder has colours, else ignored). */
+    void (*color)(void *user, size_t triangle, const double bary[3], uint8_t rgb[3]);
+    void *user;
+} voxdag_mesh;
+
+/* Voxelizes MESH conservatively: a voxel is full when a triangle intersects
+   its closed box (exact separating-axis test). Parts outside the grid are
+   clipped. Works chunk by chunk (aligned subtrees of 2^chunk_levels voxels
+   per axis, in Morton order),
+   flushing each, so memory holds the unique nodes plus one chunk's voxels.
+   A voxel's colour comes from the triangle touching it with the highest
+   index, at the point of that triangle nearest to the voxel centre. Call it
+   on a builder that holds no voxels yet; more meshes need one combined call.
+   Returns VOXDAG_ERR_INVALID_ARGUMENT for an index >= vertex_count or a
+   non-finite vertex. */
+VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
+                                                 voxdag_error *err);
 
 /* Per-level node counts and timing of a build, filled by voxdag_builder_finish.
    Arrays are indexed by level 0..levels-2; the last entry counts 4^3 bricks. */
@@ -275,6 +304,56 @@ typedef int (*voxdag_voxel_fn)(void *user, uint32_t x, uint32_t y, uint32_t z,
                                uint64_t index);
 VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
                                           void *user);
+
+// -- Ray casting
+#ifndef VOXDAG_NO_RAYTRACE
+
+/* A ray in grid units (the grid spans [0, 2^L)^3, voxel (x, y, z) occupies
+   [x, x+1) x [y, y+1) x [z, z+1)). Points are origin + t * dir for t in
+   [t_min, t_max]; dir need not be normalized (t is in units of |dir|), and
+   t_max may be HUGE_VAL. A ray that starts on a face between two voxels
+   starts in the one it moves into; a zero direction component keeps that
+   coordinate fixed (a ray lying in a face plane belongs to the voxels above
+   it). Ties between axes (rays through edges and corners) are broken towards
+   x, then y, then z, so every answer is exact and deterministic. */
+typedef struct voxdag_ray {
+    double origin[3];
+    double dir[3];
+    double t_min, t_max;
+} voxdag_ray;
+
+/* Ray options. A NULL pointer or an all-zero struct means defaults: no level
+   of detail and no voxel index. */
+typedef struct voxdag_ray_opts {
+    int want_index;    /* 1: fill hit.index (one extra descent at the hit) */
+    double lod_factor; /* size of one pixel at distance t = 1, in grid units */
+    double lod_pixels; /* stop at a full cell whose projected size, cell side /
+                          (t * lod_factor), is below this; 0 = full detail */
+} voxdag_ray_opts;
+
+typedef struct voxdag_hit {
+    double t;         /* where the ray enters the voxel (t_min when it starts inside) */
+    uint32_t xyz[3];  /* the voxel, or the lowest voxel of the level-of-detail cell */
+    int normal[3];    /* entry face normal, one of -1/0/1 per axis; all 0 when the
+                         ray starts inside the voxel */
+    uint32_t level;   /* L for a voxel; a level-of-detail cell spans 2^(L-level) voxels */
+    uint64_t index;   /* voxel index (a cell's first voxel, in Morton order), when
+                         opts->want_index */
+} voxdag_hit;
+
+/* Finds the first full voxel (or level-of-detail cell) along RAY and fills
+   *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched). OPTS may be NULL.
+   Thread-safe on a shared DAG; no allocation; stack use bounded by
+   VOXDAG_MAX_LEVELS. NaN inputs miss. */
+VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray,
+                              const voxdag_ray_opts *opts, voxdag_hit *hit);
+
+/* Shadow query: returns 1 when any full voxel lies along RAY within
+   [t_min, t_max], else 0. Same answer as voxdag_raycast without level of
+   detail, with less bookkeeping. Thread-safe; no allocation. */
+VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
+
+#endif /* VOXDAG_NO_RAYTRACE */
 
 #ifdef __cplusplus
 }
@@ -1372,6 +1451,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
         w++;
     }
     i = 0;
+    if (b->any_reduced && code[0] < b->last_code) return VOXDAG_ERR_ORDER;
     if (b->any_reduced && code[0] == b->last_code) {
         if (rgb) {
             uint8_t *c = b->colors + 3 * (size_t)(b->voxels - 1);
@@ -1414,6 +1494,296 @@ VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *e
     if (st != VOXDAG_OK) {
         b->failed = st;
         return VOXDAGI_FAIL(err, st, "out of memory while reducing voxels");
+    }
+    return voxdagi_ok(err);
+}
+
+// -- Triangle voxelization (conservative, exact separating-axis test)
+
+/* Small replacements for libm so that the header needs libc only. */
+static double voxdagi_abs(double x) { return x < 0 ? -x : x; }
+static double voxdagi_floor(double x) { /* |x| < 2^62 */
+    double i = (double)(int64_t)x;
+    return i > x ? i - 1 : i;
+}
+
+typedef struct voxdagi_tri {
+    double v[3][3];      /* vertices, grid units */
+    double n[3];         /* normal (unnormalized; zero when degenerate) */
+    double lo[3], hi[3]; /* bounding box */
+} voxdagi_tri;
+
+/* Does triangle T intersect the closed box [b, b + size]^3? The 13 axes of
+   the separating-axis theorem for a triangle and a box: the box normals, the
+   triangle normal, and the 9 cross products of edges and box normals. Touching
+   counts as intersecting. Degenerate triangles give zero axes, which never
+   separate, so segments and points are handled by the remaining axes. */
+static int voxdagi_tri_box(const voxdagi_tri *t, const double b[3], double size) {
+    double h = size / 2, v[3][3], e[3][3], d, r;
+    unsigned i, k, a;
+    for (k = 0; k < 3; k++) {
+        double c = b[k] + h;
+        if (t->lo[k] > c + h || t->hi[k] < c - h) return 0;
+        for (i = 0; i < 3; i++) v[i][k] = t->v[i][k] - c;
+    }
+    d = t->n[0] * v[0][0] + t->n[1] * v[0][1] + t->n[2] * v[0][2];
+    r = h * (voxdagi_abs(t->n[0]) + voxdagi_abs(t->n[1]) + voxdagi_abs(t->n[2]));
+    if (d > r || d < -r) return 0;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) e[i][k] = v[(i + 1) % 3][k] - v[i][k];
+    for (i = 0; i < 3; i++)
+        for (a = 0; a < 3; a++) { /* axis = e[i] x unit(a) */
+            unsigned a1 = (a + 1) % 3, a2 = (a + 2) % 3;
+            double axis[3], p0, p1, p2, mn, mx;
+            axis[a] = 0;
+            axis[a1] = e[i][a2];
+            axis[a2] = -e[i][a1];
+            p0 = axis[a1] * v[0][a1] + axis[a2] * v[0][a2];
+            p1 = axis[a1] * v[1][a1] + axis[a2] * v[1][a2];
+            p2 = axis[a1] * v[2][a1] + axis[a2] * v[2][a2];
+            mn = p0 < p1 ? p0 : p1;
+            mn = mn < p2 ? mn : p2;
+            mx = p0 > p1 ? p0 : p1;
+            mx = mx > p2 ? mx : p2;
+            r = h * (voxdagi_abs(axis[a1]) + voxdagi_abs(axis[a2]));
+            if (mn > r || mx < -r) return 0;
+        }
+    return 1;
+}
+
+/* Range of voxels whose closed boxes [x, x+1] may touch [lo, hi], clamped to
+   [0, limit). Returns 0 when empty. */
+static int voxdagi_voxel_range(double lo, double hi, int64_t limit, int64_t *first, int64_t *last) {
+    double f, l;
+    if (lo < -2) lo = -2; /* keeps the values small enough for voxdagi_floor */
+    if (hi > (double)limit + 1) hi = (double)limit + 1;
+    if (lo > hi) return 0;
+    f = -voxdagi_floor(1 - lo); /* ceil(lo - 1) */
+    l = voxdagi_floor(hi);
+    if (f < 0) f = 0;
+    if (l > (double)(limit - 1)) l = (double)(limit - 1);
+    if (f > l) return 0;
+    *first = (int64_t)f;
+    *last = (int64_t)l;
+    return 1;
+}
+
+/* Barycentric coordinates of the point of T nearest to P's projection on
+   its plane, clamped into the triangle. */
+static void voxdagi_tri_bary(const voxdagi_tri *t, const double p[3], double bary[3]) {
+    double nn = t->n[0] * t->n[0] + t->n[1] * t->n[1] + t->n[2] * t->n[2], sum = 0;
+    unsigned i, k;
+    if (!(nn > 0)) {
+        bary[0] = bary[1] = bary[2] = 1.0 / 3;
+        return;
+    }
+    for (i = 0; i < 3; i++) { /* signed area of (p, v[i+1], v[i+2]) along n */
+        const double *a = t->v[(i + 1) % 3], *c = t->v[(i + 2) % 3];
+        double x[3], y[3], w = 0;
+        for (k = 0; k < 3; k++) {
+            x[k] = a[k] - p[k];
+            y[k] = c[k] - p[k];
+        }
+        for (k = 0; k < 3; k++) w += t->n[k] * (x[(k + 1) % 3] * y[(k + 2) % 3] - x[(k + 2) % 3] * y[(k + 1) % 3]);
+        bary[i] = w > 0 ? w / nn : 0;
+        sum += bary[i];
+    }
+    for (i = 0; i < 3; i++) bary[i] = sum > 0 ? bary[i] / sum : 1.0 / 3;
+}
+
+/* Appends one voxel (and its colour) to the builder's buffer. */
+static int voxdagi_emit(voxdag_builder *b, const voxdag_mesh *mesh, const voxdagi_tri *t, size_t tri,
+                        int64_t x, int64_t y, int64_t z) {
+    if (b->pend_n == b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + 1)) return 0;
+    b->pend_code[b->pend_n] = voxdag_morton_encode((uint32_t)x, (uint32_t)y, (uint32_t)z);
+    if (b->opts.colors) {
+        double c[3], bary[3];
+        uint8_t rgb[3];
+        c[0] = (double)x + 0.5;
+        c[1] = (double)y + 0.5;
+        c[2] = (double)z + 0.5;
+        voxdagi_tri_bary(t, c, bary);
+        mesh->color(mesh->user, tri, bary, rgb);
+        b->pend_rgb[b->pend_n] = (uint32_t)rgb[0] << 16 | (uint32_t)rgb[1] << 8 | rgb[2];
+    }
+    b->pend_n++;
+    return 1;
+}
+
+/* Every voxel of T inside the box [clo, chi): columns along the normal's
+   dominant axis w hold only the few voxels the plane crosses. */
+static int voxdagi_voxelize_tri(voxdag_builder *b, const voxdag_mesh *mesh, const voxdagi_tri *t, size_t tri,
+                                const int64_t clo[3], const int64_t chi[3]) {
+    unsigned w = 2, u, v, k;
+    int64_t first[3], last[3], i, j, q;
+    for (k = 0; k < 3; k++)
+        if (!voxdagi_voxel_range(t->lo[k] > (double)clo[k] ? t->lo[k] : (double)clo[k],
+                                 t->hi[k] < (double)chi[k] ? t->hi[k] : (double)chi[k], chi[k], &first[k], &last[k]) ||
+            last[k] < clo[k])
+            return 1;
+    for (k = 0; k < 3; k++) /* the chunk's own voxels only */
+        if (first[k] < clo[k]) first[k] = clo[k];
+    if (voxdagi_abs(t->n[0]) > voxdagi_abs(t->n[w])) w = 0;
+    if (voxdagi_abs(t->n[1]) > voxdagi_abs(t->n[w])) w = 1;
+    u = (w + 1) % 3;
+    v = (w + 2) % 3;
+    for (i = first[u]; i <= last[u]; i++)
+        for (j = first[v]; j <= last[v]; j++) {
+            int64_t wf = first[w], wl = last[w];
+            if (t->n[w] != 0) { /* the plane's w over the column's square, widened by rounding */
+                double d = t->n[0] * t->v[0][0] + t->n[1] * t->v[0][1] + t->n[2] * t->v[0][2];
+                double lo = 1e308, hi = -1e308;
+                unsigned c;
+                for (c = 0; c < 4; c++) {
+                    double pu = (double)i + (c & 1), pv = (double)j + (c >> 1);
+                    double pw = (d - t->n[u] * pu - t->n[v] * pv) / t->n[w];
+                    if (pw < lo) lo = pw;
+                    if (pw > hi) hi = pw;
+                }
+                lo -= 1e-6 * (1 + voxdagi_abs(lo));
+                hi += 1e-6 * (1 + voxdagi_abs(hi));
+                if (!voxdagi_voxel_range(lo, hi, chi[w], &wf, &wl)) continue;
+                if (wf < first[w]) wf = first[w];
+                if (wl > last[w]) wl = last[w];
+            }
+            for (q = wf; q <= wl; q++) {
+                double box[3];
+                int64_t p[3];
+                p[u] = i;
+                p[v] = j;
+                p[w] = q;
+                box[0] = (double)p[0];
+                box[1] = (double)p[1];
+                box[2] = (double)p[2];
+                if (voxdagi_tri_box(t, box, 1.0) && !voxdagi_emit(b, mesh, t, tri, p[0], p[1], p[2])) return 0;
+            }
+        }
+    return 1;
+}
+
+static int voxdagi_load_tri(const voxdag_mesh *mesh, size_t i, voxdagi_tri *t) {
+    double e1[3], e2[3];
+    unsigned c, k;
+    for (c = 0; c < 3; c++) {
+        uint32_t vi = mesh->indices[3 * i + c];
+        if (vi >= mesh->vertex_count) return 0;
+        for (k = 0; k < 3; k++) {
+            double x = mesh->positions[3 * (size_t)vi + k];
+            if (!(x > -1e300 && x < 1e300)) return 0;
+            t->v[c][k] = x;
+        }
+    }
+    for (k = 0; k < 3; k++) {
+        e1[k] = t->v[1][k] - t->v[0][k];
+        e2[k] = t->v[2][k] - t->v[0][k];
+        t->lo[k] = t->hi[k] = t->v[0][k];
+        for (c = 1; c < 3; c++) {
+            if (t->v[c][k] < t->lo[k]) t->lo[k] = t->v[c][k];
+            if (t->v[c][k] > t->hi[k]) t->hi[k] = t->v[c][k];
+        }
+    }
+    for (k = 0; k < 3; k++) t->n[k] = e1[(k + 1) % 3] * e2[(k + 2) % 3] - e1[(k + 2) % 3] * e2[(k + 1) % 3];
+    return 1;
+}
+
+VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
+    const unsigned chunk_want = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8;
+    const unsigned chunk_shift = b && b->levels < chunk_want ? b->levels : chunk_want;
+    int64_t n, chunks;
+    uint64_t *pair_chunk = NULL, *tmp_chunk = NULL;
+    uint32_t *pair_tri = NULL, *tmp_tri = NULL;
+    size_t pairs = 0, cap = 0, cap2 = 0, i, p;
+    voxdag_status st = VOXDAG_OK;
+    if (!b || !mesh || (mesh->triangle_count && (!mesh->indices || !mesh->positions)) ||
+        (b->opts.colors && !mesh->color))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "builder, mesh arrays or colour callback missing");
+    if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
+    if (b->pend_n || b->any_reduced)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "meshes go into a builder without voxels");
+    if (mesh->triangle_count > UINT32_MAX)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more than 2^32-1 triangles");
+    n = (int64_t)1 << b->levels;
+    chunks = n >> chunk_shift;
+    /* Bin: (chunk Morton code, triangle) for every chunk a triangle touches. */
+    for (i = 0; i < mesh->triangle_count && st == VOXDAG_OK; i++) {
+        voxdagi_tri t;
+        int64_t first[3], last[3], cx, cy, cz;
+        unsigned k;
+        int inside = 1;
+        if (!voxdagi_load_tri(mesh, i, &t)) {
+            st = VOXDAG_ERR_INVALID_ARGUMENT;
+            break;
+        }
+        for (k = 0; k < 3 && inside; k++) {
+            inside = voxdagi_voxel_range(t.lo[k], t.hi[k], n, &first[k], &last[k]);
+            first[k] >>= chunk_shift;
+            last[k] >>= chunk_shift;
+        }
+        if (!inside) continue;
+        for (cz = first[2]; cz <= last[2]; cz++)
+            for (cy = first[1]; cy <= last[1]; cy++)
+                for (cx = first[0]; cx <= last[0]; cx++) {
+                    double box[3];
+                    box[0] = (double)(cx << chunk_shift);
+                    box[1] = (double)(cy << chunk_shift);
+                    box[2] = (double)(cz << chunk_shift);
+                    if (!voxdagi_tri_box(&t, box, (double)((int64_t)1 << chunk_shift))) continue;
+                    if (pairs == cap) {
+                        size_t c1 = cap;
+                        if (!voxdagi_grow(&b->mem, (void **)&pair_chunk, &c1, pairs + 1, sizeof *pair_chunk) ||
+                            !voxdagi_grow(&b->mem, (void **)&pair_tri, &cap2, c1, sizeof *pair_tri)) {
+                            cap = c1;
+                            st = VOXDAG_ERR_OUT_OF_MEMORY;
+                            cz = last[2] + 1;
+                            break;
+                        }
+                        cap = c1;
+                    }
+                    pair_chunk[pairs] = voxdag_morton_encode((uint32_t)cx, (uint32_t)cy, (uint32_t)cz);
+                    pair_tri[pairs] = (uint32_t)i;
+                    pairs++;
+                }
+    }
+    if (st == VOXDAG_OK && pairs) {
+        tmp_chunk = (uint64_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_chunk);
+        tmp_tri = (uint32_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_tri);
+        if (tmp_chunk && tmp_tri) {
+            unsigned bits = 0;
+            while (((int64_t)1 << bits) < chunks) bits++;
+            voxdagi_radix_sort(pair_chunk, pair_tri, tmp_chunk, tmp_tri, pairs, 3 * bits);
+        } else {
+            st = VOXDAG_ERR_OUT_OF_MEMORY;
+        }
+        voxdagi_free(&b->mem, tmp_chunk, pairs * sizeof *tmp_chunk);
+        voxdagi_free(&b->mem, tmp_tri, pairs * sizeof *tmp_tri);
+    }
+    /* Voxelize chunk by chunk in Morton order, reducing each chunk at once. */
+    for (p = 0; p < pairs && st == VOXDAG_OK;) {
+        uint64_t code = pair_chunk[p];
+        uint32_t cx, cy, cz;
+        int64_t clo[3], chi[3];
+        unsigned k;
+        voxdag_morton_decode(code, &cx, &cy, &cz);
+        clo[0] = (int64_t)cx << chunk_shift;
+        clo[1] = (int64_t)cy << chunk_shift;
+        clo[2] = (int64_t)cz << chunk_shift;
+        for (k = 0; k < 3; k++) chi[k] = clo[k] + ((int64_t)1 << chunk_shift);
+        for (; p < pairs && pair_chunk[p] == code; p++) {
+            voxdagi_tri t;
+            voxdagi_load_tri(mesh, pair_tri[p], &t);
+            if (!voxdagi_voxelize_tri(b, mesh, &t, pair_tri[p], clo, chi)) st = VOXDAG_ERR_OUT_OF_MEMORY;
+        }
+        if (st == VOXDAG_OK) st = voxdagi_builder_reduce(b, 0);
+        if (b->opts.progress && (p == pairs || (p & 0xFFF) == 0))
+            b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
+    }
+    voxdagi_free(&b->mem, pair_chunk, cap * sizeof *pair_chunk);
+    voxdagi_free(&b->mem, pair_tri, cap2 * sizeof *pair_tri);
+    if (st == VOXDAG_ERR_INVALID_ARGUMENT)
+        return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, (uint64_t)i);
+    if (st != VOXDAG_OK) {
+        b->failed = st;
+        return VOXDAGI_FAIL(err, st, "out of memory while voxelizing");
     }
     return voxdagi_ok(err);
 }
@@ -2378,6 +2748,193 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
     }
     return index;
 }
+
+// -- Ray casting
+#ifndef VOXDAG_NO_RAYTRACE
+//
+// A hierarchical integer DDA over the encoded DAG (SSVDAG Listing 1), with
+// the geometry mirrored by the accumulated mask: cell w of a node reached
+// with mirror M is stored octant w ^ M, or brick bit p ^ (M | M << 3).
+// State: the current cell's integer coordinates c at cell level q (2^q cells
+// per axis) and the event (te, ae) at which the ray entered it (ae = 3 for
+// the start). Every t comes from a plane as (plane - origin) * (1 / dir), so
+// a plane has one t at every level: coarse and fine steps agree bit for bit
+// and ties follow the axis order. Entering a node picks the child cell from
+// the mid planes the ray has crossed by (te, ae). After a step, the highest
+// bit that changed in c names the ancestor whose child changed (a carry), so
+// the walk jumps straight there, like the paper's conditional push but with
+// no push: per node level it keeps only the record, header and mirror to
+// return to, which also give the voxel index at the hit in one pass.
+
+#include <math.h>
+
+typedef struct voxdagi_frame {
+    const uint8_t *rec;
+    unsigned header, mirror;
+} voxdagi_frame;
+
+static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
+#if defined(__GNUC__) || defined(__clang__)
+    return 31u - (unsigned)__builtin_clz(x);
+#else
+    unsigned n = 0;
+    while (x >>= 1) n++;
+    return n;
+#endif
+}
+
+/* Morton position inside a 4^3 brick of the voxel with coordinates C. */
+static unsigned voxdagi_brick_pos(const uint32_t c[3]) {
+    return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
+           (c[2] & 2) << 4;
+}
+
+/* Index of the first voxel of cell C at cell level Q: the voxels of all
+   preceding siblings on the path (DESIGN 3.5), read from the frames. */
+static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint64_t mask,
+                                  const uint32_t c[3], uint32_t q) {
+    uint32_t B = d->levels - 2, top = q < B ? q : B, k;
+    uint64_t idx = 0;
+    for (k = 0; k < top; k++) {
+        unsigned sh = q - 1 - k, j;
+        unsigned w = (c[0] >> sh & 1) | (c[1] >> sh & 1) << 1 | (c[2] >> sh & 1) << 2;
+        for (j = 0; j < 8; j++)
+            if ((f[k].header >> (2 * j) & 3) && (j ^ f[k].mirror) < w)
+                idx += voxdagi_node_count(d, k + 1, voxdagi_child(&d->level[k], f[k].rec, f[k].header, j) >> 3);
+    }
+    if (q == d->levels) {
+        unsigned p = voxdagi_brick_pos(c);
+        idx += (uint64_t)voxdagi_popcount64(voxdagi_reflect_brick(mask, f[B].mirror) & ((1ull << p) - 1));
+    }
+    return idx;
+}
+
+/* The traversal shared by both queries; HIT NULL means any hit will do. */
+static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index,
+                         voxdag_hit *hit) {
+    const uint32_t L = d->levels, B = L - 2, N = 1u << L;
+    voxdagi_frame f[VOXDAG_MAX_LEVELS];
+    double ox[3], ix[3], te = -HUGE_VAL, tx = HUGE_VAL, t_stop;
+    uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
+    int sgn[3];
+    unsigned ae = 0, ax = 0, a, M = d->root_mirror, header = 0;
+    const uint8_t *rec = NULL;
+    uint64_t mask = 0, at = 0;
+
+    if (!d->voxels || !(ray->t_min <= ray->t_max)) return 0;
+    for (a = 0; a < 3; a++) { /* the grid's entry and exit events */
+        double o = ray->origin[a], dir = ray->dir[a], lo, hi;
+        if (o - o != 0 || dir - dir != 0) return 0; /* NaN or infinite */
+        if (dir == 0) {
+            if (!(o >= 0 && o < (double)N)) return 0;
+            sgn[a] = 0, up[a] = 0, step[a] = 0, ox[a] = -HUGE_VAL, ix[a] = 1; /* t = +inf */
+            continue;
+        }
+        sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
+        ox[a] = o, ix[a] = 1.0 / dir;
+        lo = ((dir > 0 ? 0.0 : (double)N) - o) * ix[a];
+        hi = ((dir > 0 ? (double)N : 0.0) - o) * ix[a];
+        if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
+        if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
+    }
+    if (ray->t_min >= te) te = ray->t_min, ae = 3;
+    if (tx < te || (tx == te && ax < ae) || te > ray->t_max) return 0;
+    t_stop = tx == HUGE_VAL ? te : ray->t_max < tx ? ray->t_max : tx;
+
+    for (;;) {
+        /* Enter node (l, at, M), which is cell c of level q. */
+        unsigned halves = 1, b;
+        if (l < B) {
+            rec = d->level[l].data + at;
+            header = (unsigned)voxdagi_le(rec, 2);
+            f[l].rec = rec;
+            f[l].header = header;
+        } else {
+            mask = voxdagi_brick(d, at);
+            halves = 2;
+        }
+        f[l].mirror = M;
+        while (halves--) { /* the child cell: which mid planes are crossed by (te, ae) */
+            uint32_t sh = L - q - 1;
+            for (b = 0; b < 3; b++) {
+                uint32_t mid = (2 * c[b] + 1) << sh;
+                unsigned h;
+                if (!sgn[b]) {
+                    h = ray->origin[b] >= (double)mid;
+                } else {
+                    double tm = ((double)mid - ox[b]) * ix[b];
+                    unsigned crossed = tm < te || (tm == te && b < ae);
+                    h = sgn[b] > 0 ? crossed : !crossed;
+                }
+                c[b] = 2 * c[b] + h;
+            }
+            q++;
+        }
+        /* Step through the node's cells until a full one. */
+        for (;;) {
+            double t, t1, t2;
+            uint32_t old, sh;
+            int k;
+            if (l < B) {
+                if (header >> (2 * (((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M)) & 3) break;
+            } else if (mask >> (voxdagi_brick_pos(c) ^ (M | M << 3)) & 1) {
+                break;
+            }
+            sh = L - q;
+            t = ((double)((c[0] + up[0]) << sh) - ox[0]) * ix[0];
+            t1 = ((double)((c[1] + up[1]) << sh) - ox[1]) * ix[1];
+            t2 = ((double)((c[2] + up[2]) << sh) - ox[2]) * ix[2];
+            a = 0;
+            if (t1 < t) t = t1, a = 1;
+            if (t2 < t) t = t2, a = 2;
+            if (!(t <= t_stop)) return 0;
+            old = c[a];
+            c[a] += step[a];
+            te = t, ae = a;
+            sh = voxdagi_high_bit(old ^ c[a]);
+            k = (int)q - 1 - (int)sh; /* the node level whose child changed */
+            if (k < (int)l) {
+                if (k < 0) return 0; /* left the grid */
+                c[0] >>= sh, c[1] >>= sh, c[2] >>= sh;
+                q -= sh, l = (uint32_t)k;
+                rec = f[l].rec, header = f[l].header, M = f[l].mirror;
+            }
+        }
+        /* Cell c of level q is full: a hit, or go down into it. */
+        if (q == L || (double)(1u << (L - q)) < lod * te) {
+            if (!hit) return 1;
+            hit->t = te;
+            for (b = 0; b < 3; b++) {
+                hit->xyz[b] = c[b] << (L - q);
+                hit->normal[b] = b == ae ? -sgn[b] : 0;
+            }
+            hit->level = q;
+            hit->index = want_index ? voxdagi_ray_index(d, f, mask, c, q) : 0;
+            return 1;
+        }
+        {
+            uint64_t ptr = voxdagi_child(&d->level[l], rec, header,
+                                         ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M);
+            M ^= (unsigned)(ptr & 7);
+            at = ptr >> 3;
+            l++;
+        }
+    }
+}
+
+VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
+                              voxdag_hit *hit) {
+    double lod = opts && opts->lod_pixels > 0 ? opts->lod_factor * opts->lod_pixels : 0;
+    VOXDAG_ASSERT(dag && ray && hit);
+    return voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+}
+
+VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
+    VOXDAG_ASSERT(dag && ray);
+    return voxdagi_trace(dag, ray, 0, 0, NULL);
+}
+
+#endif /* VOXDAG_NO_RAYTRACE */
 
 // -- Files
 

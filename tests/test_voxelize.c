@@ -1,0 +1,239 @@
+/* Triangle voxelization against a brute-force oracle: every voxel of small
+   grids tested with an exact integer separating-axis test written here
+   (coordinates are multiples of 1/16, scaled to integers). */
+#include "test.h"
+#include "voxdag.h"
+
+#ifndef THREADS
+#define THREADS 2
+#endif
+#define SCALE 16 /* vertices are k / SCALE */
+
+typedef struct itri {
+    int64_t v[3][3]; /* scaled by SCALE */
+} itri;
+
+static int64_t dot3(const int64_t a[3], const int64_t b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+static void cross3(const int64_t a[3], const int64_t b[3], int64_t out[3]) {
+    out[0] = a[1] * b[2] - a[2] * b[1];
+    out[1] = a[2] * b[0] - a[0] * b[2];
+    out[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Projections of the triangle and of the box [lo, lo+1]^3 (scaled) on AXIS
+   overlap (touching included)? A zero axis never separates. */
+static int overlap_on(const itri *t, const int64_t box_lo[3], const int64_t axis[3]) {
+    int64_t tmin = INT64_MAX, tmax = INT64_MIN, bmin = INT64_MAX, bmax = INT64_MIN;
+    int i, c;
+    for (i = 0; i < 3; i++) {
+        int64_t p = dot3(axis, t->v[i]);
+        if (p < tmin) tmin = p;
+        if (p > tmax) tmax = p;
+    }
+    for (c = 0; c < 8; c++) {
+        int64_t corner[3], p;
+        corner[0] = box_lo[0] + (c & 1 ? SCALE : 0);
+        corner[1] = box_lo[1] + (c & 2 ? SCALE : 0);
+        corner[2] = box_lo[2] + (c & 4 ? SCALE : 0);
+        p = dot3(axis, corner);
+        if (p < bmin) bmin = p;
+        if (p > bmax) bmax = p;
+    }
+    return !(tmin > bmax || tmax < bmin);
+}
+
+static int brute_overlap(const itri *t, int x, int y, int z) {
+    static const int64_t unit[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    int64_t lo[3], e[3][3], n[3], axis[3];
+    int i, k;
+    lo[0] = (int64_t)x * SCALE;
+    lo[1] = (int64_t)y * SCALE;
+    lo[2] = (int64_t)z * SCALE;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) e[i][k] = t->v[(i + 1) % 3][k] - t->v[i][k];
+    for (k = 0; k < 3; k++)
+        if (!overlap_on(t, lo, unit[k])) return 0;
+    cross3(e[0], e[1], n);
+    if (!overlap_on(t, lo, n)) return 0;
+    for (i = 0; i < 3; i++)
+        for (k = 0; k < 3; k++) {
+            cross3(e[i], unit[k], axis);
+            if (!overlap_on(t, lo, axis)) return 0;
+        }
+    return 1;
+}
+
+typedef struct mesh_data {
+    double *pos;
+    uint32_t *idx;
+    size_t tris;
+} mesh_data;
+
+static void tri_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
+    (void)user;
+    (void)bary;
+    rgb[0] = (uint8_t)tri;
+    rgb[1] = (uint8_t)(tri >> 8);
+    rgb[2] = 7;
+}
+
+/* Random triangles of a few kinds in (or partly outside) the grid. */
+static void random_tris(uint64_t *r, uint32_t n, size_t count, itri *out) {
+    size_t i;
+    for (i = 0; i < count; i++) {
+        int kind = (int)test_rand_below(r, 6), c, k;
+        int64_t span = (int64_t)(n + 2) * SCALE;
+        for (c = 0; c < 3; c++)
+            for (k = 0; k < 3; k++) out[i].v[c][k] = (int64_t)test_rand_below(r, (uint32_t)span) - SCALE;
+        if (kind == 1) /* small */
+            for (c = 1; c < 3; c++)
+                for (k = 0; k < 3; k++) out[i].v[c][k] = out[i].v[0][k] + (int64_t)test_rand_below(r, 2 * SCALE) - SCALE;
+        if (kind == 2) /* on a voxel face plane z = integer */
+            for (c = 0; c < 3; c++) out[i].v[c][2] = (out[i].v[0][2] / SCALE) * SCALE;
+        if (kind == 3) /* degenerate: a segment */
+            for (k = 0; k < 3; k++) out[i].v[2][k] = (out[i].v[0][k] + out[i].v[1][k]) / 2 / 2 * 2;
+        if (kind == 4) /* a point */
+            for (c = 1; c < 3; c++) memcpy(out[i].v[c], out[i].v[0], sizeof out[i].v[0]);
+        if (kind == 5) /* a sliver along a long edge */
+            for (k = 0; k < 3; k++) out[i].v[2][k] = out[i].v[0][k] + (out[i].v[1][k] - out[i].v[0][k]) / 2 + (k == 0);
+    }
+}
+
+static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t count, uint64_t seed) {
+    uint32_t n = 1u << levels, x, y, z;
+    uint64_t r = seed;
+    itri *tris = (itri *)malloc(count * sizeof *tris);
+    mesh_data m;
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    voxdag_mesh mesh;
+    size_t i, bad = 0, bad_color = 0, full = 0;
+    random_tris(&r, n, count, tris);
+    m.pos = (double *)malloc(9 * count * sizeof *m.pos);
+    m.idx = (uint32_t *)malloc(3 * count * sizeof *m.idx);
+    for (i = 0; i < count; i++) {
+        int c, k;
+        for (c = 0; c < 3; c++) {
+            for (k = 0; k < 3; k++) m.pos[9 * i + 3 * c + k] = (double)tris[i].v[c][k] / SCALE;
+            m.idx[3 * i + c] = (uint32_t)(3 * i + c);
+        }
+    }
+    memset(&o, 0, sizeof o);
+    o.levels = levels;
+    o.colors = 1;
+    o.chunk_levels = chunk_levels;
+    o.threads = THREADS;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = m.pos;
+    mesh.vertex_count = 3 * count;
+    mesh.indices = m.idx;
+    mesh.triangle_count = count;
+    mesh.color = tri_color;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    for (z = 0; d && z < n; z++)
+        for (y = 0; y < n; y++)
+            for (x = 0; x < n; x++) {
+                size_t last = SIZE_MAX;
+                uint64_t index;
+                int want;
+                for (i = 0; i < count; i++)
+                    if (brute_overlap(&tris[i], (int)x, (int)y, (int)z)) last = i;
+                want = last != SIZE_MAX;
+                full += (size_t)want;
+                if (voxdag_lookup(d, x, y, z, &index) != want) {
+                    bad++;
+                } else if (want) {
+                    uint8_t c[3];
+                    voxdag_color(d, index, c);
+                    if (c[0] != (uint8_t)last || c[1] != (uint8_t)(last >> 8)) bad_color++;
+                }
+            }
+    CHECK_MSG(bad == 0 && bad_color == 0, "L=%u chunks 2^%u: %zu voxels wrong, %zu colours wrong (of %zu full)",
+              levels, chunk_levels, bad, bad_color, full);
+    CHECK(full > 0);
+    voxdag_free(d);
+    free(tris);
+    free(m.pos);
+    free(m.idx);
+}
+
+static void test_random_triangles(void) {
+    check_voxelization(3, 0, 40, 1);
+    check_voxelization(4, 2, 60, 2);
+    check_voxelization(5, 3, 80, 3);
+    check_voxelization(5, 2, 30, 4);
+}
+
+/* A square on the plane z = 8 fills the voxel layers z = 7 and z = 8. */
+static void test_face_plane(void) {
+    static const double pos[] = {2, 2, 8, 6, 2, 8, 6, 6, 8, 2, 6, 8};
+    static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    voxdag_mesh mesh;
+    voxdag_info info;
+    memset(&o, 0, sizeof o);
+    o.levels = 4;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = pos;
+    mesh.vertex_count = 4;
+    mesh.indices = idx;
+    mesh.triangle_count = 2;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    voxdag_get_info(d, &info);
+    CHECK(info.voxels == 2 * 6 * 6); /* x, y in 1..6 (closed boxes touch 2 and 6), z in 7..8 */
+    CHECK(voxdag_lookup(d, 1, 1, 7, NULL) && voxdag_lookup(d, 6, 6, 8, NULL) && !voxdag_lookup(d, 3, 3, 9, NULL));
+    voxdag_free(d);
+}
+
+static void test_bad_meshes(void) {
+    static const double pos[] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+    static const uint32_t bad_idx[] = {0, 1, 3};
+    double nan_pos[9];
+    static const uint32_t idx[] = {0, 1, 2};
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag_mesh mesh;
+    voxdag_error err;
+    uint32_t xyz[3] = {1, 1, 1};
+    memset(&o, 0, sizeof o);
+    o.levels = 4;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = pos;
+    mesh.vertex_count = 3;
+    mesh.indices = bad_idx;
+    mesh.triangle_count = 1;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, &err) == VOXDAG_ERR_INVALID_ARGUMENT && err.node == 0);
+    voxdag_builder_free(b);
+    memcpy(nan_pos, pos, sizeof pos);
+    nan_pos[4] = 0.0 / 0.0;
+    mesh.positions = nan_pos;
+    mesh.indices = idx;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, &err) == VOXDAG_ERR_INVALID_ARGUMENT);
+    voxdag_builder_free(b);
+    mesh.positions = pos;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add(b, xyz, NULL, 1, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, &err) == VOXDAG_ERR_INVALID_ARGUMENT);
+    voxdag_builder_free(b);
+    o.colors = 1; /* colours need a colour callback */
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, &err) == VOXDAG_ERR_INVALID_ARGUMENT);
+    voxdag_builder_free(b);
+}
+
+const test_case test_voxelize_cases[] = {
+    {"voxelize/random_triangles", test_random_triangles},
+    {"voxelize/face_plane", test_face_plane},
+    {"voxelize/bad_meshes", test_bad_meshes},
+    {NULL, NULL},
+};
