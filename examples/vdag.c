@@ -174,6 +174,70 @@ static int scene_to_grid(const vdag_scene *sc, build_args *a, uint32_t **xyz_out
     return 0;
 }
 
+/* Colour of a point on a mesh triangle: the vertex colours interpolated,
+   else the material's texture (nearest texel, wrapping), else its Kd. */
+static void mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
+    const vdag_scene *sc = (const vdag_scene *)user;
+    const uint32_t *v = sc->indices + 3 * tri;
+    int32_t m = sc->triangle_material ? sc->triangle_material[tri] : -1;
+    int k, c;
+    if (sc->vertex_rgb) {
+        for (k = 0; k < 3; k++) {
+            double x = 0;
+            for (c = 0; c < 3; c++) x += bary[c] * sc->vertex_rgb[3 * (size_t)v[c] + k];
+            rgb[k] = (uint8_t)(x + 0.5 > 255 ? 255 : x + 0.5);
+        }
+        return;
+    }
+    if (m < 0 || (size_t)m >= sc->material_count) {
+        rgb[0] = rgb[1] = rgb[2] = 255;
+        return;
+    }
+    if (sc->uv && sc->materials[m].image >= 0 && (size_t)sc->materials[m].image < sc->image_count) {
+        const vdag_image *im = &sc->images[sc->materials[m].image];
+        double u = 0, w = 0;
+        long px, py;
+        for (c = 0; c < 3; c++) {
+            u += bary[c] * sc->uv[2 * (size_t)v[c]];
+            w += bary[c] * sc->uv[2 * (size_t)v[c] + 1];
+        }
+        u -= floor(u);
+        w -= floor(w);
+        px = (long)(u * im->width);
+        py = (long)((1 - w) * im->height); /* uv origin at the bottom left, rows top down */
+        if (px >= (long)im->width) px = (long)im->width - 1;
+        if (py >= (long)im->height) py = (long)im->height - 1;
+        if (px < 0) px = 0;
+        if (py < 0) py = 0;
+        memcpy(rgb, im->rgb + 3 * ((size_t)py * im->width + (size_t)px), 3);
+        return;
+    }
+    memcpy(rgb, sc->materials[m].rgb, 3);
+}
+
+/* Mesh vertices in grid units: the bounding box fitted into the 2^L grid
+   with one uniform scale; BOUNDS receives the grid's world-space box. */
+static double *mesh_to_grid(const vdag_scene *sc, uint32_t levels, double bounds[6]) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, extent = 0, scale;
+    double *grid = (double *)malloc(3 * sc->vertex_count * sizeof *grid + 1);
+    size_t i;
+    int k;
+    if (!grid) return NULL;
+    for (i = 0; i < 3 * sc->vertex_count; i++) {
+        if (sc->positions[i] < lo[i % 3]) lo[i % 3] = sc->positions[i];
+        if (sc->positions[i] > hi[i % 3]) hi[i % 3] = sc->positions[i];
+    }
+    for (k = 0; k < 3; k++)
+        if (hi[k] - lo[k] > extent) extent = hi[k] - lo[k];
+    scale = extent > 0 ? (double)(1u << levels) / extent : 1;
+    for (i = 0; i < 3 * sc->vertex_count; i++) grid[i] = (sc->positions[i] - lo[i % 3]) * scale;
+    for (k = 0; k < 3; k++) {
+        bounds[k] = lo[k];
+        bounds[k + 3] = lo[k] + (double)(1u << levels) / scale;
+    }
+    return grid;
+}
+
 static void print_build_summary(const voxdag *dag, const voxdag_build_stats *st, double seconds) {
     voxdag_info info;
     uint32_t l;
@@ -229,14 +293,60 @@ static int compress_colors(voxdag **dag, const build_args *a) {
     return 0;
 }
 
+static voxdag_build_opts build_opts(const build_args *a, int colors, const double *bounds) {
+    voxdag_build_opts o;
+    memset(&o, 0, sizeof o);
+    o.levels = a->levels;
+    o.no_symmetry = a->no_symmetry;
+    o.colors = colors;
+    o.compare_structures = a->stats;
+    o.threads = a->threads;
+    o.bounds = bounds;
+    o.progress = progress;
+    return o;
+}
+
+static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0);
+
+static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
+    double bounds[6], *grid;
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag_mesh mesh;
+    voxdag_error err;
+    int colors = sc->vertex_rgb || sc->material_count, rc;
+    if (!a->levels) a->levels = 10;
+    fprintf(stderr, "vdag: voxelizing %zu triangles into %u^3\n", sc->triangle_count, 1u << a->levels);
+    grid = mesh_to_grid(sc, a->levels, bounds);
+    if (!grid) {
+        vdag_scene_free(sc);
+        return vdag_fail("out of memory");
+    }
+    o = build_opts(a, colors, bounds);
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = grid;
+    mesh.vertex_count = sc->vertex_count;
+    mesh.indices = sc->indices;
+    mesh.triangle_count = sc->triangle_count;
+    mesh.color = colors ? mesh_color : NULL;
+    mesh.user = sc;
+    rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
+    if (!rc && voxdag_builder_add_mesh(b, &mesh, &err) != VOXDAG_OK) {
+        voxdag_builder_free(b);
+        rc = 1;
+    }
+    rc = finish_build(a, b, rc, &err, t0);
+    free(grid);
+    vdag_scene_free(sc);
+    return rc;
+}
+
 static int cmd_build(int argc, char **argv) {
     build_args a;
     vdag_scene sc;
     char msg[256];
     voxdag_build_opts o;
     voxdag_builder *b;
-    voxdag *dag = NULL;
-    voxdag_build_stats st;
     voxdag_error err;
     uint32_t *xyz = NULL;
     double bounds[6], t0 = now_seconds();
@@ -277,22 +387,12 @@ static int cmd_build(int argc, char **argv) {
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--no-symmetry] ...");
     fprintf(stderr, "vdag: reading %s\n", a.in);
     if (!vdag_import_file(a.in, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
-    if (sc.triangle_count && !sc.point_count) {
-        vdag_scene_free(&sc);
-        return vdag_fail("%s: triangle meshes are not supported by this build of vdag yet", a.in);
-    }
+    if (sc.triangle_count) return build_mesh(&a, &sc, t0);
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);
         return 1;
     }
-    memset(&o, 0, sizeof o);
-    o.levels = a.levels;
-    o.no_symmetry = a.no_symmetry;
-    o.colors = sc.point_rgb != NULL;
-    o.compare_structures = a.stats;
-    o.threads = a.threads;
-    o.bounds = bounds;
-    o.progress = progress;
+    o = build_opts(&a, sc.point_rgb != NULL, bounds);
     rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
     for (i = 0; !rc && i < sc.point_count; i += 1u << 20) {
         size_t n = sc.point_count - i < (1u << 20) ? sc.point_count - i : (1u << 20);
@@ -301,17 +401,26 @@ static int cmd_build(int argc, char **argv) {
     }
     free(xyz);
     vdag_scene_free(&sc);
-    if (!rc) rc = voxdag_builder_finish(b, &dag, &st, &err) != VOXDAG_OK;
-    if (rc) return vdag_fail("build: %s (%s)", voxdag_status_string(err.status), err.message);
+    return finish_build(&a, b, rc, &err, t0);
+}
+
+/* Finishes a build whose input is all added (FAILED: adding failed, B is
+   freed), compresses colours when asked, and saves. */
+static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0) {
+    voxdag *dag = NULL;
+    voxdag_build_stats st;
+    int rc = failed;
+    if (!rc) rc = voxdag_builder_finish(b, &dag, &st, err) != VOXDAG_OK;
+    if (rc) return vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
     print_build_summary(dag, &st, now_seconds() - t0);
-    if (a.compress && compress_colors(&dag, &a)) {
+    if (a->compress && compress_colors(&dag, a)) {
         voxdag_free(dag);
         return 1;
     }
-    rc = voxdag_save_file(dag, a.out, &err) != VOXDAG_OK;
+    rc = voxdag_save_file(dag, a->out, err) != VOXDAG_OK;
     voxdag_free(dag);
-    if (rc) return vdag_fail("%s: %s", a.out, err.message);
-    fprintf(stderr, "vdag: wrote %s\n", a.out);
+    if (rc) return vdag_fail("%s: %s", a->out, err->message);
+    fprintf(stderr, "vdag: wrote %s\n", a->out);
     return 0;
 }
 

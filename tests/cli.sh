@@ -104,6 +104,16 @@ open('$T/flip.vdag', 'wb').write(b)"
 check "flipped byte is invalid, one-line reason" sh -c "! '$VDAG' validate '$T/flip.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
 check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1 2 x 2>/dev/null"
 
+# -- meshes: an axis-aligned square fitted into the grid fills one or two layers
+printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 0 8 0 1 0 0\nf 1 2 3\nf 1 3 4\n' >"$T/square.obj"
+check "build a coloured .obj" "$VDAG" build "$T/square.obj" "$T/sq.vdag" --levels 3 2>/dev/null
+check "the square is the 8x8 layer z = 0, red" sh -c "'$VDAG' export-voxels '$T/sq.vdag' | python3 -c \"
+import sys
+v = [tuple(map(int, l.split())) for l in sys.stdin]
+assert sorted(p[:3] for p in v) == sorted((x, y, 0) for x in range(8) for y in range(8)), v[:5]
+assert all(p[3:] == (255, 0, 0) for p in v)
+\""
+
 # -- the demo scene generator
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
