@@ -8,12 +8,14 @@ extern const test_case test_core_cases[];
 extern const test_case test_voxcolor_cases[];
 extern const test_case test_import_cases[];
 extern const test_case test_voxelize_cases[];
+extern const test_case test_raytrace_cases[];
 
 static const test_case *const suites[] = {
     test_core_cases,
     test_voxcolor_cases,
     test_import_cases,
     test_voxelize_cases,
+    test_raytrace_cases,
 };
 
 const char *test_data_dir(void) {

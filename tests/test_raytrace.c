@@ -1,0 +1,371 @@
+/* Oracle tests of ray casting: every answer of voxdag_raycast is compared with
+   a flat 3D DDA written here over a dense grid (with a per-level occupancy
+   pyramid for level of detail), and every voxel index with the Morton rank.
+
+   Distances are compared bit for bit: a plane's t is defined (voxdag.h, "Ray
+   casting") as (plane - origin) * (1 / dir), and the DDA below computes it the
+   same way, so any difference is a traversal error, not rounding. Rays through
+   edges and corners are exact ties between axes; the documented tie rule
+   (x before y before z) makes them deterministic, so they are compared
+   exactly as well, and the test counts them to prove they are exercised. */
+#include "test.h"
+#include "voxdag.h"
+
+#include <math.h>
+
+// -- Dense scenes and their occupancy pyramid
+
+typedef struct rscene {
+    uint32_t levels, n;
+    uint8_t *occ[VOXDAG_MAX_LEVELS + 1]; /* occ[q]: 2^q cells per axis, 1 = not empty */
+    uint64_t *rank;                      /* voxel index of each full voxel */
+} rscene;
+
+static size_t rcell(uint32_t n, uint32_t x, uint32_t y, uint32_t z) {
+    return (size_t)x + (size_t)n * ((size_t)y + (size_t)n * z);
+}
+
+enum { RS_EMPTY, RS_ONE, RS_FULL, RS_SPARSE, RS_DENSE, RS_SPHERE, RS_PLANE, RS_BLOB, RS_CHECKER, RS_COUNT };
+
+static int rscene_voxel(int kind, uint32_t n, uint32_t x, uint32_t y, uint32_t z, uint64_t *r,
+                        const uint32_t one[3]) {
+    double c = n / 2.0 - 0.3, rad = n * 0.4, dx = x + 0.5 - c, dy = y + 0.5 - c, dz = z + 0.5 - c;
+    double d2 = dx * dx + dy * dy + dz * dz;
+    uint32_t h = n / 2, mx = x < h ? x : n - 1 - x, my = y < h ? y : n - 1 - y, mz = z < h ? z : n - 1 - z;
+    switch (kind) {
+    case RS_ONE: return x == one[0] && y == one[1] && z == one[2];
+    case RS_FULL: return 1;
+    case RS_SPARSE: return test_rand(r) % 23 == 0;
+    case RS_DENSE: return (test_rand(r) & 3) != 0;
+    case RS_SPHERE: return d2 <= rad * rad && d2 >= (rad - 1.7) * (rad - 1.7);
+    case RS_PLANE: return (x + 2 * y + 3 * z) / 3 == n / 2;
+    case RS_BLOB: /* reflected into all 8 octants: many mirrored subtrees */
+        return (mx * 7 + my * 13 + mz * 5 + mx * my) % 5 == 0 || mx + my + mz < n / 4;
+    case RS_CHECKER: return ((x ^ y ^ z) & 1) && (x / 4 + y / 4 + z / 4) % 3 != 0;
+    default: return 0;
+    }
+}
+
+/* Builds a scene into a dense pyramid and a DAG (symmetric or not). */
+static voxdag *rscene_make(rscene *s, int kind, uint32_t levels, int symmetric, uint64_t seed) {
+    uint32_t n = 1u << levels, x, y, z, q, one[3];
+    uint64_t r = seed, count = 0, m, cells = (uint64_t)n * n * n;
+    uint32_t *xyz = (uint32_t *)malloc(3 * cells * sizeof(uint32_t));
+    uint8_t *rgb = (uint8_t *)malloc(3 * cells);
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    memset(s, 0, sizeof *s);
+    s->levels = levels;
+    s->n = n;
+    for (q = 0; q <= levels; q++) s->occ[q] = (uint8_t *)calloc((size_t)1 << (3 * q), 1);
+    s->rank = (uint64_t *)calloc(cells, sizeof(uint64_t));
+    for (q = 0; q < 3; q++) one[q] = test_rand_below(&r, n);
+    for (z = 0; z < n; z++)
+        for (y = 0; y < n; y++)
+            for (x = 0; x < n; x++) {
+                if (!rscene_voxel(kind, n, x, y, z, &r, one)) continue;
+                for (q = 0; q <= levels; q++) {
+                    uint32_t sh = levels - q;
+                    s->occ[q][rcell(1u << q, x >> sh, y >> sh, z >> sh)] = 1;
+                }
+                xyz[3 * count] = x, xyz[3 * count + 1] = y, xyz[3 * count + 2] = z;
+                rgb[3 * count] = (uint8_t)x, rgb[3 * count + 1] = (uint8_t)y, rgb[3 * count + 2] = (uint8_t)z;
+                count++;
+            }
+    /* Morton rank: walk every cell in Morton order (bit-by-bit decode here). */
+    for (m = 0, count = 0; m < cells; m++) {
+        uint32_t c[3] = {0, 0, 0}, bit;
+        for (bit = 0; bit < 3 * levels; bit++) c[bit % 3] |= (uint32_t)(m >> bit & 1) << (bit / 3);
+        if (s->occ[levels][rcell(n, c[0], c[1], c[2])]) s->rank[rcell(n, c[0], c[1], c[2])] = count++;
+    }
+    memset(&o, 0, sizeof o);
+    o.levels = levels;
+    o.no_symmetry = !symmetric;
+    o.colors = 1;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add(b, xyz, rgb, count, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    free(xyz);
+    free(rgb);
+    return d;
+}
+
+static void rscene_free(rscene *s) {
+    uint32_t q;
+    for (q = 0; q <= s->levels; q++) free(s->occ[q]);
+    free(s->rank);
+}
+
+// -- The flat DDA oracle
+
+/* One cell visited by the oracle: its coordinates at level q, the t where the
+   ray enters it and the axis it crossed (3: the ray starts in it). */
+typedef struct visit {
+    uint32_t c[3];
+    double t;
+    int axis;
+    int edge; /* entered through an edge or corner (another axis ties) */
+} visit;
+
+/* (t1, a1) < (t2, a2): crossings are ordered by t, then by axis. */
+static int event_before(double t1, int a1, double t2, int a2) { return t1 < t2 || (t1 == t2 && a1 < a2); }
+
+/* Walks the cells of level Q along RAY in order, calling STOP on each until it
+   returns 1. Returns 1 when STOP accepted a cell (left in *v). */
+static int oracle_walk(const rscene *s, const voxdag_ray *ray, uint32_t q,
+                       int (*stop)(const rscene *, uint32_t, const visit *, void *), void *user, visit *v) {
+    uint32_t n = 1u << q, size = s->n >> q, b, k;
+    double inv[3], ts = -HUGE_VAL, tx = HUGE_VAL;
+    int as = 0, ax = 0;
+    for (b = 0; b < 3; b++) {
+        double o = ray->origin[b], d = ray->dir[b], lo, hi;
+        if (d == 0) {
+            if (o < 0 || o >= s->n) return 0;
+            continue;
+        }
+        inv[b] = 1.0 / d;
+        lo = ((d > 0 ? 0.0 : (double)s->n) - o) * inv[b];
+        hi = ((d > 0 ? (double)s->n : 0.0) - o) * inv[b];
+        if (!event_before(lo, (int)b, ts, as)) ts = lo, as = (int)b;
+        if (event_before(hi, (int)b, tx, ax)) tx = hi, ax = (int)b;
+    }
+    if (!event_before(ray->t_min, 3, ts, as)) ts = ray->t_min, as = 3;
+    if (event_before(tx, ax, ts, as) || ts > ray->t_max) return 0;
+    /* Start cell: count the interior planes crossed before the start event. */
+    for (b = 0; b < 3; b++) {
+        double d = ray->dir[b];
+        uint32_t crossed = 0;
+        if (d == 0) {
+            v->c[b] = (uint32_t)ray->origin[b] / size;
+            continue;
+        }
+        for (k = 1; k < n; k++)
+            crossed += event_before(((double)(k * size) - ray->origin[b]) * inv[b], (int)b, ts, as);
+        v->c[b] = d > 0 ? crossed : n - 1 - crossed;
+    }
+    v->t = ts;
+    v->axis = as;
+    v->edge = 0;
+    for (;;) {
+        double best = HUGE_VAL;
+        int a = -1;
+        if (stop(s, q, v, user)) return 1;
+        for (b = 0; b < 3; b++) {
+            double t;
+            if (ray->dir[b] == 0) continue;
+            t = ((double)((v->c[b] + (ray->dir[b] > 0)) * size) - ray->origin[b]) * inv[b];
+            if (t < best) best = t, a = (int)b;
+        }
+        if (a < 0 || best > ray->t_max) return 0;
+        if (ray->dir[a] > 0 ? ++v->c[a] == n : v->c[a]-- == 0) return 0;
+        v->edge = 0;
+        for (b = 0; b < 3; b++)
+            if ((int)b != a && ray->dir[b] != 0 &&
+                ((double)((v->c[b] + (ray->dir[b] < 0)) * size) - ray->origin[b]) * inv[b] == best)
+                v->edge = 1;
+        v->t = best;
+        v->axis = a;
+    }
+}
+
+static int stop_full(const rscene *s, uint32_t q, const visit *v, void *user) {
+    (void)user;
+    return s->occ[q][rcell(1u << q, v->c[0], v->c[1], v->c[2])];
+}
+
+/* Level of detail: stop at a full cell whose side is below lod * t. */
+typedef struct lod_walk {
+    double lod;
+    int early; /* a full cell before the target already met the condition */
+    uint32_t target[3];
+} lod_walk;
+
+static int stop_lod(const rscene *s, uint32_t q, const visit *v, void *user) {
+    lod_walk *w = (lod_walk *)user;
+    double side = (double)(s->n >> q);
+    if (v->c[0] == w->target[0] && v->c[1] == w->target[1] && v->c[2] == w->target[2]) return 1;
+    if (stop_full(s, q, v, NULL) && side < w->lod * v->t) w->early = 1;
+    return 0;
+}
+
+// -- Rays
+
+static double rand_unit(uint64_t *r) { return (double)(test_rand(r) >> 11) / 9007199254740992.0; }
+
+/* A float in [lo, hi) (rays come from float text in the tool). */
+static double rand_in(uint64_t *r, double lo, double hi) { return (float)(lo + (hi - lo) * rand_unit(r)); }
+
+static voxdag_ray make_ray(uint64_t *r, uint32_t n) {
+    voxdag_ray ray;
+    uint32_t b, kind = test_rand_below(r, 6);
+    double target[3];
+    memset(&ray, 0, sizeof ray);
+    ray.t_max = HUGE_VAL;
+    for (b = 0; b < 3; b++) {
+        ray.origin[b] = rand_in(r, 0, n);
+        ray.dir[b] = rand_in(r, -1, 1);
+        target[b] = rand_in(r, 0, n);
+    }
+    switch (kind) {
+    case 0: break; /* inside, random direction */
+    case 1:        /* outside, aimed at the grid */
+        for (b = 0; b < 3; b++) ray.origin[b] = rand_in(r, -(double)n, 2.0 * n);
+        for (b = 0; b < 3; b++) ray.dir[b] = target[b] - ray.origin[b];
+        break;
+    case 2: /* axis-parallel: one or two zero components, origin often on a face plane */
+        for (b = 0; b < 3; b++) {
+            if (test_rand_below(r, 3) == 0) ray.origin[b] = test_rand_below(r, n + 1);
+            if (test_rand_below(r, 3) == 0) ray.origin[b] = -ray.origin[b] - 1;
+        }
+        ray.dir[test_rand_below(r, 3)] = 0;
+        if (test_rand(r) & 1) ray.dir[test_rand_below(r, 3)] = 0;
+        break;
+    case 3: /* through edges and corners: lattice origin, small integer direction */
+    case 4:
+        for (b = 0; b < 3; b++) {
+            ray.origin[b] = (double)test_rand_below(r, n + 5) - 2;
+            ray.dir[b] = (double)test_rand_below(r, 5) - 2;
+            if (kind == 4 && b == 0) ray.origin[b] += 0.5;
+        }
+        break;
+    case 5: /* a window [t_min, t_max] inside the grid */
+        ray.t_min = rand_in(r, 0, n / 2.0);
+        ray.t_max = ray.t_min + rand_in(r, 0, (double)n);
+        break;
+    }
+    return ray;
+}
+
+// -- Cases
+
+typedef struct ray_stats {
+    uint64_t rays, hits, edges, lod_hits, starts_inside;
+} ray_stats;
+
+static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count, ray_stats *st) {
+    rscene s;
+    uint64_t r = 0x51ED + (uint64_t)kind * 1000 + levels * 10 + (uint64_t)symmetric;
+    voxdag *d = rscene_make(&s, kind, levels, symmetric, r);
+    voxdag_ray_opts opts;
+    uint32_t i;
+    memset(&opts, 0, sizeof opts);
+    opts.want_index = 1;
+    for (i = 0; d && i < count; i++) {
+        voxdag_ray ray = make_ray(&r, s.n);
+        voxdag_hit hit;
+        visit v;
+        int want = oracle_walk(&s, &ray, levels, stop_full, NULL, &v), got;
+        memset(&hit, 0, sizeof hit);
+        got = voxdag_raycast(d, &ray, &opts, &hit);
+        st->rays++;
+        CHECK_MSG(got == want, "scene %d L=%u sym=%d ray %u: hit %d, oracle %d", kind, levels, symmetric, i,
+                  got, want);
+        CHECK(voxdag_occluded(d, &ray) == want);
+        if (got && want) {
+            int normal[3] = {0, 0, 0};
+            if (v.axis < 3) normal[v.axis] = ray.dir[v.axis] > 0 ? -1 : 1;
+            st->hits++;
+            st->edges += (uint64_t)v.edge;
+            st->starts_inside += v.axis == 3;
+            CHECK_MSG(hit.t == v.t && hit.xyz[0] == v.c[0] && hit.xyz[1] == v.c[1] && hit.xyz[2] == v.c[2] &&
+                          hit.level == levels,
+                      "scene %d L=%u sym=%d ray %u: t %.17g (%u %u %u), oracle t %.17g (%u %u %u)", kind,
+                      levels, symmetric, i, hit.t, hit.xyz[0], hit.xyz[1], hit.xyz[2], v.t, v.c[0], v.c[1],
+                      v.c[2]);
+            CHECK(hit.normal[0] == normal[0] && hit.normal[1] == normal[1] && hit.normal[2] == normal[2]);
+            CHECK(hit.index == s.rank[rcell(s.n, v.c[0], v.c[1], v.c[2])]);
+        }
+        if (want && levels > 2) { /* the same ray with level of detail */
+            voxdag_ray_opts lo = opts;
+            voxdag_hit lh;
+            lod_walk w;
+            visit lv;
+            lo.lod_factor = rand_in(&r, 0.002, 0.2);
+            lo.lod_pixels = 1;
+            CHECK(voxdag_raycast(d, &ray, &lo, &lh) == 1);
+            CHECK(lh.t <= v.t && lh.level >= 1 && lh.level <= levels);
+            if (lh.level < levels) {
+                uint32_t sh = levels - lh.level, x, y, z;
+                uint64_t first = UINT64_MAX;
+                st->lod_hits++;
+                w.lod = lo.lod_factor * lo.lod_pixels;
+                w.early = 0;
+                w.target[0] = lh.xyz[0] >> sh, w.target[1] = lh.xyz[1] >> sh, w.target[2] = lh.xyz[2] >> sh;
+                /* the cell is full, met the condition where the ray entered it, and no
+                   full cell of its level met it earlier */
+                CHECK(s.occ[lh.level][rcell(1u << lh.level, w.target[0], w.target[1], w.target[2])]);
+                CHECK(oracle_walk(&s, &ray, lh.level, stop_lod, &w, &lv) == 1);
+                CHECK_MSG(lv.t == lh.t && !w.early, "lod t %.17g oracle %.17g early %d", lh.t, lv.t, w.early);
+                CHECK((double)(1u << sh) < w.lod * lh.t);
+                if (lh.level > 1) { /* and its parent cell did not */
+                    w.target[0] >>= 1, w.target[1] >>= 1, w.target[2] >>= 1;
+                    CHECK(oracle_walk(&s, &ray, lh.level - 1, stop_lod, &w, &lv) == 1);
+                    CHECK(!w.early && !((double)(2u << sh) < w.lod * lv.t));
+                }
+                for (z = 0; z < 1u << sh; z++) /* the cell's first voxel index */
+                    for (y = 0; y < 1u << sh; y++)
+                        for (x = 0; x < 1u << sh; x++) {
+                            size_t c = rcell(s.n, lh.xyz[0] + x, lh.xyz[1] + y, lh.xyz[2] + z);
+                            if (s.occ[levels][c] && s.rank[c] < first) first = s.rank[c];
+                        }
+                CHECK(lh.index == first);
+            }
+        }
+    }
+    voxdag_free(d);
+    rscene_free(&s);
+}
+
+static void test_raytrace_oracle(void) {
+    ray_stats st;
+    uint32_t levels;
+    int kind, sym;
+    memset(&st, 0, sizeof st);
+    for (levels = 2; levels <= 7; levels++)
+        for (kind = 0; kind < RS_COUNT; kind++)
+            for (sym = 0; sym < 2; sym++) check_scene(kind, levels, sym, levels < 7 ? 1000 : 2000, &st);
+    fprintf(stderr, "  %llu rays, %llu hits (%llu through edges or corners, %llu starting inside), %llu LOD hits\n",
+            (unsigned long long)st.rays, (unsigned long long)st.hits, (unsigned long long)st.edges,
+            (unsigned long long)st.starts_inside, (unsigned long long)st.lod_hits);
+    CHECK(st.rays >= 100000);
+    CHECK(st.edges > 1000 && st.lod_hits > 1000);
+}
+
+/* Hand-checked cases: the conventions of the header's comment. */
+static void test_raytrace_conventions(void) {
+    rscene s;
+    voxdag *d = rscene_make(&s, RS_FULL, 3, 1, 1);
+    voxdag_ray ray;
+    voxdag_hit h;
+    memset(&ray, 0, sizeof ray);
+    ray.t_max = HUGE_VAL;
+    /* inside a full voxel: t = t_min, no normal */
+    ray.origin[0] = 2.5, ray.origin[1] = 3.5, ray.origin[2] = 4.5, ray.dir[0] = 1;
+    CHECK(voxdag_raycast(d, &ray, NULL, &h) && h.t == 0 && h.xyz[0] == 2 && h.xyz[1] == 3 && h.xyz[2] == 4);
+    CHECK(h.normal[0] == 0 && h.normal[1] == 0 && h.normal[2] == 0 && h.level == 3);
+    /* on a face moving down: starts in the voxel below */
+    ray.origin[0] = 2, ray.dir[0] = -1;
+    CHECK(voxdag_raycast(d, &ray, NULL, &h) && h.t == 0 && h.xyz[0] == 1);
+    /* from outside along -x: enters voxel 7 through its +x face */
+    ray.origin[0] = 20;
+    CHECK(voxdag_raycast(d, &ray, NULL, &h) && h.t == 12 && h.xyz[0] == 7 && h.normal[0] == 1);
+    /* in the face plane y = 8 (outside the grid): misses */
+    ray.origin[1] = 8;
+    CHECK(!voxdag_raycast(d, &ray, NULL, &h) && !voxdag_occluded(d, &ray));
+    /* zero direction: a point query; NaN misses */
+    ray.origin[0] = 2, ray.origin[1] = 1, ray.dir[0] = 0;
+    CHECK(voxdag_raycast(d, &ray, NULL, &h) && h.t == 0 && h.xyz[0] == 2 && h.xyz[1] == 1);
+    ray.origin[0] = 20;
+    CHECK(!voxdag_raycast(d, &ray, NULL, &h));
+    ray.dir[1] = NAN;
+    CHECK(!voxdag_raycast(d, &ray, NULL, &h));
+    voxdag_free(d);
+    rscene_free(&s);
+}
+
+const test_case test_raytrace_cases[] = {
+    {"raytrace_conventions", test_raytrace_conventions},
+    {"raytrace_oracle", test_raytrace_oracle},
+    {NULL, NULL},
+};
