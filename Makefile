@@ -29,7 +29,7 @@ IMAGE_DEPS := examples/image.h examples/image_oiio.cpp examples/image_none.c
 # Importer fuzzing: libFuzzer (clang) for `make fuzz-import`; `make test`
 # replays the committed corpus with the same entry point.
 FUZZ_IMPORT_SRC  := tests/fuzz_import.c examples/import.c examples/image_none.c
-FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=4194304
+FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=65536
 FUZZ_SECONDS     ?= 120
 
 .PHONY: all test deps demo bench clean fuzz-import

@@ -286,6 +286,18 @@ static void vi_as_points(vdag_scene *s) {
     s->vertex_count = 0;
 }
 
+/* Gives S the triangles in TRIS (three uint32 corners each), taking the
+   memory; without any, S is a point cloud. */
+static void vi_set_triangles(vdag_scene *s, vi_buf *tris) {
+    if (!tris->count) {
+        vi_as_points(s);
+        return;
+    }
+    s->triangle_count = tris->count / 3;
+    s->indices = (uint32_t *)tris->data;
+    tris->data = NULL;
+}
+
 // -- .xyz: one voxel per line, "x y z" or "x y z r g b"
 
 /* The first voxel line decides whether the file has colours; every other
@@ -664,13 +676,7 @@ static int vi_parse_ply(vi_ctx *c, vi_text *t, vdag_scene *out) {
             }
         }
     }
-    if (!tris.count) {
-        vi_as_points(out);
-    } else {
-        out->triangle_count = tris.count / 3;
-        out->indices = (uint32_t *)tris.data;
-        tris.data = NULL;
-    }
+    vi_set_triangles(out, &tris);
     ok = 1;
 done:
     vi_buf_free(&elems);
@@ -764,13 +770,7 @@ static int vi_parse_off(vi_ctx *c, vi_text *t, vdag_scene *out) {
         }
         if (!vi_fan(c, &tris, poly.data, poly.count, sizeof(uint32_t))) goto done;
     }
-    if (!tris.count) {
-        vi_as_points(out);
-    } else {
-        out->triangle_count = tris.count / 3;
-        out->indices = (uint32_t *)tris.data;
-        tris.data = NULL;
-    }
+    vi_set_triangles(out, &tris);
     ok = 1;
 done:
     vi_buf_free(&poly);

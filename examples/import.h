@@ -1,6 +1,40 @@
 /* Scene importers for the vdag tool: .xyz, .ply, .obj(+.mtl), .off, .vox.
    Every parser reads untrusted bytes: it returns 0 with a message on any
-   malformed input, never crashes, and frees what it allocated. */
+   malformed input, never crashes, and frees what it allocated. Counts read
+   from a file are checked against the bytes left before anything is sized
+   by them; coordinates must be finite with a magnitude of at most 1e30.
+
+   Formats, and the rules where they leave a choice:
+   - .xyz: "x y z" or "x y z r g b" per line, non-negative integers below
+     2^32 and colours 0..255; '#' starts a comment. The first voxel line
+     decides whether the file has colours: every line must then agree.
+   - .ply: ASCII, binary little- and big-endian; any scalar types. Vertex
+     x y z, optional red green blue (integers 0..255, ushort 0..65535, or
+     floats 0..1) and s t / u v texture coordinates; face vertex_indices
+     (or vertex_index) lists, fan-triangulated. Other elements and
+     properties, lists included, are skipped. No faces: a point cloud.
+   - .off: [ST][C][N]OFF headers; the counts may follow on the header line.
+     COFF colours are 0..1 floats when written with a '.' or an exponent,
+     else 0..255 integers (decided per vertex line). Text after a face's
+     corners (a face colour) is ignored. No faces: a point cloud.
+   - .obj: v (with "v x y z r g b" colours, 0..1), vt, f in every corner
+     form with negative (relative) indices; polygons fan-triangulated, lines
+     and points ignored. One material per name given to usemtl, numbered by
+     first use, white until a library (mtllib, read from BASE_DIR) gives its
+     Kd and map_Kd; Kd values 0..1 map straight to 0..255. A map_Kd texture
+     that cannot be decoded leaves image = -1 (the Kd colour) and a warning
+     on stderr. Faces with texture coordinates give one vertex per distinct
+     (v, vt) pair; corners without vt get uv (0, 0). No faces: a point cloud.
+   - .mtl on its own: every material, in file order.
+   - .vox (MagicaVoxel 150 and 200): colour index i is RGBA entry i - 1
+     (index 0 is empty); without an RGBA chunk, MagicaVoxel's default
+     palette. With a scene graph (nTRN, nGRP, nSHP from node 0, first
+     animation frame), each model's centre sits at its transform's origin:
+     voxel v fills the cell holding R (v + 1/2 - size/2) + t, rounded down
+     where that lands on a cell corner; without one, models keep their own
+     coordinates. MagicaVoxel's z-up axes become y-up ones, (x, y, z) ->
+     (x, z, -y), and the result is shifted so each axis starts at 0. A model
+     shown by several shapes appears once per shape. */
 #ifndef VDAG_IMPORT_H
 #define VDAG_IMPORT_H
 

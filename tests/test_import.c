@@ -1042,31 +1042,23 @@ static void graph_explosion(bytes *b) {
     }
     vox_shape(b, 41, 0);
 }
-static void graph_outside(bytes *b) {
+/* A 2x2x2 model whose XYZI chunk declares COUNT voxels but holds one. */
+static void vox_raw_model(bytes *b, int64_t count, const char *xyzi) {
     bytes c = {NULL, 0, 0};
     int i;
     for (i = 0; i < 3; i++) put_le32(&c, 2);
     vox_chunk(b, "SIZE", &c, 0);
     c.n = 0;
-    put_le32(&c, 1);
-    put(&c, "\x01\x02\x01\x07", 4);
+    put_le32(&c, count);
+    put(&c, xyzi, 4);
     vox_chunk(b, "XYZI", &c, 0);
     free(c.p);
 }
+static void graph_outside(bytes *b) { vox_raw_model(b, 1, "\x01\x02\x01\x07"); }
+static void graph_xyzi_short(bytes *b) { vox_raw_model(b, 1000000000, "\x01\x01\x01\x07"); }
 static void graph_xyzi_only(bytes *b) {
     bytes c = {NULL, 0, 0};
     put_le32(&c, 0);
-    vox_chunk(b, "XYZI", &c, 0);
-    free(c.p);
-}
-static void graph_xyzi_short(bytes *b) {
-    bytes c = {NULL, 0, 0};
-    int i;
-    for (i = 0; i < 3; i++) put_le32(&c, 2);
-    vox_chunk(b, "SIZE", &c, 0);
-    c.n = 0;
-    put_le32(&c, 1000000000);
-    put(&c, "\x01\x01\x01\x07", 4);
     vox_chunk(b, "XYZI", &c, 0);
     free(c.p);
 }
