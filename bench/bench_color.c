@@ -1,0 +1,283 @@
+/* Colour codec benchmark (make bench-color): voxcolor.h against the
+   reimplemented baselines of bench/color_baselines.h on the same colour
+   arrays, in one run. Prints markdown tables shaped like Dolonius et al.
+   2017, Tables 2-4: size (% of 24-bit), global MSE, PSNR, largest error,
+   encode speed, random and coherent lookup speed.
+
+   Usage: bench_color [--max N] [--quick] NAME=IMAGE.ppm[,IMAGE.ppm...] ...
+   Each image (binary PPM, as bench/color_fetch.sh makes them) is read along
+   a 2D Morton curve, as a voxelized surface's colours would be, and the
+   images of one NAME are concatenated into one colour array. Speeds are per
+   core: single-threaded, in CPU time. */
+#define _POSIX_C_SOURCE 199309L /* clock_gettime */
+#define VOXCOLOR_IMPLEMENTATION
+#include "../voxcolor.h"
+#include "color_baselines.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double cpu_seconds(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+// -- Inputs
+
+/* Appends the pixels of a binary PPM to *RGB along a Morton curve. */
+static int load_ppm(const char *path, uint8_t **rgb, size_t *n, size_t *cap) {
+    FILE *f = fopen(path, "rb");
+    unsigned w, h, maxval;
+    uint8_t *img;
+    uint64_t i, size;
+    if (!f) return 0;
+    if (fscanf(f, "P6 %u %u %u", &w, &h, &maxval) != 3 || maxval != 255 || fgetc(f) == EOF) {
+        fclose(f);
+        return 0;
+    }
+    img = (uint8_t *)malloc(3 * (size_t)w * h);
+    if (!img || fread(img, 3, (size_t)w * h, f) != (size_t)w * h) {
+        free(img);
+        fclose(f);
+        return 0;
+    }
+    fclose(f);
+    if (*n + (size_t)w * h > *cap) {
+        *cap = 2 * (*n + (size_t)w * h);
+        *rgb = (uint8_t *)realloc(*rgb, 3 * *cap);
+    }
+    /* Every pixel once, in Morton order of its position. */
+    size = voxcolor_morton2d_encode(w - 1, h - 1) + 1;
+    for (i = 0; i < size; i++) {
+        uint32_t x, y;
+        voxcolor_morton2d_decode(i, &x, &y);
+        if (x < w && y < h) memcpy(*rgb + 3 * (*n)++, img + 3 * ((size_t)y * w + x), 3);
+    }
+    free(img);
+    return 1;
+}
+
+// -- Measurements
+
+typedef struct result {
+    const char *method;
+    char setting[48];
+    uint64_t bits;
+    double mse, psnr, max_error, encode_rate, random_rate, coherent_rate;
+} result;
+
+typedef void (*get_fn)(const void *codec, size_t i, uint8_t out[3]);
+
+static void get_ours(const void *codec, size_t i, uint8_t out[3]) {
+    voxcolor_view_get((const voxcolor_view *)codec, i, out);
+}
+
+static void get_baseline(const void *codec, size_t i, uint8_t out[3]) {
+    color_codec_get((const color_codec *)codec, i, out);
+}
+
+static size_t *random_indices(size_t n, size_t count) {
+    size_t *idx = (size_t *)malloc(count * sizeof *idx), i;
+    uint64_t s = 0x9e3779b97f4a7c15ull;
+    for (i = 0; i < count; i++) {
+        s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+        idx[i] = (size_t)(s % n);
+    }
+    return idx;
+}
+
+/* Quality over all colours and lookup speeds. */
+static void measure(result *r, const uint8_t *rgb, size_t n, const void *codec, get_fn get,
+                    const size_t *idx, size_t lookups) {
+    double se = 0, worst = 0, t;
+    size_t i, coherent = n < 4000000 ? n : 4000000;
+    unsigned sum = 0;
+    for (i = 0; i < n; i++) {
+        uint8_t d[3];
+        int e0, e1, e2, e;
+        get(codec, i, d);
+        e0 = d[0] - rgb[3 * i], e1 = d[1] - rgb[3 * i + 1], e2 = d[2] - rgb[3 * i + 2];
+        e = e0 * e0 + e1 * e1 + e2 * e2;
+        se += e;
+        if (e > worst) worst = e;
+    }
+    r->mse = se / (3.0 * (double)n);
+    r->psnr = r->mse > 0 ? 10 * log10(255.0 * 255.0 / r->mse) : INFINITY;
+    r->max_error = sqrt(worst) / 255.0;
+    t = cpu_seconds();
+    for (i = 0; i < lookups; i++) {
+        uint8_t d[3];
+        get(codec, idx[i], d);
+        sum += d[0];
+    }
+    r->random_rate = (double)lookups / (cpu_seconds() - t);
+    t = cpu_seconds();
+    for (i = 0; i < coherent; i++) {
+        uint8_t d[3];
+        get(codec, i, d);
+        sum += d[1];
+    }
+    r->coherent_rate = (double)coherent / (cpu_seconds() - t);
+    if (sum == 1) fprintf(stderr, " "); /* keeps the loops */
+}
+
+static void print_row(const result *r, size_t n) {
+    printf("| %s | %s | %.2f%% | %.2f | %s%.1f | %.4f | %.2f | %.1f | %.1f |\n", r->method,
+           r->setting, 100.0 * (double)r->bits / (24.0 * (double)n), r->mse,
+           isinf(r->psnr) ? "" : "", isinf(r->psnr) ? 999.0 : r->psnr, r->max_error,
+           r->encode_rate / 1e6, r->random_rate / 1e6, r->coherent_rate / 1e6);
+    fflush(stdout);
+}
+
+static void run_ours(result *r, const uint8_t *rgb, size_t n, const voxcolor_encode_opts *o,
+                     const size_t *idx, size_t lookups) {
+    size_t cap = voxcolor_encode_bound(n), size;
+    uint8_t *buf = (uint8_t *)malloc(cap);
+    voxcolor_view v;
+    double t = cpu_seconds();
+    size = voxcolor_encode(buf, cap, rgb, n, o);
+    r->encode_rate = (double)n / (cpu_seconds() - t);
+    r->bits = 8 * (uint64_t)size;
+    if (voxcolor_view_init(&v, buf, size) != VOXCOLOR_OK) {
+        fprintf(stderr, "bench_color: own stream rejected\n");
+        exit(1);
+    }
+    measure(r, rgb, n, &v, get_ours, idx, lookups);
+    if (o->metric == VOXCOLOR_METRIC_RGB && r->max_error > o->max_error + 1e-12) {
+        fprintf(stderr, "bench_color: error bound broken\n");
+        exit(1);
+    }
+    free(buf);
+}
+
+static void run_baseline(result *r, const uint8_t *rgb, size_t n, int kind, double e, uint32_t k,
+                         const size_t *idx, size_t lookups) {
+    double t = cpu_seconds();
+    color_codec *c = kind == 0 ? color_alg1_encode(rgb, n, e)
+                     : kind == 1 ? color_hdag_encode(rgb, n, e)
+                                 : color_dado_encode(rgb, n, k);
+    r->encode_rate = (double)n / (cpu_seconds() - t);
+    if (!c) {
+        fprintf(stderr, "bench_color: out of memory\n");
+        exit(1);
+    }
+    r->bits = color_codec_bits(c);
+    measure(r, rgb, n, c, get_baseline, idx, lookups);
+    color_codec_free(c);
+}
+
+static void machine(char *out, size_t size) {
+    FILE *f = fopen("/proc/cpuinfo", "r");
+    char line[256];
+    snprintf(out, size, "unknown CPU");
+    while (f && fgets(line, sizeof line, f))
+        if (!strncmp(line, "model name", 10) && strchr(line, ':')) {
+            snprintf(out, size, "%s", strchr(line, ':') + 2);
+            out[strcspn(out, "\n")] = 0;
+            break;
+        }
+    if (f) fclose(f);
+}
+
+int main(int argc, char **argv) {
+    static const double ours_e[] = {0, 0.01, 0.025, 0.038, 0.05, 0.1};
+    static const double base_e[] = {0.01, 0.025, 0.038, 0.05, 0.1};
+    static const uint32_t dado_k[] = {0, 4096, 2048, 256};
+    size_t max = 0, a, k;
+    int quick = 0;
+    char cpu[128];
+    machine(cpu, sizeof cpu);
+    printf("Machine: %s; compiler: %s; voxcolor %d.%d.%d (stream format %d). "
+           "Speeds in millions per second per core (CPU time).\n\n",
+           cpu, __VERSION__, VOXCOLOR_VERSION_MAJOR, VOXCOLOR_VERSION_MINOR,
+           VOXCOLOR_VERSION_PATCH, VOXCOLOR_FORMAT_VERSION);
+    for (a = 1; a < (size_t)argc; a++) {
+        char *spec = argv[a], *files, *file;
+        uint8_t *rgb = NULL;
+        size_t n = 0, cap = 0, images = 0, lookups;
+        size_t *idx;
+        result r;
+        if (!strcmp(spec, "--max") && a + 1 < (size_t)argc) {
+            max = (size_t)strtoull(argv[++a], NULL, 10);
+            continue;
+        }
+        if (!strcmp(spec, "--quick")) {
+            quick = 1;
+            continue;
+        }
+        files = strchr(spec, '=');
+        if (!files) {
+            fprintf(stderr, "bench_color: expected NAME=IMAGE.ppm[,...], got %s\n", spec);
+            return 1;
+        }
+        *files++ = 0;
+        for (file = strtok(files, ","); file; file = strtok(NULL, ","), images++)
+            if (!load_ppm(file, &rgb, &n, &cap)) {
+                fprintf(stderr, "bench_color: cannot read %s\n", file);
+                return 1;
+            }
+        if (max && n > max) n = max;
+        lookups = 2000000;
+        idx = random_indices(n, lookups);
+        printf("### %s: %zu colours from %zu image%s\n\n", spec, n, images, images == 1 ? "" : "s");
+        printf("| codec | setting | size (%% of 24-bit) | MSE | PSNR (dB) | max error | encode "
+               "| random lookup | coherent lookup |\n|---|---|---|---|---|---|---|---|---|\n");
+        for (k = 0; k < sizeof ours_e / sizeof ours_e[0]; k++) {
+            voxcolor_encode_opts o;
+            memset(&o, 0, sizeof o);
+            o.max_error = ours_e[k];
+            r.method = "voxcolor";
+            snprintf(r.setting, sizeof r.setting, "e_t %g", ours_e[k]);
+            run_ours(&r, rgb, n, &o, idx, lookups);
+            print_row(&r, n);
+        }
+        {
+            voxcolor_encode_opts o;
+            memset(&o, 0, sizeof o);
+            o.max_error = 0.05;
+            o.weight_bits = 3;
+            r.method = "voxcolor";
+            snprintf(r.setting, sizeof r.setting, "e_t 0.05, 3-bit weights only");
+            run_ours(&r, rgb, n, &o, idx, lookups);
+            print_row(&r, n);
+            o.weight_bits = 0;
+            o.page_shift = 6;
+            snprintf(r.setting, sizeof r.setting, "e_t 0.05, pages of 64");
+            run_ours(&r, rgb, n, &o, idx, lookups);
+            print_row(&r, n);
+            o.page_shift = 0;
+            o.metric = VOXCOLOR_METRIC_CIELAB;
+            o.max_error = 2;
+            snprintf(r.setting, sizeof r.setting, "CIELAB delta E 2");
+            run_ours(&r, rgb, n, &o, idx, lookups);
+            print_row(&r, n);
+        }
+        for (k = quick ? 1 : 0; k < sizeof base_e / sizeof base_e[0]; k++) {
+            r.method = "Dolonius Alg. 1 (3-bit)";
+            snprintf(r.setting, sizeof r.setting, "e_t %g", base_e[k]);
+            run_baseline(&r, rgb, n, 0, base_e[k], 0, idx, lookups);
+            print_row(&r, n);
+        }
+        for (k = 0; k < sizeof base_e / sizeof base_e[0]; k++) {
+            r.method = "HashDAG 64-bit headers";
+            snprintf(r.setting, sizeof r.setting, "e_t %g", base_e[k]);
+            run_baseline(&r, rgb, n, 1, base_e[k], 0, idx, lookups);
+            print_row(&r, n);
+        }
+        for (k = 0; k < sizeof dado_k / sizeof dado_k[0]; k++) {
+            r.method = "Dado palettes";
+            if (dado_k[k]) snprintf(r.setting, sizeof r.setting, "%u colours", (unsigned)dado_k[k]);
+            else snprintf(r.setting, sizeof r.setting, "lossless");
+            run_baseline(&r, rgb, n, 2, 0, dado_k[k], idx, lookups);
+            print_row(&r, n);
+        }
+        printf("\n");
+        free(idx);
+        free(rgb);
+    }
+    return 0;
+}
