@@ -15,7 +15,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c examples/import.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c examples/import.c
 
 # Texture decoding (examples/image.h): OpenImageIO when installed, compiled
 # with $(CXX) and linked with the C++ driver; else a stub. These are expanded

@@ -1,0 +1,791 @@
+/* The .vdag format pinned by golden files (tests/data/golden, written by
+   tests/make_golden.c): byte-identical rebuilds, header fields at FORMAT.md's
+   offsets, rejection of every truncation and single-byte change, allocation
+   failure at every step of a load, load limits, and hand-crafted hostile
+   files whose checksums are recomputed, so that the structural validation is
+   what refuses them.
+
+   Sweep sizes (all goldens together, 2248 bytes): about 2.2k truncations,
+   9k patched files, 2 x 40 failing allocations; well under a second with
+   sanitizers. */
+
+/* This unit carries its own static copy of the implementation, for the file
+   layout macros (VOXDAG_FILE_*) that only the implementation part defines. */
+#define VOXDAG_STATIC
+#define VOXDAG_IMPLEMENTATION
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-function"
+#endif
+#include "voxdag.h"
+#if defined(__GNUC__) || defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+
+#include "golden.h"
+#include "test.h"
+
+// -- Helpers
+
+static uint8_t *read_golden(int kind, size_t *size) {
+    char path[4096];
+    FILE *f;
+    long n;
+    uint8_t *buf;
+    snprintf(path, sizeof path, "%s/golden/%s.vdag", test_data_dir(), golden_names[kind]);
+    f = fopen(path, "rb");
+    if (!f) {
+        fprintf(stderr, "  cannot open %s\n", path);
+        return NULL;
+    }
+    if (fseek(f, 0, SEEK_END) || (n = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
+        fclose(f);
+        return NULL;
+    }
+    buf = (uint8_t *)malloc(n ? (size_t)n : 1);
+    if (fread(buf, 1, (size_t)n, f) != (size_t)n) {
+        fclose(f);
+        free(buf);
+        return NULL;
+    }
+    fclose(f);
+    *size = (size_t)n;
+    return buf;
+}
+
+/* A counting allocator that fails at call FAIL_AT (never when negative). */
+typedef struct count_alloc {
+    long calls, fail_at;
+    uint64_t held, peak;
+    int bad_free;
+} count_alloc;
+
+static void *ca_alloc(void *user, size_t size) {
+    count_alloc *a = (count_alloc *)user;
+    unsigned char *p;
+    if (a->fail_at >= 0 && a->calls == a->fail_at) {
+        a->calls++;
+        return NULL;
+    }
+    a->calls++;
+    p = (unsigned char *)malloc(size + 16);
+    if (!p) return NULL;
+    memcpy(p, &size, sizeof size);
+    a->held += size;
+    if (a->held > a->peak) a->peak = a->held;
+    return p + 16;
+}
+
+static void ca_free(void *user, void *ptr, size_t size) {
+    count_alloc *a = (count_alloc *)user;
+    size_t stored;
+    memcpy(&stored, (unsigned char *)ptr - 16, sizeof stored);
+    if (stored != size || a->held < size) a->bad_free = 1;
+    a->held -= size;
+    free((unsigned char *)ptr - 16);
+}
+
+static void opts_with(voxdag_load_opts *o, count_alloc *ca, long fail_at) {
+    memset(ca, 0, sizeof *ca);
+    ca->fail_at = fail_at;
+    memset(o, 0, sizeof *o);
+    o->allocator.alloc = ca_alloc;
+    o->allocator.free = ca_free;
+    o->allocator.user = ca;
+}
+
+/* Loads an exact-size heap copy of DATA; returns the status, frees the DAG,
+   and checks that nothing stays allocated. */
+static voxdag_status load_copy(const uint8_t *data, size_t size, int copy, voxdag_error *err) {
+    voxdag_load_opts o;
+    count_alloc ca;
+    voxdag *d = NULL;
+    voxdag_status st;
+    uint8_t *buf = size ? (uint8_t *)malloc(size) : NULL;
+    if (size) memcpy(buf, data, size);
+    opts_with(&o, &ca, -1);
+    o.copy = copy;
+    st = voxdag_load_memory(buf, size, &o, &d, err);
+    CHECK(st == err->status);
+    CHECK((st == VOXDAG_OK) == (d != NULL));
+    CHECK(err->message != NULL);
+    if (st != VOXDAG_OK) CHECK(err->byte_offset == UINT64_MAX || err->byte_offset <= size);
+    voxdag_free(d);
+    CHECK(ca.held == 0 && !ca.bad_free);
+    free(buf);
+    return st;
+}
+
+/* Every voxel with its index, in order (at most CAP), as Morton codes. */
+typedef struct voxel_list {
+    uint64_t n, cap, *morton;
+} voxel_list;
+
+static int collect(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    voxel_list *v = (voxel_list *)user;
+    if (index != v->n || v->n >= v->cap) return 1;
+    v->morton[v->n++] = voxdag_morton_encode(x, y, z);
+    return 0;
+}
+
+static int same_voxels(const voxdag *a, const voxdag *b) {
+    uint64_t ma[4096], mb[4096];
+    voxel_list va = {0, 4096, ma}, vb = {0, 4096, mb};
+    voxdag_for_each_voxel(a, collect, &va);
+    voxdag_for_each_voxel(b, collect, &vb);
+    return va.n == vb.n && !memcmp(ma, mb, va.n * sizeof *ma);
+}
+
+// -- (a) Rebuilding the scenes gives the committed bytes
+
+static void test_golden_identical(void) {
+    int kind;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        voxdag *d = NULL;
+        size_t size = 0, built_size = 0;
+        uint8_t *file = read_golden(kind, &size);
+        const void *built;
+        CHECK_MSG(file != NULL, "%s", golden_names[kind]);
+        CHECK(golden_build(kind, NULL, &d) == VOXDAG_OK);
+        if (file && d) {
+            built = voxdag_image(d, &built_size);
+            CHECK_MSG(built_size == size && !memcmp(built, file, size),
+                      "%s: the format changed (rebuild with make_golden if intended, and bump the version)",
+                      golden_names[kind]);
+        }
+        voxdag_free(d);
+        free(file);
+    }
+}
+
+// -- (b) Header fields at the documented offsets agree with voxdag_get_info
+
+static void test_offsets_documented(void) {
+    /* FORMAT.md's header table */
+    CHECK(VOXDAG_FILE_OFF_MAGIC == 0 && VOXDAG_FILE_OFF_VERSION == 8 && VOXDAG_FILE_OFF_ENDIAN == 12);
+    CHECK(VOXDAG_FILE_OFF_HEADER_SIZE == 16 && VOXDAG_FILE_OFF_FLAGS == 20 && VOXDAG_FILE_OFF_FILE_SIZE == 24);
+    CHECK(VOXDAG_FILE_OFF_VOXELS == 32 && VOXDAG_FILE_OFF_LEVELS == 40 && VOXDAG_FILE_OFF_ROOT_MIRROR == 41);
+    CHECK(VOXDAG_FILE_OFF_SECTION_COUNT == 44 && VOXDAG_FILE_OFF_TABLE_CRC == 48);
+    CHECK(VOXDAG_FILE_OFF_HEADER_CRC == 52 && VOXDAG_FILE_HEADER_SIZE == 64);
+    CHECK(VOXDAG_FILE_SECTION_ENTRY_SIZE == 32 && VOXDAG_FILE_LEVEL_ENTRY_SIZE == 24);
+    CHECK(VOXDAG_FILE_NODE_PADDING == 8 && VOXDAG_FILE_MAX_SECTIONS == 16);
+    CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 1);
+    /* the helpers of golden.h use the same numbers */
+    CHECK(GOLDEN_OFF_SECTION_COUNT == VOXDAG_FILE_OFF_SECTION_COUNT && GOLDEN_OFF_TABLE_CRC == VOXDAG_FILE_OFF_TABLE_CRC);
+    CHECK(GOLDEN_OFF_HEADER_CRC == VOXDAG_FILE_OFF_HEADER_CRC && GOLDEN_HEADER_SIZE == VOXDAG_FILE_HEADER_SIZE);
+    CHECK(GOLDEN_SECTION_ENTRY_SIZE == VOXDAG_FILE_SECTION_ENTRY_SIZE);
+    CHECK(GOLDEN_LEVEL_ENTRY_SIZE == VOXDAG_FILE_LEVEL_ENTRY_SIZE);
+    CHECK(golden_crc32c((const uint8_t *)"123456789", 9) == 0xE3069283u); /* the CRC-32C check value */
+}
+
+static void test_header_fields(void) {
+    static const uint8_t magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
+    static const uint64_t voxels[GOLDEN_COUNT] = {0, 0, 1, 24, 184, 0}; /* 0: not pinned here */
+    int kind;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        size_t size = 0;
+        uint8_t *f = read_golden(kind, &size), h[VOXDAG_FILE_HEADER_SIZE];
+        voxdag *d = NULL;
+        voxdag_info info;
+        uint32_t count, i, seen = 0;
+        if (!f) {
+            CHECK_MSG(0, "%s missing", golden_names[kind]);
+            continue;
+        }
+        CHECK(size >= VOXDAG_FILE_HEADER_SIZE && size % 8 == 0);
+        CHECK(voxdag_load_memory(f, size, NULL, &d, NULL) == VOXDAG_OK);
+        if (!d || size < VOXDAG_FILE_HEADER_SIZE) {
+            free(f);
+            continue;
+        }
+        voxdag_get_info(d, &info);
+        CHECK(!memcmp(f + VOXDAG_FILE_OFF_MAGIC, magic, 8));
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_VERSION, 4) == VOXDAG_FORMAT_VERSION);
+        CHECK(!memcmp(f + VOXDAG_FILE_OFF_ENDIAN, "\x0D\x0C\x0B\x0A", 4));
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_SIZE, 4) == 64);
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_FLAGS, 4) == info.symmetric);
+        CHECK(info.symmetric == (kind != GOLDEN_SVDAG));
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_FILE_SIZE, 8) == size && info.file_bytes == size);
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_VOXELS, 8) == info.voxels);
+        CHECK(!voxels[kind] || info.voxels == voxels[kind]);
+        CHECK((info.voxels == 0) == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_EMPTY_L5));
+        CHECK(f[VOXDAG_FILE_OFF_LEVELS] == info.levels);
+        CHECK(info.levels == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_BRICK_ROOT_L2 ? 2u : 5u));
+        CHECK(f[VOXDAG_FILE_OFF_ROOT_MIRROR] < 8 && !f[42] && !f[43]);
+        CHECK(golden_le(f + 56, 8) == 0);
+        memcpy(h, f, sizeof h);
+        golden_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_CRC, 4) == golden_crc32c(h, sizeof h));
+        count = (uint32_t)golden_le(f + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
+        CHECK(count == 3u + (kind == GOLDEN_MIRRORED_BLOB ? 2u : 0u));
+        CHECK(64 + (size_t)count * 32 <= size);
+        if (64 + (size_t)count * 32 > size) count = 0;
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_TABLE_CRC, 4) == golden_crc32c(f + 64, (size_t)count * 32));
+        for (i = 0; i < count; i++) {
+            const uint8_t *e = f + 64 + 32 * i;
+            uint32_t type = (uint32_t)golden_le(e, 4);
+            uint64_t off = golden_le(e + 8, 8), sz = golden_le(e + 16, 8);
+            CHECK(golden_le(e + 4, 4) == 0 && golden_le(e + 28, 4) == 0 && off % 8 == 0);
+            CHECK(off <= size && sz <= size - off);
+            if (off > size || sz > size - off) continue;
+            CHECK(golden_le(e + 24, 4) == golden_crc32c(f + off, (size_t)sz));
+            CHECK(type >= 1 && type <= 6 && !(seen >> type & 1));
+            seen |= 1u << (type & 31);
+            switch (type) {
+            case VOXDAG_SECTION_LEVELS: {
+                uint32_t l;
+                uint64_t at = 0;
+                CHECK(sz == 24 * (uint64_t)(info.levels - 2));
+                for (l = 0; l + 2 < info.levels && 24 * (l + 1) <= sz; l++) {
+                    const uint8_t *le = f + off + 24 * l;
+                    CHECK(golden_le(le, 8) == at);
+                    CHECK(golden_le(le + 8, 8) == info.level_bytes[l]);
+                    CHECK(golden_le(le + 16, 4) == info.nodes[l]);
+                    CHECK(le[20] == (l + 3 < info.levels ? (info.voxels ? le[20] : 1) : 0));
+                    CHECK(le[21] >= 4 && le[21] <= 8 && !le[22] && !le[23]);
+                    at += info.level_bytes[l];
+                }
+                CHECK(at == info.node_bytes);
+                break;
+            }
+            case VOXDAG_SECTION_NODES: CHECK(sz == info.node_bytes + 8); break;
+            case VOXDAG_SECTION_BRICKS:
+                CHECK(sz == info.brick_bytes && sz == 8 * info.nodes[info.levels - 2]);
+                break;
+            case VOXDAG_SECTION_COLORS_RGB8:
+                CHECK(info.color_kind == VOXDAG_COLORS_RGB8 && sz == info.color_bytes && sz == 3 * info.voxels);
+                break;
+            case VOXDAG_SECTION_BOUNDS: {
+                unsigned k;
+                CHECK(sz == 48 && info.has_bounds);
+                for (k = 0; k < 6 && sz == 48; k++) {
+                    uint64_t bits = golden_le(f + off + 8 * k, 8);
+                    double v;
+                    memcpy(&v, &bits, 8);
+                    CHECK(v == info.bounds[k]);
+                }
+                break;
+            }
+            default: break;
+            }
+        }
+        CHECK((seen & 0xE) == 0xE); /* levels, nodes, bricks */
+        CHECK(!!(seen & 0x10) == (info.color_kind == VOXDAG_COLORS_RGB8));
+        CHECK(!!(seen & 0x40) == info.has_bounds);
+        if (kind == GOLDEN_ONE_VOXEL) {
+            uint64_t index = 7;
+            CHECK(voxdag_lookup(d, 9, 20, 3, &index) == 1 && index == 0);
+            CHECK(voxdag_lookup(d, 9, 20, 4, NULL) == 0);
+        }
+        if (kind == GOLDEN_MIRRORED_BLOB) CHECK(info.bounds[0] == -1.5 && info.bounds[5] == 8.25);
+        voxdag_free(d);
+        free(f);
+    }
+}
+
+// -- (c) Every truncation and every single-byte patch is rejected
+
+static void test_mutations(void) {
+    static const int patch[4] = {1, -1, 0x100, 0x1FF}; /* +1, -1, set 0, set 0xff */
+    int kind;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        size_t size = 0, i;
+        uint8_t *f = read_golden(kind, &size), *m;
+        voxdag_error err;
+        long accepted = 0, cut_accepted = 0;
+        if (!f) {
+            CHECK_MSG(0, "%s missing", golden_names[kind]);
+            continue;
+        }
+        CHECK(load_copy(f, size, 0, &err) == VOXDAG_OK);
+        for (i = 0; i < size; i++) /* exact-size copies: ASan sees any over-read */
+            if (load_copy(f, i, (int)(i & 1), &err) == VOXDAG_OK) cut_accepted++;
+        m = (uint8_t *)malloc(size);
+        for (i = 0; i < size; i++) {
+            int k;
+            for (k = 0; k < 4; k++) {
+                uint8_t v = patch[k] == 0x100 ? 0 : patch[k] == 0x1FF ? 0xFF : (uint8_t)(f[i] + patch[k]);
+                if (v == f[i]) continue; /* unchanged bytes load, of course */
+                memcpy(m, f, size);
+                m[i] = v;
+                if (load_copy(m, size, k & 1, &err) == VOXDAG_OK) accepted++;
+            }
+        }
+        CHECK_MSG(cut_accepted == 0, "%s: %ld truncations accepted", golden_names[kind], cut_accepted);
+        CHECK_MSG(accepted == 0, "%s: %ld patched files accepted", golden_names[kind], accepted);
+        free(m);
+        free(f);
+    }
+}
+
+// -- (d) Allocation N fails, for every N of a load
+
+static void test_allocation_failures(void) {
+    int kind, copy;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        size_t size = 0;
+        uint8_t *f = read_golden(kind, &size);
+        if (!f) continue;
+        for (copy = 0; copy < 2; copy++) {
+            long n;
+            int done = 0;
+            for (n = 0; !done && n < 1000; n++) {
+                voxdag_load_opts o;
+                count_alloc ca;
+                voxdag *d = NULL;
+                voxdag_status st;
+                opts_with(&o, &ca, n);
+                o.copy = copy;
+                st = voxdag_load_memory(f, size, &o, &d, NULL);
+                CHECK_MSG(st == VOXDAG_OK || st == VOXDAG_ERR_OUT_OF_MEMORY, "%s: status %d at allocation %ld",
+                          golden_names[kind], (int)st, n);
+                if (st == VOXDAG_OK) {
+                    CHECK(ca.calls <= n); /* succeeded only without reaching the failure */
+                    done = 1;
+                } else {
+                    CHECK(d == NULL && ca.calls > n);
+                }
+                voxdag_free(d);
+                CHECK_MSG(ca.held == 0 && !ca.bad_free, "%s: %llu bytes held after failing allocation %ld",
+                          golden_names[kind], (unsigned long long)ca.held, n);
+            }
+            CHECK(done);
+        }
+        free(f);
+    }
+}
+
+// -- (e) Load limits refuse what exceeds them
+
+static void test_limits(void) {
+    int kind;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        size_t size = 0;
+        uint8_t *f = read_golden(kind, &size);
+        voxdag_load_opts o;
+        count_alloc ca;
+        voxdag *d = NULL;
+        voxdag_info info;
+        uint64_t nodes = 0, peak;
+        uint32_t l;
+        voxdag_status st;
+        if (!f) continue;
+        opts_with(&o, &ca, -1);
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        if (!d) {
+            free(f);
+            continue;
+        }
+        voxdag_get_info(d, &info);
+        voxdag_free(d);
+        d = NULL;
+        peak = ca.peak;
+        for (l = 0; l + 1 < info.levels; l++) nodes += info.nodes[l];
+        /* max_levels */
+        opts_with(&o, &ca, -1);
+        o.max_levels = info.levels;
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        voxdag_free(d);
+        if (info.levels > 2) {
+            o.max_levels = info.levels - 1;
+            CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_ERR_LIMIT && !d);
+        }
+        /* max_nodes: all nodes and bricks together */
+        opts_with(&o, &ca, -1);
+        o.max_nodes = nodes ? nodes : 1;
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        voxdag_free(d);
+        if (nodes > 1) {
+            o.max_nodes = nodes - 1;
+            CHECK_MSG(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_ERR_LIMIT && !d, "%s max_nodes",
+                      golden_names[kind]);
+        }
+        /* max_input_bytes */
+        opts_with(&o, &ca, -1);
+        o.max_input_bytes = size;
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        voxdag_free(d);
+        o.max_input_bytes = size - 1;
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_ERR_LIMIT && !d);
+        /* max_memory: the measured peak passes, one byte less fails, with and without a copy */
+        opts_with(&o, &ca, -1);
+        o.max_memory = peak;
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        voxdag_free(d);
+        o.max_memory = peak - 1;
+        st = voxdag_load_memory(f, size, &o, &d, NULL);
+        CHECK_MSG((st == VOXDAG_ERR_LIMIT || st == VOXDAG_ERR_OUT_OF_MEMORY) && !d, "%s max_memory: %d",
+                  golden_names[kind], (int)st);
+        o.copy = 1;
+        o.max_memory = peak + size - 1;
+        st = voxdag_load_memory(f, size, &o, &d, NULL);
+        CHECK((st == VOXDAG_ERR_LIMIT || st == VOXDAG_ERR_OUT_OF_MEMORY) && !d);
+        CHECK(ca.held == 0 && !ca.bad_free);
+        free(f);
+    }
+}
+
+// -- (f) Hand-crafted hostile files
+
+/* A file taken apart into its sections, to be changed and written again with
+   the layout FORMAT.md gives (8-byte aligned, zero gaps, fresh checksums). */
+typedef struct parts {
+    uint8_t header[64];
+    uint32_t count;
+    uint32_t type[16], flags[16];
+    uint8_t *data[16];
+    size_t size[16];
+} parts;
+
+static int parts_read(parts *p, const uint8_t *f, size_t size) {
+    uint32_t i;
+    memset(p, 0, sizeof *p);
+    if (size < 64) return 0;
+    memcpy(p->header, f, 64);
+    p->count = (uint32_t)golden_le(f + 44, 4);
+    if (p->count > 16 || 64 + 32 * (size_t)p->count > size) return 0;
+    for (i = 0; i < p->count; i++) {
+        const uint8_t *e = f + 64 + 32 * i;
+        uint64_t off = golden_le(e + 8, 8), sz = golden_le(e + 16, 8);
+        if (off > size || sz > size - off) return 0;
+        p->type[i] = (uint32_t)golden_le(e, 4);
+        p->flags[i] = (uint32_t)golden_le(e + 4, 4);
+        p->size[i] = (size_t)sz;
+        p->data[i] = (uint8_t *)malloc(sz + 64); /* room to grow a section a little */
+        memcpy(p->data[i], f + off, (size_t)sz);
+    }
+    return 1;
+}
+
+static void parts_free(parts *p) {
+    uint32_t i;
+    for (i = 0; i < p->count; i++) free(p->data[i]);
+}
+
+static int parts_find(const parts *p, uint32_t type) {
+    uint32_t i;
+    for (i = 0; i < p->count; i++)
+        if (p->type[i] == type) return (int)i;
+    return -1;
+}
+
+/* Writes P as a file (resealed) of *SIZE bytes; the caller frees it. */
+static uint8_t *parts_write(const parts *p, size_t *size) {
+    size_t at = 64 + 32 * (size_t)p->count, total;
+    size_t off[16];
+    uint32_t i;
+    uint8_t *f;
+    for (i = 0; i < p->count; i++) {
+        at = (at + 7) & ~(size_t)7;
+        off[i] = at;
+        at += p->size[i];
+    }
+    total = at;
+    f = (uint8_t *)calloc(total, 1);
+    memcpy(f, p->header, 64);
+    golden_put_le(f + 24, total, 8);
+    golden_put_le(f + 44, p->count, 4);
+    for (i = 0; i < p->count; i++) {
+        uint8_t *e = f + 64 + 32 * i;
+        golden_put_le(e, p->type[i], 4);
+        golden_put_le(e + 4, p->flags[i], 4);
+        golden_put_le(e + 8, off[i], 8);
+        golden_put_le(e + 16, p->size[i], 8);
+        golden_put_le(e + 28, 0, 4);
+        memcpy(f + off[i], p->data[i], p->size[i]);
+    }
+    golden_reseal(f, total);
+    *size = total;
+    return f;
+}
+
+/* The records of inner level L of a parsed file: start offsets inside NODES
+   and the offset of the level. Returns the number found (at most CAP). */
+typedef struct level_view {
+    uint64_t offset, size;
+    unsigned count_bytes, long_bytes;
+} level_view;
+
+static level_view level_of(const parts *p, uint32_t l) {
+    level_view v;
+    const uint8_t *e = p->data[parts_find(p, 1)] + 24 * l;
+    v.offset = golden_le(e, 8);
+    v.size = golden_le(e + 8, 8);
+    v.count_bytes = e[20];
+    v.long_bytes = e[21];
+    return v;
+}
+
+static unsigned record_size(const uint8_t *rec, const level_view *v) {
+    unsigned header = (unsigned)golden_le(rec, 2), s, n = 2 + v->count_bytes;
+    for (s = 0; s < 8; s++) {
+        unsigned tag = header >> (2 * s) & 3;
+        n += tag == 0 ? 0 : tag == 1 ? 2 : tag == 2 ? 3 : v->long_bytes;
+    }
+    return n;
+}
+
+static size_t record_starts(const parts *p, uint32_t l, uint64_t *starts, size_t cap) {
+    level_view v = level_of(p, l);
+    const uint8_t *nodes = p->data[parts_find(p, 2)] + v.offset;
+    uint64_t at = 0;
+    size_t n = 0;
+    while (at < v.size && n < cap) {
+        starts[n++] = at;
+        at += record_size(nodes + at, &v);
+    }
+    return n;
+}
+
+/* Offset (inside NODES) and byte size of the first pointer of the record at
+   START of level L. */
+static uint64_t first_pointer(const parts *p, uint32_t l, uint64_t start, unsigned *bytes) {
+    level_view v = level_of(p, l);
+    const uint8_t *rec = p->data[parts_find(p, 2)] + v.offset + start;
+    unsigned header = (unsigned)golden_le(rec, 2), s = 0, tag;
+    while (!(header >> (2 * s) & 3)) s++;
+    tag = header >> (2 * s) & 3;
+    *bytes = tag == 1 ? 2 : tag == 2 ? 3 : v.long_bytes;
+    return v.offset + start + 2 + v.count_bytes;
+}
+
+static void expect(const parts *p, voxdag_status want, const char *what, const voxdag *original) {
+    size_t size;
+    uint8_t *f = parts_write(p, &size);
+    voxdag_error err;
+    voxdag_status st = load_copy(f, size, 0, &err);
+    CHECK_MSG(st == want, "%s: status %d (%s), expected %d", what, (int)st, err.message, (int)want);
+    if (getenv("FORMAT_VERBOSE")) fprintf(stderr, "  %s: %s\n", what, err.message);
+    if (st == VOXDAG_OK && want == VOXDAG_OK && original) {
+        voxdag *d = NULL;
+        CHECK(voxdag_load_memory(f, size, NULL, &d, NULL) == VOXDAG_OK);
+        if (d) CHECK_MSG(same_voxels(d, original), "%s: different voxels", what);
+        voxdag_free(d);
+    }
+    free(f);
+}
+
+static void test_hostile_files(void) {
+    size_t size = 0, n1, n2, i;
+    uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size), *w;
+    parts p;
+    voxdag *orig = NULL;
+    uint64_t starts1[512], starts2[512], ptr_at;
+    unsigned bytes;
+    int nodes, bricks;
+    if (!f || !parts_read(&p, f, size)) {
+        CHECK_MSG(0, "mirrored blob golden missing or unreadable");
+        free(f);
+        return;
+    }
+    CHECK(voxdag_load_memory(f, size, NULL, &orig, NULL) == VOXDAG_OK);
+    nodes = parts_find(&p, 2);
+    bricks = parts_find(&p, 3);
+    CHECK(nodes >= 0 && bricks >= 0 && f[40] == 5);
+    if (!orig || nodes < 0 || bricks < 0) goto done;
+    /* Writing the parts back gives the golden: this writer follows FORMAT.md. */
+    w = parts_write(&p, &i);
+    CHECK(i == size && !memcmp(w, f, size));
+    free(w);
+    n1 = record_starts(&p, 1, starts1, 512);
+    n2 = record_starts(&p, 2, starts2, 512);
+    CHECK(n1 >= 1 && n2 >= 2);
+
+    { /* a pointer to a byte inside a record of the next level */
+        parts q;
+        parts_read(&q, f, size);
+        ptr_at = first_pointer(&q, 0, 0, &bytes);
+        {
+            uint64_t v = golden_le(q.data[nodes] + ptr_at, bytes), t = v >> 3;
+            CHECK(t == starts1[0] || t < level_of(&q, 1).size);
+            golden_put_le(q.data[nodes] + ptr_at, (t + 1) << 3 | (v & 7), bytes);
+        }
+        expect(&q, VOXDAG_ERR_CORRUPT, "pointer to a non-start byte", NULL);
+        parts_free(&q);
+    }
+    { /* a pointer past the end of the next level; and a brick index past the bricks */
+        parts q;
+        parts_read(&q, f, size);
+        ptr_at = first_pointer(&q, 1, starts1[n1 - 1], &bytes);
+        golden_put_le(q.data[nodes] + ptr_at, level_of(&q, 2).size << 3, bytes);
+        expect(&q, VOXDAG_ERR_CORRUPT, "pointer past the level", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        ptr_at = first_pointer(&q, 2, starts2[0], &bytes);
+        golden_put_le(q.data[nodes] + ptr_at, (uint64_t)(q.size[bricks] / 8) << 3, bytes);
+        expect(&q, VOXDAG_ERR_CORRUPT, "brick index past the bricks", NULL);
+        parts_free(&q);
+    }
+    { /* a count that differs from the sum of the children's (the level-1 node's) */
+        parts q;
+        level_view v;
+        parts_read(&q, f, size);
+        v = level_of(&q, 1);
+        CHECK(v.count_bytes >= 1);
+        q.data[nodes][v.offset + starts1[0] + 2] ^= 1;
+        expect(&q, VOXDAG_ERR_CORRUPT, "count differs from the children's sum", NULL);
+        parts_free(&q);
+        /* the root's count and the header's voxel count both one higher */
+        parts_read(&q, f, size);
+        v = level_of(&q, 0);
+        golden_put_le(q.data[nodes] + 2, golden_le(q.data[nodes] + 2, v.count_bytes) + 1, v.count_bytes);
+        golden_put_le(q.header + 32, golden_le(q.header + 32, 8) + 1, 8);
+        q.size[parts_find(&q, 4)] += 3; /* one more colour (zero), so that only the counts disagree */
+        memset(q.data[parts_find(&q, 4)] + q.size[parts_find(&q, 4)] - 3, 0, 3);
+        expect(&q, VOXDAG_ERR_CORRUPT, "root count above its children's", NULL);
+        parts_free(&q);
+        /* only the header's voxel count */
+        parts_read(&q, f, size);
+        golden_put_le(q.header + 32, golden_le(q.header + 32, 8) - 1, 8);
+        q.size[parts_find(&q, 4)] -= 3;
+        expect(&q, VOXDAG_ERR_CORRUPT, "header voxel count", NULL);
+        parts_free(&q);
+    }
+    { /* cycle-like: a node whose pointer holds its own offset (a pointer only
+         reaches the next level, so this lands elsewhere, never on itself) */
+        int tried = 0;
+        for (i = 0; i < n1 + n2; i++) {
+            parts q;
+            size_t k;
+            uint32_t l = i < n1 ? 1 : 2;
+            uint64_t own = i < n1 ? starts1[i] : starts2[i - n1];
+            int lands = 0;
+            if (l == 1)
+                for (k = 0; k < n2; k++) lands |= starts2[k] == own;
+            else
+                lands = own < p.size[bricks] / 8;
+            if (lands) continue; /* would be a real node of the next level */
+            parts_read(&q, f, size);
+            ptr_at = first_pointer(&q, l, own, &bytes);
+            golden_put_le(q.data[nodes] + ptr_at, own << 3, bytes);
+            expect(&q, VOXDAG_ERR_CORRUPT, "self pointer", NULL);
+            parts_free(&q);
+            tried++;
+        }
+        CHECK(tried > 0);
+        /* the root pointing at its own offset 0: the first node of level 1 */
+        {
+            parts q;
+            parts_read(&q, f, size);
+            ptr_at = first_pointer(&q, 0, 0, &bytes);
+            golden_put_le(q.data[nodes] + ptr_at, golden_le(q.data[nodes] + ptr_at, bytes) & 7, bytes);
+            w = parts_write(&q, &i);
+            {
+                voxdag_error err;
+                voxdag_status st = load_copy(w, i, 0, &err);
+                /* the same target as before can only be accepted unchanged */
+                CHECK(st != VOXDAG_OK || (i == size && !memcmp(w, f, size)));
+            }
+            free(w);
+            parts_free(&q);
+        }
+    }
+    { /* a node without children */
+        parts q;
+        parts_read(&q, f, size);
+        golden_put_le(q.data[nodes] + level_of(&q, 2).offset + starts2[1], 0, 2);
+        expect(&q, VOXDAG_ERR_CORRUPT, "node without children", NULL);
+        parts_free(&q);
+    }
+    { /* an unreferenced node: a copy of brick 0 appended to the bricks */
+        parts q;
+        parts_read(&q, f, size);
+        memcpy(q.data[bricks] + q.size[bricks], q.data[bricks], 8);
+        q.size[bricks] += 8;
+        expect(&q, VOXDAG_ERR_CORRUPT, "unreferenced brick", NULL);
+        parts_free(&q);
+        /* an empty brick */
+        parts_read(&q, f, size);
+        memset(q.data[bricks] + q.size[bricks], 0, 8);
+        q.size[bricks] += 8;
+        expect(&q, VOXDAG_ERR_CORRUPT, "empty brick", NULL);
+        parts_free(&q);
+    }
+    { /* trailing bytes, inside and outside the declared size */
+        parts q;
+        uint8_t *g;
+        size_t gs;
+        parts_read(&q, f, size);
+        w = parts_write(&q, &i);
+        g = (uint8_t *)calloc(i + 8, 1);
+        memcpy(g, w, i);
+        gs = i + 8;
+        {
+            voxdag_error err;
+            CHECK(load_copy(g, gs, 0, &err) == VOXDAG_ERR_CORRUPT); /* past the declared size */
+            golden_put_le(g + 24, gs, 8);
+            golden_reseal(g, gs);
+            CHECK(load_copy(g, gs, 0, &err) == VOXDAG_ERR_CORRUPT); /* after the last section */
+        }
+        free(g);
+        free(w);
+        parts_free(&q);
+    }
+    { /* unknown sections: required refused, optional skipped */
+        parts q;
+        parts_read(&q, f, size);
+        q.type[q.count] = 0x7F;
+        q.flags[q.count] = 0;
+        q.size[q.count] = 5;
+        q.data[q.count] = (uint8_t *)calloc(8, 1);
+        q.count++;
+        expect(&q, VOXDAG_ERR_VERSION, "unknown required section", NULL);
+        q.flags[q.count - 1] = 1;
+        expect(&q, VOXDAG_OK, "unknown optional section", orig);
+        /* also first in the file */
+        {
+            uint32_t t = q.type[0], fl = q.flags[0];
+            uint8_t *dp = q.data[0];
+            size_t sz = q.size[0];
+            q.type[0] = q.type[q.count - 1], q.flags[0] = 1, q.data[0] = q.data[q.count - 1], q.size[0] = 5;
+            q.type[q.count - 1] = t, q.flags[q.count - 1] = fl, q.data[q.count - 1] = dp, q.size[q.count - 1] = sz;
+            expect(&q, VOXDAG_OK, "unknown optional section first", orig);
+        }
+        /* a known section twice */
+        q.type[0] = 2;
+        q.flags[0] = 0;
+        expect(&q, VOXDAG_ERR_CORRUPT, "duplicate section", NULL);
+        parts_free(&q);
+    }
+    { /* overlapping sections: the bricks entry starts inside the nodes */
+        parts q;
+        uint8_t *e;
+        parts_read(&q, f, size);
+        w = parts_write(&q, &i);
+        e = w + 64 + 32 * (size_t)bricks;
+        golden_put_le(e + 8, golden_le(e + 8, 8) - 8, 8);
+        golden_put_le(e + 16, golden_le(e + 16, 8) + 8, 8);
+        golden_reseal(w, i);
+        {
+            voxdag_error err;
+            CHECK(load_copy(w, i, 0, &err) == VOXDAG_ERR_CORRUPT);
+        }
+        /* and the nodes section reaching into the bricks */
+        free(w);
+        w = parts_write(&q, &i);
+        e = w + 64 + 32 * (size_t)nodes;
+        golden_put_le(e + 16, golden_le(e + 16, 8) + 16, 8);
+        golden_reseal(w, i);
+        {
+            voxdag_error err;
+            CHECK(load_copy(w, i, 0, &err) == VOXDAG_ERR_CORRUPT);
+        }
+        free(w);
+        parts_free(&q);
+    }
+done:
+    voxdag_free(orig);
+    parts_free(&p);
+    free(f);
+}
+
+const test_case test_format_cases[] = {
+    {"format/golden_identical", test_golden_identical},
+    {"format/offsets_documented", test_offsets_documented},
+    {"format/header_fields", test_header_fields},
+    {"format/mutations", test_mutations},
+    {"format/allocation_failures", test_allocation_failures},
+    {"format/limits", test_limits},
+    {"format/hostile_files", test_hostile_files},
+    {NULL, NULL},
+};
