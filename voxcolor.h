@@ -170,6 +170,13 @@ VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
 VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t first,
                                           size_t n, uint8_t *rgb_out);
 
+/* Writes the colours at INDICES[0..n) (each < view->count) to RGB_OUT
+   (3 * N bytes). Same result as N calls of voxcolor_view_get; faster for
+   scattered indices, as the memory accesses of successive lookups overlap.
+   Thread-safe. */
+VOXCOLOR_API void voxcolor_view_get_many(const voxcolor_view *view, const uint64_t *indices,
+                                         size_t n, uint8_t *rgb_out);
+
 // -- 2D mapping (Dolonius §4.1)
 
 /* Pixel of array element INDEX along a 2D Morton curve: the bits of INDEX
@@ -497,6 +504,28 @@ VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
     voxcolori_block_color(view->data, &b, i, rgb_out);
 }
 
+#if defined(__GNUC__) || defined(__clang__)
+#define VOXCOLORI_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define VOXCOLORI_PREFETCH(p) ((void)(p))
+#endif
+
+VOXCOLOR_API void voxcolor_view_get_many(const voxcolor_view *view, const uint64_t *indices,
+                                         size_t n, uint8_t *rgb_out) {
+    /* Software pipeline: the page table entry 16 lookups ahead, the page 8
+       lookups ahead (its entry is in cache by then). */
+    size_t i, entry = view->wide ? 8u : 4u;
+    VOXCOLOR_ASSERT(view && (indices || !n) && (rgb_out || !n));
+    for (i = 0; i < n; i++) {
+        if (i + 16 < n) VOXCOLORI_PREFETCH(view->table + (size_t)(indices[i + 16] >> view->page_shift) * entry);
+        if (i + 8 < n) {
+            VOXCOLOR_ASSERT(indices[i + 8] < view->count);
+            VOXCOLORI_PREFETCH(view->data + voxcolori_page_offset(view, indices[i + 8] >> view->page_shift));
+        }
+        voxcolor_view_get(view, indices[i], rgb_out + 3 * i);
+    }
+}
+
 VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t first,
                                           size_t n, uint8_t *rgb_out) {
     uint64_t page, i;
@@ -754,15 +783,16 @@ static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_
 }
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
-   precision encodes within the bound (0 if not even the first colour), with
-   its endpoints in F. Colours that fit the current endpoints are accepted as
-   they are; one that does not triggers a refit including it, and repeated
-   refits a refit over twice the length (so gradients cost O(n log n)). */
-static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+   precision encodes within the bound, with its endpoints in F; 0 when not
+   even the first MIN colours fit (shorter blocks would not pay for their
+   entry). Colours that fit the current endpoints are accepted as they are;
+   one that does not triggers a refit including it, and repeated refits a
+   refit over twice the length (so gradients cost O(n log n)). */
+static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n, size_t min,
                                voxcolori_fit *f) {
     voxcolori_fit t = *f;
-    size_t len = 1, streak = 0;
-    if (!voxcolori_fit_block(e, rgb, 1, f)) return 0;
+    size_t len = min < n ? min : n, streak = 0;
+    if (!voxcolori_fit_block(e, rgb, len, f)) return 0;
     while (len < n) {
         size_t guess = 2 * len + 1 < n ? 2 * len + 1 : n;
         if (voxcolori_fits(e, f, rgb + 3 * len)) {
@@ -837,9 +867,12 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
             /* A wider mode costs more than f.mode bits per colour. */
             if (best_len && best_bits <= f.mode * best_len) break;
             for (p = 0; p < e->precision_count; p++) {
-                size_t bits;
+                size_t bits, fixed;
                 f.precision = e->precisions[p];
-                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, &f);
+                /* Blocks shorter than this cost more than raw colours. */
+                fixed = 2 * entry + voxcolori_endpoint_bits(f.mode, f.precision);
+                len = voxcolori_extend(e, rgb + 3 * pos, n - pos,
+                                       (fixed + 23 - f.mode) / (24 - f.mode), &f);
                 if (!len) continue;
                 bits = entry + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
                 if (!best_len || bits * best_len < best_bits * len ||

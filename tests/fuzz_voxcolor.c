@@ -42,6 +42,17 @@ static void fuzz_decode(const uint8_t *data, size_t size) {
         voxcolor_view_get(&v, i, one);
         require(memcmp(one, all + 3 * i, 3) == 0, "get and get_range differ");
     }
+    /* Batched lookups, backwards. */
+    {
+        uint64_t *idx = (uint64_t *)malloc(n * sizeof *idx + 1);
+        uint8_t *many = (uint8_t *)malloc(3 * n + 3);
+        for (i = 0; i < n; i++) idx[i] = n - 1 - i;
+        voxcolor_view_get_many(&v, idx, n, many);
+        for (i = 0; i < n; i++)
+            require(memcmp(many + 3 * i, all + 3 * (n - 1 - i), 3) == 0, "get_many differs");
+        free(idx);
+        free(many);
+    }
     /* The end of long streams too. */
     if (v.count > n) {
         voxcolor_view_get_range(&v, v.count - n, n, all);

@@ -166,6 +166,16 @@ static void check_roundtrip(const uint8_t *rgb, size_t n, const voxcolor_encode_
     }
     CHECK_MSG(bad == 0, "%s: %zu colours over %g (worst %g)", what, bad, bound, worst);
     CHECK_MSG(differ == 0, "%s: get, get_range and reference reader differ at %zu", what, differ);
+    /* Batched lookups of scattered indices equal single lookups. */
+    if (n) {
+        uint64_t *idx = (uint64_t *)malloc(n * sizeof *idx), seed = 3;
+        for (i = 0; i < n; i++) idx[i] = test_rand_below(&seed, (uint32_t)n);
+        voxcolor_view_get_many(&v, idx, n, a);
+        for (i = 0; i < n; i++)
+            if (memcmp(a + 3 * i, b + 3 * idx[i], 3)) break;
+        CHECK_MSG(i == n, "%s: get_many differs at %zu", what, i);
+        free(idx);
+    }
     /* Ranges starting and ending anywhere equal single lookups. */
     for (i = 0; i < 40 && n; i++) {
         size_t first = (i * 7919) % n, len = (i * 104729) % (n - first) + 1;
