@@ -563,14 +563,20 @@ static int voxdagi_popcount64(uint64_t x) {
 #endif
 }
 
-static uint64_t voxdagi_spread3(uint32_t v) { /* bit i of v -> bit 3i */
-    uint64_t x = v & 0x1FFFFFu;
-    x = (x | x << 32) & 0x1F00000000FFFFull;
-    x = (x | x << 16) & 0x1F0000FF0000FFull;
-    x = (x | x << 8) & 0x100F00F00F00F00Full;
-    x = (x | x << 4) & 0x10C30C30C30C30C3ull;
-    x = (x | x << 2) & 0x1249249249249249ull;
-    return x;
+/* Bit i of a byte moved to bit 3i, for all 256 bytes, built by the
+   preprocessor. */
+#define VOXDAGI_S8(v)                                                                        \
+    (((v) & 1) | ((v) & 2) << 2 | ((v) & 4) << 4 | ((v) & 8) << 6 | ((v) & 16) << 8 |            \
+     ((v) & 32) << 10 | ((v) & 64) << 12 | ((v) & 128) << 14)
+#define VOXDAGI_S4(v) VOXDAGI_S8(v), VOXDAGI_S8((v) + 1), VOXDAGI_S8((v) + 2), VOXDAGI_S8((v) + 3)
+#define VOXDAGI_S16(v) VOXDAGI_S4(v), VOXDAGI_S4((v) + 4), VOXDAGI_S4((v) + 8), VOXDAGI_S4((v) + 12)
+#define VOXDAGI_S64(v) VOXDAGI_S16(v), VOXDAGI_S16((v) + 16), VOXDAGI_S16((v) + 32), VOXDAGI_S16((v) + 48)
+static const uint32_t voxdagi_spread8[256] = {VOXDAGI_S64(0u), VOXDAGI_S64(64u), VOXDAGI_S64(128u),
+                                              VOXDAGI_S64(192u)};
+
+static uint64_t voxdagi_spread3(uint32_t v) { /* bit i of v -> bit 3i, 21 bits */
+    return (uint64_t)voxdagi_spread8[v & 0xFF] | (uint64_t)voxdagi_spread8[(v >> 8) & 0xFF] << 24 |
+           (uint64_t)voxdagi_spread8[(v >> 16) & 0x1F] << 48;
 }
 
 static uint32_t voxdagi_compact3(uint64_t x) { /* inverse of voxdagi_spread3 */
@@ -914,7 +920,38 @@ typedef struct voxdagi_reducer {
     uint32_t part_child[VOXDAG_MAX_LEVELS][8];
     uint32_t root; /* reference to the root, or VOXDAGI_NONE */
     int failed;    /* out of memory or node ids */
+    struct voxdagi_memo *memo; /* recent inputs -> references; NULL: none */
 } voxdagi_reducer;
+
+/* A direct-mapped memo of recent reductions: the same brick mask or the same
+   8 child references recur constantly in real scenes (flat floors, repeated
+   walls), and their reference never changes once interned, so a hit skips
+   the canonicalization and the hash-table probe. */
+#define VOXDAGI_MEMO_SIZE 8192
+typedef struct voxdagi_memo {
+    uint32_t word[VOXDAGI_MEMO_SIZE][8]; /* child references, or the brick mask */
+    uint32_t level[VOXDAGI_MEMO_SIZE];
+    uint32_t ref[VOXDAGI_MEMO_SIZE];     /* VOXDAGI_NONE: empty */
+} voxdagi_memo;
+
+static uint32_t *voxdagi_memo_slot(voxdagi_reducer *r, uint32_t level, const uint32_t word[8]) {
+    uint64_t h = level;
+    unsigned i;
+    if (!r->memo) {
+        r->memo = (voxdagi_memo *)voxdagi_alloc(r->mem, sizeof *r->memo);
+        if (!r->memo) return NULL;
+        memset(r->memo->ref, 0xFF, sizeof r->memo->ref);
+    }
+    for (i = 0; i < 8; i++) h = (h ^ word[i]) * 0x9E3779B97F4A7C15ull;
+    i = (unsigned)(h >> 51) & (VOXDAGI_MEMO_SIZE - 1);
+    if (r->memo->ref[i] == VOXDAGI_NONE || r->memo->level[i] != level ||
+        memcmp(r->memo->word[i], word, sizeof r->memo->word[i])) {
+        memcpy(r->memo->word[i], word, sizeof r->memo->word[i]);
+        r->memo->level[i] = level;
+        r->memo->ref[i] = VOXDAGI_NONE;
+    }
+    return &r->memo->ref[i];
+}
 
 static void voxdagi_reducer_init(voxdagi_reducer *r, voxdagi_mem *mem,
                                  const voxdagi_group *g, uint32_t levels, uint32_t top) {
@@ -929,17 +966,25 @@ static void voxdagi_reducer_init(voxdagi_reducer *r, voxdagi_mem *mem,
 static void voxdagi_reducer_free(voxdagi_reducer *r) {
     uint32_t l;
     for (l = 0; l < VOXDAG_MAX_LEVELS; l++) voxdagi_store_free(r->mem, &r->store[l]);
+    voxdagi_free(r->mem, r->memo, sizeof *r->memo);
+    r->memo = NULL;
 }
 
 /* Interns a brick mask; returns the reference (id << 3 | mirror). */
 static uint32_t voxdagi_reduce_brick(voxdagi_reducer *r, uint64_t mask) {
-    voxdagi_canon c = voxdagi_canon_brick(r->group, mask);
-    uint32_t id = voxdagi_store_intern(r->mem, &r->store[r->levels - 2], 0, c.key, NULL,
-                                       0, c.stab);
+    uint32_t word[8] = {0}, *memo, id;
+    voxdagi_canon c;
+    word[0] = (uint32_t)mask;
+    word[1] = (uint32_t)(mask >> 32);
+    memo = voxdagi_memo_slot(r, r->levels - 2, word);
+    if (memo && *memo != VOXDAGI_NONE) return *memo;
+    c = voxdagi_canon_brick(r->group, mask);
+    id = voxdagi_store_intern(r->mem, &r->store[r->levels - 2], 0, c.key, NULL, 0, c.stab);
     if (id == VOXDAGI_NONE) {
         r->failed = 1;
         return VOXDAGI_NONE;
     }
+    if (memo) *memo = id << 3 | c.mirror;
     return id << 3 | c.mirror;
 }
 
@@ -949,9 +994,10 @@ static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const ui
     const voxdagi_store *cs = &r->store[level + 1];
     voxdagi_children c;
     voxdagi_canon k;
-    uint32_t slots[8], id;
+    uint32_t slots[8], id, *memo = voxdagi_memo_slot(r, level, ref);
     uint64_t count = 0;
     unsigned j;
+    if (memo && *memo != VOXDAGI_NONE) return *memo;
     c.present = 0;
     for (j = 0; j < 8; j++) {
         if (ref[j] == VOXDAGI_NONE) {
@@ -973,6 +1019,7 @@ static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const ui
         r->failed = 1;
         return VOXDAGI_NONE;
     }
+    if (memo) *memo = id << 3 | k.mirror;
     return id << 3 | k.mirror;
 }
 
@@ -1186,34 +1233,32 @@ static int voxdagi_builder_reserve(voxdag_builder *b, size_t need) {
 
 VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *xyz,
                                             const uint8_t *rgb, size_t n, voxdag_error *err) {
-    uint32_t limit;
     size_t i;
+    uint64_t *code;
     if (!b || (n && !xyz) || (n && b->opts.colors && !rgb))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
                             "builder, coordinates or colours missing");
     if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
-    limit = (uint32_t)1 << b->levels;
-    for (i = 0; i < n; i++) {
-        uint64_t code;
-        if (xyz[3 * i] >= limit || xyz[3 * i + 1] >= limit || xyz[3 * i + 2] >= limit)
-            return voxdagi_fail(err, VOXDAG_ERR_COORDINATE, "voxel coordinate >= 2^levels",
-                                UINT64_MAX, (uint64_t)i);
-        code = voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-        if (b->any_reduced && code < b->last_code)
-            return voxdagi_fail(err, VOXDAG_ERR_ORDER,
-                                "voxel precedes voxels already flushed", UINT64_MAX,
-                                (uint64_t)i);
-    }
     if (n > ((size_t)-1) / 16 - b->pend_n)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "too many voxels");
     if (b->pend_n + n > b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + n))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot grow the voxel buffer");
+    /* Encode into the free tail of the buffer; it only counts once all pass. */
+    code = b->pend_code + b->pend_n;
     for (i = 0; i < n; i++) {
-        b->pend_code[b->pend_n + i] = voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-        if (b->opts.colors)
+        const uint32_t *p = xyz + 3 * i;
+        if ((p[0] | p[1] | p[2]) >> b->levels)
+            return voxdagi_fail(err, VOXDAG_ERR_COORDINATE, "voxel coordinate >= 2^levels",
+                                UINT64_MAX, (uint64_t)i);
+        code[i] = voxdag_morton_encode(p[0], p[1], p[2]);
+        if (code[i] < b->last_code && b->any_reduced)
+            return voxdagi_fail(err, VOXDAG_ERR_ORDER,
+                                "voxel precedes voxels already flushed", UINT64_MAX, (uint64_t)i);
+    }
+    if (b->opts.colors)
+        for (i = 0; i < n; i++)
             b->pend_rgb[b->pend_n + i] = (uint32_t)rgb[3 * i] << 16 |
                                          (uint32_t)rgb[3 * i + 1] << 8 | rgb[3 * i + 2];
-    }
     b->pend_n += n;
     return voxdagi_ok(err);
 }
@@ -1421,10 +1466,14 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     size_t n = b->pend_n, i, w;
     uint64_t *code = b->pend_code;
     uint32_t *rgb = b->pend_rgb;
-    int sorted = 1, done = 0;
+    int sorted = 1, distinct = 1, done = 0;
     unsigned k;
     if (!n) return VOXDAG_OK;
-    for (i = 1; i < n && sorted; i++) sorted = code[i - 1] <= code[i];
+    for (i = 1; i < n && sorted; i++) {
+        sorted = code[i - 1] <= code[i];
+        distinct &= code[i - 1] != code[i];
+    }
+    distinct &= sorted;
     if (!sorted) {
         size_t rgb_size = rgb ? n * sizeof *rgb : 0;
         uint64_t *tc = (uint64_t *)voxdagi_alloc(&b->mem, n * sizeof *tc);
@@ -1440,8 +1489,8 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     }
     /* Keep the last of equal codes; a repeat of the last reduced voxel only
        replaces its colour. */
-    w = 0;
-    for (i = 0; i < n; i++) {
+    w = distinct ? n : 0;
+    for (i = w; i < n; i++) {
         if (w && code[w - 1] == code[i]) {
             if (rgb) rgb[w - 1] = rgb[i];
             continue;
