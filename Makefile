@@ -97,6 +97,17 @@ fuzz-load: | $(BUILD)
 	$(BUILD)/fuzz_load_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/load.dict \
 	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_load_corpus tests/data/fuzz/load
 
+# The main job on the built-in scene: generate, build, compress the colours,
+# save, validate, render.
+demo: $(BUILD)/vdag
+	$(BUILD)/vdag gen demo $(BUILD)/demo.xyz --levels 8
+	$(BUILD)/vdag build $(BUILD)/demo.xyz $(BUILD)/demo.vdag --color-error 0.02
+	$(BUILD)/vdag validate $(BUILD)/demo.vdag
+	$(BUILD)/vdag info $(BUILD)/demo.vdag
+	$(BUILD)/vdag render $(BUILD)/demo.vdag $(BUILD)/demo.png --size 800x500 \
+	    --eye 420 -160 300 --target 128 128 60 --fov 40 --shadows
+	@echo "demo: the picture is $(BUILD)/demo.png"
+
 deps:
 	@sh tests/deps.sh
 
