@@ -299,6 +299,76 @@ static void test_cielab(void) {
     free(d);
 }
 
+/* Real colours: images (binary PPM) read along a 2D Morton curve, from
+   $VOXCOLOR_TEST_IMAGES (comma-separated) or, when bench/color_fetch.sh has
+   run, a few of bench/data/color/ppm. Skipped when there are none. */
+static uint8_t *load_ppm_morton(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    unsigned w, h, maxval;
+    uint8_t *img, *out;
+    uint64_t i, end;
+    *n = 0;
+    if (!f) return NULL;
+    if (fscanf(f, "P6 %u %u %u", &w, &h, &maxval) != 3 || maxval != 255 || fgetc(f) == EOF ||
+        (uint64_t)w * h > (1u << 24)) {
+        fclose(f);
+        return NULL;
+    }
+    img = (uint8_t *)malloc(3 * (size_t)w * h);
+    out = (uint8_t *)malloc(3 * (size_t)w * h);
+    if (fread(img, 3, (size_t)w * h, f) != (size_t)w * h) {
+        free(img), free(out), fclose(f);
+        return NULL;
+    }
+    fclose(f);
+    end = voxcolor_morton2d_encode(w - 1, h - 1) + 1;
+    for (i = 0; i < end; i++) {
+        uint32_t x, y;
+        voxcolor_morton2d_decode(i, &x, &y);
+        if (x < w && y < h) memcpy(out + 3 * (*n)++, img + 3 * ((size_t)y * w + x), 3);
+    }
+    free(img);
+    return out;
+}
+
+static void test_real_images(void) {
+    static const char *const fallback[] = {
+        "bench/data/color/ppm/terrain_rock02.ppm", "bench/data/color/ppm/terrain_grass01.ppm",
+        "bench/data/color/ppm/terrain_snow01.ppm", "bench/data/color/ppm/skybox.ppm"};
+    static const double bounds[] = {0, 0.01, 0.025, 0.05, 0.1};
+    const char *env = getenv("VOXCOLOR_TEST_IMAGES");
+    char list[4096], *path;
+    size_t used = 0, k, f;
+    if (env) {
+        snprintf(list, sizeof list, "%s", env);
+        path = strtok(list, ",");
+    } else {
+        path = NULL;
+    }
+    for (f = 0; env ? path != NULL : f < 4; f++) {
+        const char *p = env ? path : fallback[f];
+        size_t n;
+        uint8_t *c = load_ppm_morton(p, &n);
+        if (c) {
+            used++;
+            if (n > (1u << 17)) n = 1u << 17; /* keeps the sanitized run short */
+            for (k = 0; k < sizeof bounds / sizeof bounds[0]; k++) {
+                voxcolor_encode_opts o;
+                char what[256];
+                memset(&o, 0, sizeof o);
+                o.max_error = bounds[k];
+                snprintf(what, sizeof what, "%s e_t=%g", p, bounds[k]);
+                check_roundtrip(c, n, &o, what);
+            }
+            free(c);
+        } else if (env) {
+            CHECK_MSG(0, "cannot read %s", p);
+        }
+        if (env) path = strtok(NULL, ",");
+    }
+    if (!used) fprintf(stderr, "  no real images (run bench/color_fetch.sh bench/data/color): skipped\n");
+}
+
 // -- Sizes and buffers
 
 static void test_bound_and_small_buffers(void) {
@@ -638,6 +708,7 @@ static void test_morton2d(void) {
 const test_case test_voxcolor_cases[] = {
     {"voxcolor/error_bound", test_error_bound},
     {"voxcolor/options", test_options},
+    {"voxcolor/real_images", test_real_images},
     {"voxcolor/lossless", test_lossless},
     {"voxcolor/cielab", test_cielab},
     {"voxcolor/bound_and_small_buffers", test_bound_and_small_buffers},
