@@ -540,10 +540,11 @@ static int vi_ply_vertex_role(vi_span name) {
         const char *name;
         int role;
     } names[] = {
-        {"x", VI_X},   {"y", VI_Y},     {"z", VI_Z},         {"red", VI_R},       {"green", VI_G},
-        {"blue", VI_B}, {"diffuse_red", VI_R}, {"diffuse_green", VI_G}, {"diffuse_blue", VI_B},
-        {"s", VI_U},   {"t", VI_V},     {"u", VI_U},         {"v", VI_V},         {"texture_u", VI_U},
-        {"texture_v", VI_V}, {"texture_s", VI_U}, {"texture_t", VI_V},
+        {"x", VI_X}, {"y", VI_Y}, {"z", VI_Z},
+        {"red", VI_R}, {"green", VI_G}, {"blue", VI_B},
+        {"diffuse_red", VI_R}, {"diffuse_green", VI_G}, {"diffuse_blue", VI_B},
+        {"s", VI_U}, {"t", VI_V}, {"u", VI_U}, {"v", VI_V},
+        {"texture_u", VI_U}, {"texture_v", VI_V}, {"texture_s", VI_U}, {"texture_t", VI_V},
     };
     size_t i;
     for (i = 0; i < sizeof names / sizeof names[0]; i++)
@@ -844,14 +845,18 @@ static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) 
     vi_buf b = {NULL, 0, 0};
     int ok = 1;
     FILE *f = fopen(path, "rb");
+    long known;
     if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
-    for (;;) {
+    /* Reserve the size when it is known, so that big files are not copied. */
+    if (!fseek(f, 0, SEEK_END) && (known = ftell(f)) > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
+        ok = vi_push(c, &b, 1, (size_t)known + CHUNK) != NULL;
+        b.count = 0;
+    }
+    rewind(f);
+    while (ok) {
         char *chunk = (char *)vi_push(c, &b, 1, CHUNK);
         size_t got;
-        if (!chunk) {
-            ok = 0;
-            break;
-        }
+        if (!(ok = chunk != NULL)) break;
         got = fread(chunk, 1, CHUNK, f);
         b.count -= CHUNK - got;
         if (got < CHUNK) break;
@@ -903,9 +908,9 @@ static const struct {
     const char *name;
     int args, more;
 } vi_map_options[] = {
-    {"-blendu", 1, 0}, {"-blendv", 1, 0}, {"-bm", 1, 0},     {"-boost", 1, 0}, {"-cc", 1, 0},
-    {"-clamp", 1, 0},  {"-imfchan", 1, 0}, {"-mm", 2, 0},    {"-o", 1, 2},     {"-s", 1, 2},
-    {"-t", 1, 2},      {"-texres", 1, 0}, {"-type", 1, 0},
+    {"-blendu", 1, 0}, {"-blendv", 1, 0}, {"-bm", 1, 0}, {"-boost", 1, 0}, {"-cc", 1, 0},
+    {"-clamp", 1, 0}, {"-imfchan", 1, 0}, {"-mm", 2, 0}, {"-texres", 1, 0}, {"-type", 1, 0},
+    {"-o", 1, 2}, {"-s", 1, 2}, {"-t", 1, 2},
 };
 
 /* The file name of a map_Kd line (LINE: what follows the keyword): options
