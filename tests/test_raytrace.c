@@ -8,10 +8,13 @@
    edges and corners are exact ties between axes; the documented tie rule
    (x before y before z) makes them deterministic, so they are compared
    exactly as well, and the test counts them to prove they are exercised. */
+#define _XOPEN_SOURCE 700 /* mkdtemp */
 #include "test.h"
 #include "voxdag.h"
+#include "examples/image.h"
 
 #include <math.h>
+#include <stdlib.h>
 
 // -- Dense scenes and their occupancy pyramid
 
@@ -364,8 +367,135 @@ static void test_raytrace_conventions(void) {
     rscene_free(&s);
 }
 
+// -- Images: vdag render against a brute-force render of the same model
+
+/* The picture model documented at the top of examples/render.c, evaluated
+   with the oracle walk instead of the DAG. */
+typedef struct view {
+    double eye[3], f[3], r[3], u[3], light[3], s;
+    uint32_t w, h;
+} view;
+
+static void unit3(double *v) {
+    double n = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    v[0] /= n, v[1] /= n, v[2] /= n;
+}
+
+static void reference_pixel(const rscene *s, const view *c, uint32_t i, uint32_t j, uint8_t *out) {
+    static const uint8_t background[3] = {205, 218, 235};
+    double sx = (2 * (i + 0.5) / c->w - 1) * c->s * c->w / c->h, sy = (1 - 2 * (j + 0.5) / c->h) * c->s;
+    double factor = 1, lit = 0;
+    voxdag_ray ray;
+    visit v;
+    int k;
+    memset(&ray, 0, sizeof ray);
+    for (k = 0; k < 3; k++) ray.origin[k] = c->eye[k], ray.dir[k] = c->f[k] + sx * c->r[k] + sy * c->u[k];
+    unit3(ray.dir);
+    ray.t_max = HUGE_VAL;
+    if (!oracle_walk(s, &ray, s->levels, stop_full, NULL, &v)) {
+        memcpy(out, background, 3);
+        return;
+    }
+    if (v.axis < 3) {
+        double n = ray.dir[v.axis] > 0 ? -1 : 1;
+        voxdag_ray sh;
+        visit sv;
+        lit = n * c->light[v.axis];
+        factor = 0.3 + (1 - 0.3) * (lit > 0 ? lit : 0);
+        memset(&sh, 0, sizeof sh);
+        for (k = 0; k < 3; k++) sh.origin[k] = ray.origin[k] + v.t * ray.dir[k], sh.dir[k] = c->light[k];
+        sh.origin[v.axis] = v.c[v.axis] + (n > 0 ? 1.0 : 0.0);
+        sh.t_max = HUGE_VAL;
+        if (lit > 0 && oracle_walk(s, &sh, s->levels, stop_full, NULL, &sv)) factor = 0.3;
+    }
+    for (k = 0; k < 3; k++) { /* the scene's colour of voxel (x, y, z) is (x, y, z) */
+        double x = (uint8_t)v.c[k] * factor + 0.5;
+        out[k] = (uint8_t)(x > 255 ? 255 : x);
+    }
+}
+
+/* Renders FILE with the vdag tool (VDAG, default build/vdag) into OUT. */
+static int run_render(const char *file, const char *out, const char *extra) {
+    char cmd[1024];
+    const char *vdag = getenv("VDAG") ? getenv("VDAG") : "build/vdag";
+    snprintf(cmd, sizeof cmd, "%s render %s %s --size 96x72 --eye -40 60 100 --target 32 24 28 --fov 45 "
+             "--shadows --threads 3 %s 2>/dev/null", vdag, file, out, extra);
+    return system(cmd) == 0;
+}
+
+static double psnr(const vdag_image *a, const vdag_image *b) {
+    double se = 0;
+    size_t i, n = 3 * (size_t)a->width * a->height;
+    for (i = 0; i < n; i++) se += ((double)a->rgb[i] - b->rgb[i]) * ((double)a->rgb[i] - b->rgb[i]);
+    return se == 0 ? 99 : 10 * log10(255.0 * 255.0 * (double)n / se);
+}
+
+static void test_raytrace_render_image(void) {
+    static const int kinds[2] = {RS_SPHERE, RS_BLOB};
+    char dir[] = "/tmp/vdag-render-XXXXXX", file[256], png[256], lod_png[256], err[256];
+    int s_i;
+    if (!mkdtemp(dir)) {
+        CHECK(0);
+        return;
+    }
+    for (s_i = 0; s_i < 2; s_i++) {
+        rscene s;
+        voxdag *d = rscene_make(&s, kinds[s_i], 6, 1, 7);
+        view c;
+        vdag_image got, lod;
+        double up[3] = {0, 0, 1}, target[3] = {32, 24, 28}, light[3] = {0.5, 0.3, 0.8};
+        uint32_t i, j, differ = 0, k;
+        snprintf(file, sizeof file, "%s/scene.vdag", dir);
+        snprintf(png, sizeof png, "%s/full.png", dir);
+        CHECK(voxdag_save_file(d, file, NULL) == VOXDAG_OK);
+        CHECK(run_render(file, png, ""));
+        CHECK(vdag_image_load(png, &got, err, sizeof err));
+        memset(&c, 0, sizeof c);
+        c.w = 96, c.h = 72, c.eye[0] = -40, c.eye[1] = 60, c.eye[2] = 100;
+        c.s = tan(45 * 3.14159265358979323846 / 360);
+        for (k = 0; k < 3; k++) c.f[k] = target[k] - c.eye[k], c.light[k] = light[k];
+        unit3(c.f);
+        unit3(c.light);
+        c.r[0] = c.f[1] * up[2] - c.f[2] * up[1], c.r[1] = c.f[2] * up[0] - c.f[0] * up[2];
+        c.r[2] = c.f[0] * up[1] - c.f[1] * up[0];
+        unit3(c.r);
+        c.u[0] = c.r[1] * c.f[2] - c.r[2] * c.f[1], c.u[1] = c.r[2] * c.f[0] - c.r[0] * c.f[2];
+        c.u[2] = c.r[0] * c.f[1] - c.r[1] * c.f[0];
+        CHECK(got.width == c.w && got.height == c.h);
+        for (j = 0; got.rgb && j < c.h; j++)
+            for (i = 0; i < c.w; i++) {
+                uint8_t want[3];
+                reference_pixel(&s, &c, i, j, want);
+                differ += memcmp(want, got.rgb + 3 * ((size_t)j * c.w + i), 3) != 0;
+            }
+        CHECK_MSG(differ == 0, "scene %d: %u of %u pixels differ from the brute-force render", kinds[s_i], differ,
+                  c.w * c.h);
+        for (k = 1; k <= 4; k *= 2) { /* level of detail stays close to the full render */
+            char opt[32];
+            snprintf(lod_png, sizeof lod_png, "%s/lod.png", dir);
+            snprintf(opt, sizeof opt, "--lod %u", k);
+            CHECK(run_render(file, lod_png, opt));
+            CHECK(vdag_image_load(lod_png, &lod, err, sizeof err));
+            if (lod.rgb && got.rgb) {
+                double p = psnr(&got, &lod);
+                fprintf(stderr, "  scene %d: --lod %u PSNR %.1f dB\n", kinds[s_i], k, p);
+                CHECK(p > (k < 4 ? 40 : 12)); /* bricks (4^3) are the finest level-of-detail cells */
+            }
+            vdag_image_free(&lod);
+            remove(lod_png);
+        }
+        vdag_image_free(&got);
+        remove(png);
+        remove(file);
+        voxdag_free(d);
+        rscene_free(&s);
+    }
+    remove(dir);
+}
+
 const test_case test_raytrace_cases[] = {
     {"raytrace_conventions", test_raytrace_conventions},
     {"raytrace_oracle", test_raytrace_oracle},
+    {"raytrace_render_image", test_raytrace_render_image},
     {NULL, NULL},
 };
