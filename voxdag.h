@@ -328,7 +328,9 @@ typedef struct voxdag_ray_opts {
     int want_index;    /* 1: fill hit.index (one extra descent at the hit) */
     double lod_factor; /* size of one pixel at distance t = 1, in grid units */
     double lod_pixels; /* stop at a full cell whose projected size, cell side /
-                          (t * lod_factor), is below this; 0 = full detail */
+                          (t * lod_factor), is below this; 0 = full detail. Cells
+                          are nodes: 4^3 bricks and coarser (a brick resolves
+                          to voxels) */
 } voxdag_ray_opts;
 
 typedef struct voxdag_hit {
@@ -354,6 +356,38 @@ VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray,
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
 
 #endif /* VOXDAG_NO_RAYTRACE */
+
+// -- File layout (FORMAT.md): byte offsets and codes, checked by the tests
+
+#define VOXDAG_FILE_HEADER_SIZE 64
+#define VOXDAG_FILE_OFF_MAGIC 0
+#define VOXDAG_FILE_OFF_VERSION 8
+#define VOXDAG_FILE_OFF_ENDIAN 12
+#define VOXDAG_FILE_OFF_HEADER_SIZE 16
+#define VOXDAG_FILE_OFF_FLAGS 20
+#define VOXDAG_FILE_OFF_FILE_SIZE 24
+#define VOXDAG_FILE_OFF_VOXELS 32
+#define VOXDAG_FILE_OFF_LEVELS 40
+#define VOXDAG_FILE_OFF_ROOT_MIRROR 41
+#define VOXDAG_FILE_OFF_SECTION_COUNT 44
+#define VOXDAG_FILE_OFF_TABLE_CRC 48
+#define VOXDAG_FILE_OFF_HEADER_CRC 52
+#define VOXDAG_FILE_SECTION_ENTRY_SIZE 32
+#define VOXDAG_FILE_LEVEL_ENTRY_SIZE 24
+#define VOXDAG_FILE_ENDIAN_TAG 0x0A0B0C0Du
+#define VOXDAG_FILE_FLAG_SYMMETRIC 1u
+#define VOXDAG_FILE_SECTION_OPTIONAL 1u
+#define VOXDAG_FILE_MAX_SECTIONS 16
+#define VOXDAG_FILE_NODE_PADDING 8
+
+enum {
+    VOXDAG_SECTION_LEVELS = 1,
+    VOXDAG_SECTION_NODES = 2,
+    VOXDAG_SECTION_BRICKS = 3,
+    VOXDAG_SECTION_COLORS_RGB8 = 4,
+    VOXDAG_SECTION_COLORS_VOXCOLOR = 5,
+    VOXDAG_SECTION_BOUNDS = 6
+};
 
 #ifdef __cplusplus
 }
@@ -389,38 +423,6 @@ VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
 #ifndef VOXDAG_NO_THREADS
 #include <pthread.h>
 #endif
-
-// -- File layout constants (FORMAT.md)
-
-#define VOXDAG_FILE_HEADER_SIZE 64
-#define VOXDAG_FILE_OFF_MAGIC 0
-#define VOXDAG_FILE_OFF_VERSION 8
-#define VOXDAG_FILE_OFF_ENDIAN 12
-#define VOXDAG_FILE_OFF_HEADER_SIZE 16
-#define VOXDAG_FILE_OFF_FLAGS 20
-#define VOXDAG_FILE_OFF_FILE_SIZE 24
-#define VOXDAG_FILE_OFF_VOXELS 32
-#define VOXDAG_FILE_OFF_LEVELS 40
-#define VOXDAG_FILE_OFF_ROOT_MIRROR 41
-#define VOXDAG_FILE_OFF_SECTION_COUNT 44
-#define VOXDAG_FILE_OFF_TABLE_CRC 48
-#define VOXDAG_FILE_OFF_HEADER_CRC 52
-#define VOXDAG_FILE_SECTION_ENTRY_SIZE 32
-#define VOXDAG_FILE_LEVEL_ENTRY_SIZE 24
-#define VOXDAG_FILE_ENDIAN_TAG 0x0A0B0C0Du
-#define VOXDAG_FILE_FLAG_SYMMETRIC 1u
-#define VOXDAG_FILE_SECTION_OPTIONAL 1u
-#define VOXDAG_FILE_MAX_SECTIONS 16
-#define VOXDAG_FILE_NODE_PADDING 8
-
-enum {
-    VOXDAG_SECTION_LEVELS = 1,
-    VOXDAG_SECTION_NODES = 2,
-    VOXDAG_SECTION_BRICKS = 3,
-    VOXDAG_SECTION_COLORS_RGB8 = 4,
-    VOXDAG_SECTION_COLORS_VOXCOLOR = 5,
-    VOXDAG_SECTION_BOUNDS = 6
-};
 
 static const uint8_t voxdagi_magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
 
@@ -2193,6 +2195,7 @@ static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
    children's), every node and brick referenced, one root holding every voxel. */
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
     uint32_t B = d->levels - 2, l;
+    int symmetric = (d->flags & VOXDAG_FILE_FLAG_SYMMETRIC) != 0;
     uint64_t base = B ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
     voxdagi_bitmaps child, cur;
     voxdag_status st = VOXDAG_OK;
@@ -2242,7 +2245,11 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
                 uint64_t target, c;
                 if (!(header >> (2 * s) & 3)) continue;
-                target = voxdagi_child(lv, rec, header, s) >> 3;
+                target = voxdagi_child(lv, rec, header, s);
+                if (!symmetric && (target & 7)) {
+                    st = VOXDAG_ERR_CORRUPT; msg = "mirror bits in a file built without symmetry"; break;
+                }
+                target >>= 3;
                 if (target >= child_units || !voxdagi_bit(child.start, target)) {
                     st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
                 }
@@ -2328,7 +2335,8 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     if (d->levels < 2 || d->levels > max_levels)
         return voxdagi_fail(err, VOXDAG_ERR_LIMIT, "levels outside the accepted range",
                             VOXDAG_FILE_OFF_LEVELS, UINT64_MAX);
-    if (d->root_mirror > 7 || d->voxels > (1ull << (3 * d->levels)))
+    if (d->root_mirror > 7 || (d->root_mirror && !(d->flags & VOXDAG_FILE_FLAG_SYMMETRIC)) ||
+        d->voxels > (1ull << (3 * d->levels)))
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad root mirror or voxel count",
                             VOXDAG_FILE_OFF_VOXELS, UINT64_MAX);
     count = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
@@ -3000,6 +3008,8 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     *out = NULL;
     memset(&o, 0, sizeof o);
     if (opts) o = *opts;
+    if (o.zero_begin || o.zero_end)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "load options not zero-initialized");
     if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
     f = fopen(path, "rb");
@@ -3012,7 +3022,7 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
         fclose(f);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "input larger than max_input_bytes");
     }
-    voxdagi_mem_init(&m, &o.allocator, 0);
+    voxdagi_mem_init(&m, &o.allocator, o.max_memory); /* the buffer counts against max_memory */
     buf = (uint8_t *)voxdagi_alloc(&m, (size_t)len);
     if (!buf) {
         fclose(f);
@@ -3027,6 +3037,8 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     }
     fclose(f);
     o.copy = 0;
+    if (o.max_memory) /* what validation may still use (0 would mean no limit) */
+        o.max_memory = o.max_memory > m.used ? o.max_memory - m.used : 1;
     st = voxdag_load_memory(buf, (size_t)len, &o, out, err);
     if (st != VOXDAG_OK) {
         voxdagi_free(&m, buf, (size_t)len);
