@@ -1932,12 +1932,32 @@ static int voxdagi_sortrec_cmp(const void *pa, const void *pb) {
     return a->id < b->id ? -1 : a->id > b->id;
 }
 
-static unsigned voxdagi_pointer_bytes(uint64_t v, unsigned long_bytes) {
-    return v < (1u << 16) ? 2 : v < (1u << 24) ? 3 : long_bytes;
+/* The tag (1..3) of the smallest pointer size of the level that holds V. */
+static unsigned voxdagi_pointer_tag(uint64_t v, const unsigned char size[4]) {
+    unsigned need = voxdagi_bytes_for(v);
+    return need <= size[1] ? 1 : need <= size[2] ? 2 : 3;
 }
 
-static unsigned voxdagi_pointer_tag(uint64_t v) {
-    return v < (1u << 16) ? 1 : v < (1u << 24) ? 2 : 3;
+/* Chooses a level's three pointer sizes (1..8 bytes, increasing) for the
+   fewest pointer bytes, given how many pointers need 1..8 bytes. */
+static void voxdagi_choose_sizes(const uint64_t need[9], unsigned char size[4]) {
+    unsigned a, b, c, top = 8, k;
+    uint64_t best = UINT64_MAX;
+    while (top > 1 && !need[top]) top--;
+    size[0] = 0;
+    for (a = 1; a <= 8; a++)
+        for (b = a + 1; b <= 8; b++)
+            for (c = b + 1; c <= 8; c++) {
+                uint64_t cost = 0;
+                if (c < top) continue;
+                for (k = 1; k <= 8; k++) cost += need[k] * (k <= a ? a : k <= b ? b : c);
+                if (cost < best) {
+                    best = cost;
+                    size[1] = (unsigned char)a;
+                    size[2] = (unsigned char)b;
+                    size[3] = (unsigned char)c;
+                }
+            }
 }
 
 typedef struct voxdagi_encoder {
@@ -1947,7 +1967,8 @@ typedef struct voxdagi_encoder {
     uint32_t *order[VOXDAG_MAX_LEVELS]; /* ids in storage order */
     uint64_t *pos[VOXDAG_MAX_LEVELS];   /* per id: byte offset, or brick index */
     uint64_t size[VOXDAG_MAX_LEVELS];   /* bytes of each inner level */
-    unsigned count_bytes[VOXDAG_MAX_LEVELS], long_bytes[VOXDAG_MAX_LEVELS];
+    unsigned count_bytes[VOXDAG_MAX_LEVELS];
+    unsigned char ptr_bytes[VOXDAG_MAX_LEVELS][4]; /* size of tags 1..3 */
 } voxdagi_encoder;
 
 static void voxdagi_encoder_free(voxdagi_encoder *e) {
@@ -1989,7 +2010,7 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         const voxdagi_store *s = &r->store[l];
         size_t n = s->n, i;
         voxdagi_sortrec *rec = (voxdagi_sortrec *)voxdagi_alloc(e->mem, n * sizeof *rec);
-        uint64_t at = 0, max_count = 0, max_target;
+        uint64_t at = 0, max_count = 0;
         if (!rec) {
             ok = 0;
             break;
@@ -2002,28 +2023,29 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         }
         qsort(rec, n, sizeof *rec, voxdagi_sortrec_cmp);
         if (l < B) {
-            max_target = l + 1 == B ? r->store[B].n : e->size[l + 1];
-            e->long_bytes[l] = voxdagi_bytes_for(max_target << 3 | 7);
-            if (e->long_bytes[l] < 4) e->long_bytes[l] = 4;
+            uint64_t need[9] = {0};
+            unsigned j;
             e->count_bytes[l] = l + 1 < B ? voxdagi_bytes_for(max_count) : 0;
-        }
-        for (i = 0; i < n; i++) {
-            uint32_t id = rec[i].id;
-            e->order[l][i] = id;
-            if (l == B) {
-                e->pos[l][id] = i;
-                continue;
-            }
-            e->pos[l][id] = at;
-            at += 2 + e->count_bytes[l];
-            {
-                unsigned j;
+            for (i = 0; i < 8 * n; i++)
+                if (s->child[i] != VOXDAGI_NONE)
+                    need[voxdagi_bytes_for(e->pos[l + 1][s->child[i] >> 3] << 3 | (s->child[i] & 7))]++;
+            voxdagi_choose_sizes(need, e->ptr_bytes[l]);
+            for (i = 0; i < n; i++) {
+                uint32_t id = rec[i].id;
+                e->order[l][i] = id;
+                e->pos[l][id] = at;
+                at += 2 + e->count_bytes[l];
                 for (j = 0; j < 8; j++) {
                     uint32_t x = s->child[8 * (size_t)id + j];
                     if (x != VOXDAGI_NONE)
-                        at += voxdagi_pointer_bytes(e->pos[l + 1][x >> 3] << 3 | (x & 7),
-                                                    e->long_bytes[l]);
+                        at += e->ptr_bytes[l][voxdagi_pointer_tag(e->pos[l + 1][x >> 3] << 3 | (x & 7),
+                                                                  e->ptr_bytes[l])];
                 }
+            }
+        } else {
+            for (i = 0; i < n; i++) {
+                e->order[l][i] = rec[i].id;
+                e->pos[l][rec[i].id] = i;
             }
         }
         e->size[l] = at;
@@ -2047,7 +2069,7 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
         voxdagi_put_le(te + 8, e->size[l], 8);
         voxdagi_put_le(te + 16, s->n, 4);
         te[20] = (uint8_t)e->count_bytes[l];
-        te[21] = (uint8_t)e->long_bytes[l];
+        memcpy(te + 21, e->ptr_bytes[l] + 1, 3);
         for (i = 0; i < s->n; i++) {
             uint32_t id = e->order[l][i];
             const uint32_t *ch = s->child + 8 * (size_t)id;
@@ -2058,8 +2080,8 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
                 unsigned n;
                 if (ch[j] == VOXDAGI_NONE) continue;
                 v = e->pos[l + 1][ch[j] >> 3] << 3 | (ch[j] & 7);
-                n = voxdagi_pointer_bytes(v, e->long_bytes[l]);
-                header |= voxdagi_pointer_tag(v) << (2 * j);
+                n = e->ptr_bytes[l][voxdagi_pointer_tag(v, e->ptr_bytes[l])];
+                header |= voxdagi_pointer_tag(v, e->ptr_bytes[l]) << (2 * j);
                 voxdagi_put_le(p + at, v, n);
                 at += n;
             }
@@ -2077,7 +2099,8 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
 typedef struct voxdagi_level {
     const uint8_t *data;
     uint64_t size, nodes;
-    unsigned count_bytes, long_bytes;
+    unsigned count_bytes;
+    unsigned char ptr_bytes[4]; /* pointer size of tags 1..3 ([0] = 0) */
 } voxdagi_level;
 
 struct voxdag {
@@ -2122,23 +2145,21 @@ VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size) {
 
 /* Byte offset of child octant S's pointer inside a record with HEADER: the
    sum of the pointer sizes of the lower octants (popcounts over the tags). */
-static unsigned voxdagi_child_offset(unsigned header, unsigned s, unsigned long_bytes) {
+static unsigned voxdagi_child_offset(unsigned header, unsigned s, const unsigned char size[4]) {
     unsigned h = header & ((1u << (2 * s)) - 1);
     unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
-    return 2u * (unsigned)voxdagi_popcount64(lo & ~hi) + 3u * (unsigned)voxdagi_popcount64(hi & ~lo) +
-           long_bytes * (unsigned)voxdagi_popcount64(lo & hi);
+    return size[1] * (unsigned)voxdagi_popcount64(lo & ~hi) + size[2] * (unsigned)voxdagi_popcount64(hi & ~lo) +
+           size[3] * (unsigned)voxdagi_popcount64(lo & hi);
 }
 
 static unsigned voxdagi_record_size(const voxdagi_level *lv, unsigned header) {
-    return 2 + lv->count_bytes + voxdagi_child_offset(header, 8, lv->long_bytes);
+    return 2 + lv->count_bytes + voxdagi_child_offset(header, 8, lv->ptr_bytes);
 }
 
 /* The pointer of stored octant S (which must be present): target << 3 | mirror. */
 static uint64_t voxdagi_child(const voxdagi_level *lv, const uint8_t *rec, unsigned header, unsigned s) {
-    static const unsigned char size_of_tag[4] = {0, 2, 3, 0};
-    unsigned tag = header >> (2 * s) & 3;
-    unsigned n = tag == 3 ? lv->long_bytes : size_of_tag[tag];
-    return voxdagi_le_fast(rec + 2 + lv->count_bytes + voxdagi_child_offset(header, s, lv->long_bytes), n);
+    unsigned n = lv->ptr_bytes[header >> (2 * s) & 3];
+    return voxdagi_le_fast(rec + 2 + lv->count_bytes + voxdagi_child_offset(header, s, lv->ptr_bytes), n);
 }
 
 static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
@@ -2418,9 +2439,11 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         lv->size = voxdagi_le(e + 8, 8);
         lv->nodes = voxdagi_le(e + 16, 4);
         lv->count_bytes = e[20];
-        lv->long_bytes = e[21];
-        if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at || e[22] || e[23] ||
-            lv->nodes > lv->size / 2 || lv->long_bytes < 4 || lv->long_bytes > 8 ||
+        lv->ptr_bytes[0] = 0;
+        memcpy(lv->ptr_bytes + 1, e + 21, 3);
+        if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at ||
+            lv->nodes > lv->size / 2 || !lv->ptr_bytes[1] || lv->ptr_bytes[1] >= lv->ptr_bytes[2] ||
+            lv->ptr_bytes[2] >= lv->ptr_bytes[3] || lv->ptr_bytes[3] > 8 ||
             (l + 1 < B ? lv->count_bytes < 1 || lv->count_bytes > 8 : lv->count_bytes != 0))
             return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad level entry", at, l);
         lv->data = nodes + level_at;
@@ -2516,7 +2539,9 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     e.r = r;
     e.levels = b->levels;
     for (l = 0; l < B; l++) { /* what an empty scene's level table says */
-        e.long_bytes[l] = 4;
+        e.ptr_bytes[l][1] = 2;
+        e.ptr_bytes[l][2] = 3;
+        e.ptr_bytes[l][3] = 4;
         e.count_bytes[l] = l + 1 < B;
     }
     if (r->root != VOXDAGI_NONE && !voxdagi_encoder_plan(&e)) {
