@@ -1383,8 +1383,10 @@ typedef struct vi_vox_model {
 } vi_vox_model;
 
 typedef struct vi_vox_node {
-    int32_t id;
+    int32_t id;              /* first, so vi_i32_order sorts nodes by id */
     char kind;               /* 'T' transform, 'G' group, 'S' shape */
+    int hidden;              /* "_hidden" set on the node */
+    int32_t layer;           /* T: its layer */
     uint32_t child_count;    /* T: 1, G: any, S: 0 */
     const uint8_t *children; /* child node ids, int32 each */
     int32_t model;           /* S: the model it shows, or -1 */
@@ -1494,20 +1496,29 @@ static int vi_vox_translation(vi_span s, int64_t t[3]) {
     return 1;
 }
 
+/* Reads the attribute DICT of a node or layer: is "_hidden" set? */
+static int vi_vox_hidden(vi_reader *r, int *hidden) {
+    static const char *const key[] = {"_hidden"};
+    vi_span value;
+    if (!vi_vox_dict(r, key, &value, 1)) return 0;
+    *hidden = vi_is(vi_trim(value), "1");
+    return 1;
+}
+
 /* Parses an nTRN, nGRP or nSHP chunk body. */
 static int vi_vox_node_chunk(vi_reader *r, char kind, vi_vox_node *n) {
     static const char *const frame_keys[] = {"_r", "_t"};
     vi_span frame[2];
     uint32_t count, frames;
-    int32_t reserved, layer;
+    int32_t reserved;
     memset(n, 0, sizeof *n);
     n->kind = kind;
     n->model = -1;
     vi_identity(&n->xf);
-    if (!vi_i32(r, &n->id) || !vi_vox_dict(r, NULL, NULL, 0)) return 0;
+    if (!vi_i32(r, &n->id) || !vi_vox_hidden(r, &n->hidden)) return 0;
     if (kind == 'T') {
         n->child_count = 1;
-        if (!(n->children = vi_take(r, 4)) || !vi_i32(r, &reserved) || !vi_i32(r, &layer) || !vi_u32(r, &frames))
+        if (!(n->children = vi_take(r, 4)) || !vi_i32(r, &reserved) || !vi_i32(r, &n->layer) || !vi_u32(r, &frames))
             return 0;
         if (!frames) return 1; /* only the first frame (of an animation) counts */
         if (!vi_vox_dict(r, frame_keys, frame, 2)) return 0;
@@ -1525,8 +1536,9 @@ static int vi_vox_node_chunk(vi_reader *r, char kind, vi_vox_node *n) {
     return !count || (vi_i32(r, &n->model) && vi_vox_dict(r, NULL, NULL, 0));
 }
 
-static int vi_vox_node_order(const void *a, const void *b) {
-    int32_t x = ((const vi_vox_node *)a)->id, y = ((const vi_vox_node *)b)->id;
+/* Orders int32 values, or structs that start with one. */
+static int vi_i32_order(const void *a, const void *b) {
+    int32_t x = *(const int32_t *)a, y = *(const int32_t *)b;
     return (x > y) - (x < y);
 }
 
@@ -1566,9 +1578,11 @@ static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, in
     return 1;
 }
 
-/* Walks the scene graph from node 0, placing each shape's model. */
-static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *models, const uint8_t pal[256][3],
-                       vi_buf *pts, vi_buf *rgb) {
+/* Walks the scene graph from node 0, placing each shape's model; hidden
+   nodes, and transforms on hidden layers (HIDDEN: sorted ids), are left out
+   with what lies below them, as MagicaVoxel leaves them out of exports. */
+static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *hidden, const vi_buf *models,
+                       const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb) {
     const vi_vox_node *all = (const vi_vox_node *)nodes->data;
     vi_buf stack = {NULL, 0, 0};
     vi_vox_visit *v;
@@ -1584,7 +1598,7 @@ static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *models, con
         const vi_vox_node *n;
         uint32_t i;
         key.id = at.node;
-        n = (const vi_vox_node *)bsearch(&key, all, nodes->count, sizeof key, vi_vox_node_order);
+        n = (const vi_vox_node *)bsearch(&key, all, nodes->count, sizeof key, vi_i32_order);
         if (!n) {
             vi_fail(c, "scene graph refers to missing node %ld", (long)at.node);
             goto done;
@@ -1593,6 +1607,9 @@ static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *models, con
             vi_fail(c, "scene graph has a cycle");
             goto done;
         }
+        if (n->hidden || (n->kind == 'T' && hidden->count &&
+                          bsearch(&n->layer, hidden->data, hidden->count, sizeof n->layer, vi_i32_order)))
+            continue;
         if (n->kind == 'S') {
             if (n->model >= 0 && (size_t)n->model >= models->count) {
                 vi_fail(c, "shape node %ld shows missing model %ld", (long)n->id, (long)n->model);
@@ -1622,7 +1639,7 @@ done:
 
 static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
-    vi_buf models = {NULL, 0, 0}, nodes = {NULL, 0, 0}, pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
+    vi_buf models = {NULL, 0, 0}, nodes = {NULL, 0, 0}, hidden = {NULL, 0, 0}, pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
     const uint8_t *b, *palette = NULL;
     uint8_t pal[256][3];
     uint32_t version, n, m, size_xyz[3];
@@ -1697,7 +1714,19 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                 vi_fail(c, "byte %llu: malformed %.4s chunk", (vi_ull)at, (const char *)id);
                 goto done;
             }
-        } /* else PACK, LAYR, MATL, MATT, rOBJ, rCAM, NOTE, IMAP, ...: not needed */
+        } else if (!memcmp(id, "LAYR", 4)) {
+            int32_t layer;
+            int is_hidden;
+            if (!vi_i32(&body, &layer) || !vi_vox_hidden(&body, &is_hidden)) {
+                vi_fail(c, "byte %llu: malformed LAYR chunk", (vi_ull)at);
+                goto done;
+            }
+            if (is_hidden) {
+                int32_t *h = (int32_t *)vi_push(c, &hidden, sizeof *h, 1);
+                if (!h) goto done;
+                *h = layer;
+            }
+        } /* else PACK, MATL, MATT, rOBJ, rCAM, NOTE, IMAP, ...: not needed */
     }
 
     /* Colour index k + 1 is palette entry k. */
@@ -1708,13 +1737,14 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     }
     if (nodes.count) {
         const vi_vox_node *sorted = (const vi_vox_node *)nodes.data;
-        qsort(nodes.data, nodes.count, sizeof(vi_vox_node), vi_vox_node_order);
+        qsort(nodes.data, nodes.count, sizeof(vi_vox_node), vi_i32_order);
         for (i = 1; i < nodes.count; i++)
             if (sorted[i].id == sorted[i - 1].id) {
                 vi_fail(c, "two scene graph nodes have the id %ld", (long)sorted[i].id);
                 goto done;
             }
-        if (!vi_vox_walk(c, &nodes, &models, (const uint8_t(*)[3])pal, &pts, &rgb)) goto done;
+        if (hidden.count) qsort(hidden.data, hidden.count, sizeof(int32_t), vi_i32_order);
+        if (!vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb)) goto done;
     } else { /* no scene graph: every model at the origin */
         vi_xform id;
         vi_identity(&id);
@@ -1742,6 +1772,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
 done:
     vi_buf_free(&models);
     vi_buf_free(&nodes);
+    vi_buf_free(&hidden);
     vi_buf_free(&pts);
     vi_buf_free(&rgb);
     return ok;

@@ -34,7 +34,8 @@
      where that lands on a cell corner; without one, models keep their own
      coordinates. MagicaVoxel's z-up axes become y-up ones, (x, y, z) ->
      (x, z, -y), and the result is shifted so each axis starts at 0. A model
-     shown by several shapes appears once per shape. */
+     shown by several shapes appears once per shape; hidden nodes and nodes
+     on hidden layers are left out, as in MagicaVoxel's exports. */
 #ifndef VDAG_IMPORT_H
 #define VDAG_IMPORT_H
 

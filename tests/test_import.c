@@ -749,18 +749,33 @@ static void vox_file(bytes *file, const bytes *children, int version) {
     put(file, children->p, children->n);
 }
 
-static void vox_transform(bytes *b, int32_t id, int32_t child, const char *r, const char *t) {
+/* An nTRN node on LAYER, HIDDEN or not. */
+static void vox_transform_on(bytes *b, int32_t id, int32_t child, const char *r, const char *t, int32_t layer,
+                             int hidden) {
     bytes c = {NULL, 0, 0};
     put_le32(&c, id);
-    vox_dict(&c, 1, "_name", "node");
+    vox_dict(&c, 2, "_name", "node", "_hidden", hidden ? "1" : "0");
     put_le32(&c, child);
     put_le32(&c, -1);
-    put_le32(&c, 0);
+    put_le32(&c, layer);
     put_le32(&c, 1);
     if (r && t) vox_dict(&c, 2, "_r", r, "_t", t);
     else if (t) vox_dict(&c, 1, "_t", t);
     else vox_dict(&c, 0);
     vox_chunk(b, "nTRN", &c, 0);
+    free(c.p);
+}
+
+static void vox_transform(bytes *b, int32_t id, int32_t child, const char *r, const char *t) {
+    vox_transform_on(b, id, child, r, t, 0, 0);
+}
+
+static void vox_layer(bytes *b, int32_t id, int hidden) {
+    bytes c = {NULL, 0, 0};
+    put_le32(&c, id);
+    vox_dict(&c, 1, "_hidden", hidden ? "1" : "0");
+    put_le32(&c, -1);
+    vox_chunk(b, "LAYR", &c, 0);
     free(c.p);
 }
 
@@ -919,8 +934,9 @@ static void test_vox_default_palette(void) {
 static int rotation_byte(int c0, int c1, int signs) { return c0 | c1 << 2 | signs << 4; }
 
 /* Scene graph: root transform -> group -> three transforms -> shapes, one
-   model shown twice; plus chunks the importer does not use. The expected
-   voxel is floor(R_root (R (v + 1/2 - size/2) + t) + t_root), in doubles. */
+   model shown twice, and two more left out: a hidden node and a node on a
+   hidden layer; plus chunks the importer does not use. The expected voxel
+   is floor(R_root (R (v + 1/2 - size/2) + t) + t_root), in doubles. */
 static void test_vox_scene_graph(void) {
     uint64_t seed = 9;
     int round;
@@ -929,7 +945,7 @@ static void test_vox_scene_graph(void) {
         int rot[4][3][3], perm[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
         int64_t t[4][3];
         char rs[4][8], ts[4][64];
-        const int32_t group_children[3] = {2, 4, 6};
+        const int32_t group_children[5] = {2, 4, 6, 8, 10};
         const int shown[3] = {0, 1, 0};
         voxel want[120];
         bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
@@ -953,16 +969,17 @@ static void test_vox_scene_graph(void) {
         putf(&c, "anything");
         vox_chunk(&body, "NOTE", &c, 0);
         vox_transform(&body, 0, 1, rs[3], ts[3]);
-        vox_group(&body, 1, group_children, 3);
+        vox_group(&body, 1, group_children, 5);
         for (j = 0; j < 3; j++) {
             vox_transform(&body, 2 + 2 * j, 3 + 2 * j, rs[j], ts[j]);
             vox_shape(&body, 3 + 2 * j, shown[j]);
         }
-        c.n = 0;
-        put_le32(&c, 0);
-        vox_dict(&c, 1, "_hidden", "0");
-        put_le32(&c, -1);
-        vox_chunk(&body, "LAYR", &c, 0);
+        vox_transform_on(&body, 8, 9, NULL, NULL, 0, 1);
+        vox_shape(&body, 9, 1);
+        vox_transform_on(&body, 10, 11, NULL, NULL, 7, 0);
+        vox_shape(&body, 11, 0);
+        vox_layer(&body, 0, 0);
+        vox_layer(&body, 7, 1);
         c.n = 0;
         putf(&c, "unknown chunk with children");
         vox_chunk(&body, "ZZZZ", &c, 12);
@@ -1068,6 +1085,12 @@ static void graph_short_palette(bytes *b) {
     vox_chunk(b, "RGBA", &c, 0);
     free(c.p);
 }
+static void graph_bad_layer(bytes *b) {
+    bytes c = {NULL, 0, 0};
+    put(&c, "\0\0", 2);
+    vox_chunk(b, "LAYR", &c, 0);
+    free(c.p);
+}
 static void graph_chunk_overrun(bytes *b) {
     put(b, "nTRN", 4);
     put_le32(b, 1000);
@@ -1095,6 +1118,7 @@ static void test_vox_errors(void) {
     vox_error(graph_xyzi_short, "fewer voxels than it declares");
     vox_error(graph_short_palette, "RGBA chunk too short");
     vox_error(graph_chunk_overrun, "chunk runs past the end of MAIN");
+    vox_error(graph_bad_layer, "malformed LAYR chunk");
     free(b.p);
 }
 
