@@ -583,9 +583,22 @@ static double voxcolori_root(double x, unsigned n) {
     return y;
 }
 
+/* Cube root of X > 0: an exponent-thirding first guess (within 4 %), then
+   three Halley steps (to the last bit). */
+static double voxcolori_cbrt(double x) {
+    uint64_t b;
+    double y;
+    unsigned i;
+    memcpy(&b, &x, sizeof b);
+    b = b / 3 + 0x2A9F7893782DA1CEull;
+    memcpy(&y, &b, sizeof y);
+    for (i = 0; i < 3; i++) y = y * (y * y * y + 2 * x) / (2 * y * y * y + x);
+    return y;
+}
+
 static double voxcolori_lab_f(double t) {
     const double d = 6.0 / 29.0;
-    return t > d * d * d ? voxcolori_root(t, 3) : t / (3 * d * d) + 4.0 / 29.0;
+    return t > d * d * d ? voxcolori_cbrt(t) : t / (3 * d * d) + 4.0 / 29.0;
 }
 
 /* CIELAB (D65 white) of an sRGB colour. */
