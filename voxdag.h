@@ -1912,13 +1912,14 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, uint32_
 //
 // Per level, nodes are ordered by reference count (most referenced first) so
 // that most pointers are short. A node record is: a 16-bit header with a
-// 2-bit tag per child octant (0 absent, 1: 2-byte, 2: 3-byte, 3: the level's
-// long pointer of 4..8 bytes), the node's voxel count in the level's count
-// width (levels above L-3 only: an L-3 count is the popcount of its bricks),
-// then the present children's pointers in octant order. A pointer is
-// (target << 3 | mirror), little-endian; the target is a byte offset into the
-// next level, or a brick index. Records are byte-aligned: 3-byte pointers
-// and unpadded records are what pays for the counts.
+// 2-bit tag per child octant (0 absent, else one of the level's three pointer
+// sizes), the node's voxel count in the level's count width (levels above
+// L-3 only: an L-3 count is the popcount of its bricks), then the present
+// children's pointers in octant order. A pointer is (target << 3 | mirror),
+// little-endian; the target is a byte offset into the next level, or a brick
+// index. Each level picks its three pointer sizes (of 1..8 bytes) for the
+// fewest bytes, where the paper fixes 2 and 4; with byte-aligned, unpadded
+// records this is what pays for the counts.
 
 typedef struct voxdagi_sortrec {
     uint32_t refs, id;

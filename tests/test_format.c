@@ -243,7 +243,7 @@ static void test_header_fields(void) {
                     CHECK(golden_le(le + 8, 8) == info.level_bytes[l]);
                     CHECK(golden_le(le + 16, 4) == info.nodes[l]);
                     CHECK(le[20] == (l + 3 < info.levels ? (info.voxels ? le[20] : 1) : 0));
-                    CHECK(le[21] >= 4 && le[21] <= 8 && !le[22] && !le[23]);
+                    CHECK(le[21] >= 1 && le[21] < le[22] && le[22] < le[23] && le[23] <= 8);
                     at += info.level_bytes[l];
                 }
                 CHECK(at == info.node_bytes);
@@ -504,7 +504,8 @@ static uint8_t *parts_write(const parts *p, size_t *size) {
    and the offset of the level. Returns the number found (at most CAP). */
 typedef struct level_view {
     uint64_t offset, size;
-    unsigned count_bytes, long_bytes;
+    unsigned count_bytes;
+    unsigned ptr_bytes[4]; /* pointer size of tags 1..3 */
 } level_view;
 
 static level_view level_of(const parts *p, uint32_t l) {
@@ -513,7 +514,10 @@ static level_view level_of(const parts *p, uint32_t l) {
     v.offset = golden_le(e, 8);
     v.size = golden_le(e + 8, 8);
     v.count_bytes = e[20];
-    v.long_bytes = e[21];
+    v.ptr_bytes[0] = 0;
+    v.ptr_bytes[1] = e[21];
+    v.ptr_bytes[2] = e[22];
+    v.ptr_bytes[3] = e[23];
     return v;
 }
 
@@ -521,7 +525,7 @@ static unsigned record_size(const uint8_t *rec, const level_view *v) {
     unsigned header = (unsigned)golden_le(rec, 2), s, n = 2 + v->count_bytes;
     for (s = 0; s < 8; s++) {
         unsigned tag = header >> (2 * s) & 3;
-        n += tag == 0 ? 0 : tag == 1 ? 2 : tag == 2 ? 3 : v->long_bytes;
+        n += v->ptr_bytes[tag];
     }
     return n;
 }
@@ -546,7 +550,7 @@ static uint64_t first_pointer(const parts *p, uint32_t l, uint64_t start, unsign
     unsigned header = (unsigned)golden_le(rec, 2), s = 0, tag;
     while (!(header >> (2 * s) & 3)) s++;
     tag = header >> (2 * s) & 3;
-    *bytes = tag == 1 ? 2 : tag == 2 ? 3 : v.long_bytes;
+    *bytes = v.ptr_bytes[tag];
     return v.offset + start + 2 + v.count_bytes;
 }
 
