@@ -732,10 +732,10 @@ static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const 
     return voxcolori_close(e, c, d);
 }
 
-/* Chooses endpoints for the N colours RGB (one colour: the bounding box
-   centre; two: the extremes along the principal axis, found by power
-   iteration on the covariance) and checks every colour. Returns 1 when all
-   fit. */
+/* Chooses endpoints for the N colours RGB and checks every colour; returns
+   1 when all fit. Mode 0: the centre of their bounding box. Else the extreme
+   projections on their principal axis (power iteration on the covariance;
+   two colours are their own extremes). */
 static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                voxcolori_fit *f) {
     double mean[3], cov[3][3], v[3] = {1, 1, 1}, lo[3], hi[3], tmin = 0, tmax = 0, vv;
