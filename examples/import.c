@@ -1547,8 +1547,8 @@ static int64_t vi_floor_half(int64_t x) { return x >= 0 ? x / 2 : -((1 - x) / 2)
 /* Appends the voxels of model M placed by XF. In a scene graph (CENTRED) a
    model's centre sits at its node's origin: voxel v covers the cell whose
    centre is xf(v + 1/2 - size/2), rounded down where it lands on a corner.
-   Outside one, voxels keep their model coordinates. MagicaVoxel's z-up axes
-   become y-up ones: (x, y, z) -> (x, z, -y). */
+   Outside one, voxels keep their model coordinates. Axes stay MagicaVoxel's
+   (z up), the vdag tool's convention too. */
 static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, int centred,
                         const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb) {
     uint32_t i;
@@ -1571,8 +1571,8 @@ static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, in
             w[a] = xf->t[a] + vi_floor_half(xf->m[a][0] * d[0] + xf->m[a][1] * d[1] + xf->m[a][2] * d[2]);
         if (!(p = (double *)vi_push(c, pts, sizeof *p, 3)) || !(q = (uint8_t *)vi_push(c, rgb, 1, 3))) return 0;
         p[0] = (double)w[0];
-        p[1] = (double)w[2];
-        p[2] = -(double)w[1];
+        p[1] = (double)w[1];
+        p[2] = (double)w[2];
         memcpy(q, pal[b[3] - 1], 3);
     }
     return 1;

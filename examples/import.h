@@ -32,8 +32,8 @@
      animation frame), each model's centre sits at its transform's origin:
      voxel v fills the cell holding R (v + 1/2 - size/2) + t, rounded down
      where that lands on a cell corner; without one, models keep their own
-     coordinates. MagicaVoxel's z-up axes become y-up ones, (x, y, z) ->
-     (x, z, -y), and the result is shifted so each axis starts at 0. A model
+     coordinates. Axes stay MagicaVoxel's (z up, as in the vdag tool), and
+     the result is shifted so each axis starts at 0. A model
      shown by several shapes appears once per shape; hidden nodes and nodes
      on hidden layers are left out, as in MagicaVoxel's exports. */
 #ifndef VDAG_IMPORT_H

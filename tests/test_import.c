@@ -816,8 +816,8 @@ static int voxel_order(const void *a, const void *b) {
 }
 
 /* Puts WANT (MagicaVoxel world coordinates, z up) into the importer's frame:
-   y up, (x, y, z) -> (x, z, -y), shifted so each axis starts at 0; then
-   compares it with the scene's voxels. */
+   the same axes, shifted so each axis starts at 0; then compares it with the
+   scene's voxels. */
 static void check_voxels(const vdag_scene *s, voxel *want, size_t n) {
     voxel *got;
     int64_t lo[3];
@@ -826,9 +826,6 @@ static void check_voxels(const vdag_scene *s, voxel *want, size_t n) {
     CHECK_MSG(s->point_count == n, "%zu voxels, expected %zu", s->point_count, n);
     if (s->point_count != n || !n) return;
     for (i = 0; i < n; i++) {
-        int64_t y = want[i].p[1];
-        want[i].p[1] = want[i].p[2];
-        want[i].p[2] = -y;
         for (a = 0; a < 3; a++)
             if (!i || want[i].p[a] < lo[a]) lo[a] = want[i].p[a];
     }
