@@ -1207,6 +1207,55 @@ VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
     voxdagi_mem_destroy(&mem);
 }
 
+/* Runs FN on COUNT jobs (an array of SIZE-byte elements), one thread each;
+   the calling thread takes job 0 and any job a thread could not start for. */
+static void voxdagi_run_parallel(void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+#ifndef VOXDAG_NO_THREADS
+    pthread_t tid[VOXDAGI_MAX_THREADS];
+    int started[VOXDAGI_MAX_THREADS];
+    unsigned t;
+    for (t = 1; t < count; t++) started[t] = pthread_create(&tid[t], NULL, fn, (char *)jobs + t * size) == 0;
+    fn(jobs);
+    for (t = 1; t < count; t++) {
+        if (started[t]) pthread_join(tid[t], NULL);
+        else fn((char *)jobs + t * size);
+    }
+#else
+    unsigned t;
+    for (t = 0; t < count; t++) fn((char *)jobs + t * size);
+#endif
+}
+
+/* Morton encoding and checks of voxels [begin, end) of an add call. */
+typedef struct voxdagi_encode_job {
+    const voxdag_builder *b;
+    const uint32_t *xyz;
+    uint64_t *code;
+    size_t begin, end, bad;
+    voxdag_status status;
+} voxdagi_encode_job;
+
+static void *voxdagi_encode_run(void *arg) {
+    voxdagi_encode_job *j = (voxdagi_encode_job *)arg;
+    const voxdag_builder *b = j->b;
+    size_t i;
+    j->status = VOXDAG_OK;
+    for (i = j->begin; i < j->end; i++) {
+        const uint32_t *p = j->xyz + 3 * i;
+        if ((p[0] | p[1] | p[2]) >> b->levels) {
+            j->status = VOXDAG_ERR_COORDINATE;
+            break;
+        }
+        j->code[i] = voxdag_morton_encode(p[0], p[1], p[2]);
+        if (j->code[i] < b->last_code && b->any_reduced) {
+            j->status = VOXDAG_ERR_ORDER;
+            break;
+        }
+    }
+    j->bad = i;
+    return NULL;
+}
+
 /* Grows the voxel buffer (codes and colours together) to hold NEED voxels. */
 static int voxdagi_builder_reserve(voxdag_builder *b, size_t need) {
     size_t cap = b->pend_cap ? b->pend_cap : 1024;
@@ -1247,15 +1296,28 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot grow the voxel buffer");
     /* Encode into the free tail of the buffer; it only counts once all pass. */
     code = b->pend_code + b->pend_n;
-    for (i = 0; i < n; i++) {
-        const uint32_t *p = xyz + 3 * i;
-        if ((p[0] | p[1] | p[2]) >> b->levels)
-            return voxdagi_fail(err, VOXDAG_ERR_COORDINATE, "voxel coordinate >= 2^levels",
-                                UINT64_MAX, (uint64_t)i);
-        code[i] = voxdag_morton_encode(p[0], p[1], p[2]);
-        if (code[i] < b->last_code && b->any_reduced)
-            return voxdagi_fail(err, VOXDAG_ERR_ORDER,
-                                "voxel precedes voxels already flushed", UINT64_MAX, (uint64_t)i);
+    {
+        voxdagi_encode_job job[VOXDAGI_MAX_THREADS];
+        unsigned t, jobs = n >= (1u << 18) ? b->threads : 1;
+        voxdag_status st = VOXDAG_OK;
+        size_t bad = n;
+        for (t = 0; t < jobs; t++) {
+            job[t].b = b;
+            job[t].xyz = xyz;
+            job[t].code = code;
+            job[t].begin = n / jobs * t;
+            job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
+        }
+        voxdagi_run_parallel(voxdagi_encode_run, job, sizeof job[0], jobs);
+        for (t = 0; t < jobs && st == VOXDAG_OK; t++)
+            if (job[t].status != VOXDAG_OK) {
+                st = job[t].status;
+                bad = job[t].bad;
+            }
+        if (st == VOXDAG_ERR_COORDINATE)
+            return voxdagi_fail(err, st, "voxel coordinate >= 2^levels", UINT64_MAX, (uint64_t)bad);
+        if (st == VOXDAG_ERR_ORDER)
+            return voxdagi_fail(err, st, "voxel precedes voxels already flushed", UINT64_MAX, (uint64_t)bad);
     }
     if (b->opts.colors)
         for (i = 0; i < n; i++)
@@ -1281,6 +1343,7 @@ static int voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, size_t
     return 1;
 }
 
+#ifndef VOXDAG_NO_THREADS
 /* Closes the open brick and the open nodes of levels >= LEVEL (they belong to
    subtrees that precede the one about to be pushed at LEVEL). */
 static void voxdagi_reducer_close_below(voxdagi_reducer *r, uint32_t level) {
@@ -1290,7 +1353,6 @@ static void voxdagi_reducer_close_below(voxdagi_reducer *r, uint32_t level) {
         if (r->part_open[l]) voxdagi_reducer_close(r, l);
 }
 
-#ifndef VOXDAG_NO_THREADS
 /* Parallel reduction (DESIGN 3.1): complete subtrees of level SPLIT are
    reduced by workers into stores of their own, then merged into the builder's
    stores in Morton order with the same interning (so the result does not
@@ -1338,18 +1400,26 @@ static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map,
         map[l] = (uint32_t *)voxdagi_alloc(r->mem, map_size[l]);
         if (!map[l]) return 0;
         for (i = 0; i < s->n; i++) {
-            uint32_t ref;
-            if (!s->child) {
-                ref = voxdagi_reduce_brick(r, s->key[i]);
-            } else {
-                uint32_t c[8];
+            uint32_t ref, c[8], same = 0, id;
+            if (s->child) /* children as references into R; SAME: any not in W's orientation */
                 for (j = 0; j < 8; j++) {
                     uint32_t x = s->child[8 * i + j];
                     c[j] = x == VOXDAGI_NONE ? x : map[l + 1][x >> 3] ^ (x & 7);
+                    if (x != VOXDAGI_NONE) same |= map[l + 1][x >> 3] & 7;
                 }
+            if (!same) {
+                /* Canonical forms do not depend on ids (fingerprints decide),
+                   so W's node is already canonical in R: intern it as is. */
+                id = voxdagi_store_intern(r->mem, &r->store[l], s->child != NULL, s->key[i], s->child ? c : NULL,
+                                          s->child ? s->count[i] : 0, s->stab[i]);
+                ref = id == VOXDAGI_NONE ? id : id << 3;
+            } else { /* a fingerprint collision made the orientations differ */
                 ref = voxdagi_reduce_node(r, l, c);
             }
-            if (ref == VOXDAGI_NONE) return 0;
+            if (ref == VOXDAGI_NONE) {
+                r->failed = 1;
+                return 0;
+            }
             map[l][i] = ref;
         }
         r->store[l].svo += s->svo;
@@ -1365,8 +1435,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
     size_t npieces = 0, cap = 0, i, start, per;
     voxdagi_piece *piece = NULL;
     voxdagi_worker *worker;
-    pthread_t tid[VOXDAGI_MAX_THREADS];
-    unsigned t, k, started = 0;
+    unsigned t, k;
     voxdag_status st = VOXDAG_OK;
     uint64_t shift, first_open = UINT64_MAX, last_open = UINT64_MAX;
     *done = 0;
@@ -1416,13 +1485,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
         for (k = 0; k < b->red_count; k++)
             voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], L, split);
     }
-    for (t = 1; t < b->threads; t++) {
-        if (pthread_create(&tid[t], NULL, voxdagi_worker_run, &worker[t]) != 0) break;
-        started = t;
-    }
-    voxdagi_worker_run(&worker[0]);
-    for (t = 1; t <= started; t++) pthread_join(tid[t], NULL);
-    for (t = started + 1; t < b->threads; t++) voxdagi_worker_run(&worker[t]);
+    voxdagi_run_parallel(voxdagi_worker_run, worker, sizeof *worker, b->threads);
 
     /* Merge in worker order, then feed voxels and subtrees in Morton order. */
     for (t = 0; t < b->threads && st == VOXDAG_OK; t++)

@@ -493,6 +493,21 @@ static void test_bad_arguments(void) {
     CHECK(voxdag_builder_add(b, xyz, NULL, 1, &err) == VOXDAG_OK);
     voxdag_builder_free(b);
     CHECK(strcmp(voxdag_status_string(VOXDAG_ERR_CORRUPT), "corrupt data") == 0);
+    { /* a large add is checked by several threads: still the first bad voxel */
+        size_t n = 300000, i;
+        uint32_t *many = (uint32_t *)calloc(3 * n, sizeof *many);
+        o.threads = 3;
+        for (i = 0; i < 3 * n; i++) many[i] = (uint32_t)(i % 61);
+        many[3 * 250000 + 1] = 64;
+        many[3 * 280000] = 99;
+        CHECK(voxdag_builder_create(&o, &b, &err) == VOXDAG_OK);
+        CHECK(voxdag_builder_add(b, many, NULL, n, &err) == VOXDAG_ERR_COORDINATE && err.node == 250000);
+        many[3 * 250000 + 1] = 1;
+        many[3 * 280000] = 9;
+        CHECK(voxdag_builder_add(b, many, NULL, n, &err) == VOXDAG_OK);
+        voxdag_builder_free(b);
+        free(many);
+    }
 }
 
 // -- Allocation failure: a counting allocator that fails at call N
