@@ -15,7 +15,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c examples/import.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c examples/import.c
 
 # Texture decoding (examples/image.h): OpenImageIO when installed, compiled
 # with $(CXX) and linked with the C++ driver; else a stub. These are expanded
@@ -53,6 +53,9 @@ $(BUILD)/san/image.o: $(IMAGE_DEPS)
 	@mkdir -p $(@D)
 	$(IMAGE_CC) $(WARN) -O1 -g $(SAN) -c -o $@
 
+# import.c includes import_scene.c (.spm and .ac share its helpers).
+$(BUILD)/opt/examples/import.o $(BUILD)/san/examples/import.o: examples/import_scene.c
+
 $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
 	$(LINK) $(OPT) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
@@ -60,7 +63,7 @@ $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
 $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
 	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
-$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import.h examples/image.h | $(BUILD)
+$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import_scene.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(FUZZ_IMPORT_DEFS) -I. -o $@ $(FUZZ_IMPORT_SRC) -lm
 
 fuzz-import: | $(BUILD)

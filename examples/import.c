@@ -1778,10 +1778,14 @@ done:
     return ok;
 }
 
+// -- .spm and .ac: game scenes (their own file, sharing the helpers above)
+
+#include "import_scene.c"
+
 // -- Entry points
 
-enum { VI_XYZ, VI_PLY, VI_OBJ, VI_OFF, VI_VOX, VI_MTL, VI_FORMAT_COUNT };
-static const char *const vi_formats[VI_FORMAT_COUNT] = {"xyz", "ply", "obj", "off", "vox", "mtl"};
+enum { VI_XYZ, VI_PLY, VI_OBJ, VI_OFF, VI_VOX, VI_MTL, VI_SPM, VI_AC, VI_FORMAT_COUNT };
+static const char *const vi_formats[VI_FORMAT_COUNT] = {"xyz", "ply", "obj", "off", "vox", "mtl", "spm", "ac"};
 
 static int vi_format(const char *ext) {
     vi_span s;
@@ -1809,7 +1813,9 @@ static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_
     case VI_OFF: ok = vi_parse_off(c, &t, out); break;
     case VI_VOX: ok = vi_parse_vox(c, (const uint8_t *)data, size, out); break;
     case VI_MTL: ok = vi_parse_mtl(c, &t, out); break;
-    default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .vox or .mtl)"); break;
+    case VI_SPM: ok = vi_parse_spm(c, (const uint8_t *)data, size, out); break;
+    case VI_AC: ok = vi_parse_ac(c, &t, out); break;
+    default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"); break;
     }
     if (!ok) vdag_scene_free(out);
     return ok;

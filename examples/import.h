@@ -1,4 +1,5 @@
-/* Scene importers for the vdag tool: .xyz, .ply, .obj(+.mtl), .off, .vox.
+/* Scene importers for the vdag tool: .xyz, .ply, .obj(+.mtl), .off, .vox,
+   and game scenes .spm and .ac (rules in import_scene.c).
    Every parser reads untrusted bytes: it returns 0 with a message on any
    malformed input, never crashes, and frees what it allocated. Counts read
    from a file are checked against the bytes left before anything is sized
@@ -80,7 +81,8 @@ typedef struct vdag_scene {
     vdag_image *images;
 } vdag_scene;
 
-/* Reads PATH, choosing the parser by extension (.xyz .ply .obj .off .vox).
+/* Reads PATH, choosing the parser by extension (.xyz .ply .obj .off .vox
+   .mtl .spm .ac).
    Returns 1 on success; 0 with a one-line reason in err otherwise. */
 int vdag_import_file(const char *path, vdag_scene *out, char *err, size_t err_size);
 

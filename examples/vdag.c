@@ -174,26 +174,16 @@ static int scene_to_grid(const vdag_scene *sc, build_args *a, uint32_t **xyz_out
     return 0;
 }
 
-/* Colour of a point on a mesh triangle: the vertex colours interpolated,
-   else the material's texture (nearest texel, wrapping), else its Kd. */
+/* Colour of a point on a mesh triangle: the material's texture (nearest
+   texel, wrapping) tinted by the interpolated vertex colours; without a
+   texture, the vertex colours, else the material's Kd (white without one). */
 static void mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
     const vdag_scene *sc = (const vdag_scene *)user;
     const uint32_t *v = sc->indices + 3 * tri;
     int32_t m = sc->triangle_material ? sc->triangle_material[tri] : -1;
-    int k, c;
-    if (sc->vertex_rgb) {
-        for (k = 0; k < 3; k++) {
-            double x = 0;
-            for (c = 0; c < 3; c++) x += bary[c] * sc->vertex_rgb[3 * (size_t)v[c] + k];
-            rgb[k] = (uint8_t)(x + 0.5 > 255 ? 255 : x + 0.5);
-        }
-        return;
-    }
-    if (m < 0 || (size_t)m >= sc->material_count) {
-        rgb[0] = rgb[1] = rgb[2] = 255;
-        return;
-    }
-    if (sc->uv && sc->materials[m].image >= 0 && (size_t)sc->materials[m].image < sc->image_count) {
+    int k, c, textured = m >= 0 && (size_t)m < sc->material_count && sc->uv && sc->materials[m].image >= 0 &&
+                         (size_t)sc->materials[m].image < sc->image_count;
+    if (textured) {
         const vdag_image *im = &sc->images[sc->materials[m].image];
         double u = 0, w = 0;
         long px, py;
@@ -210,9 +200,19 @@ static void mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb
         if (px < 0) px = 0;
         if (py < 0) py = 0;
         memcpy(rgb, im->rgb + 3 * ((size_t)py * im->width + (size_t)px), 3);
-        return;
+    } else if (m >= 0 && (size_t)m < sc->material_count && !sc->vertex_rgb) {
+        memcpy(rgb, sc->materials[m].rgb, 3);
+    } else {
+        rgb[0] = rgb[1] = rgb[2] = 255;
     }
-    memcpy(rgb, sc->materials[m].rgb, 3);
+    if (sc->vertex_rgb) {
+        for (k = 0; k < 3; k++) {
+            double x = 0;
+            for (c = 0; c < 3; c++) x += bary[c] * sc->vertex_rgb[3 * (size_t)v[c] + k];
+            x = x * rgb[k] / 255.0;
+            rgb[k] = (uint8_t)(x + 0.5 > 255 ? 255 : x + 0.5);
+        }
+    }
 }
 
 /* Mesh vertices in grid units: the bounding box fitted into the 2^L grid

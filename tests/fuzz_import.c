@@ -1,5 +1,5 @@
 /* Fuzz target for the scene importers: the first input byte picks the format
-   (modulo 6: xyz ply obj off vox mtl), the rest is the file. Built with
+   (modulo 8: xyz ply obj off vox mtl spm ac), the rest is the file. Built with
    -DVDAG_LIBFUZZER it is a libFuzzer target (`make fuzz-import`); otherwise
    main replays the files and directories given as arguments and prints
    "N passed, N failed". Broken invariants abort, as sanitizer errors do. */
@@ -40,11 +40,11 @@ static void check_scene(const vdag_scene *s) {
 }
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
-    static const char *const formats[] = {"xyz", "ply", "obj", "off", "vox", "mtl"};
+    static const char *const formats[] = {"xyz", "ply", "obj", "off", "vox", "mtl", "spm", "ac"};
     vdag_scene scene;
     char err[256];
     if (!size) return 0;
-    if (vdag_import_memory(formats[data[0] % 6], data + 1, size - 1, NULL, &scene, err, sizeof err)) {
+    if (vdag_import_memory(formats[data[0] % 8], data + 1, size - 1, NULL, &scene, err, sizeof err)) {
         check_scene(&scene);
         vdag_scene_free(&scene);
     } else {

@@ -678,7 +678,7 @@ static void test_file_errors(void) {
     CHECK(!vdag_import_file("tests/test_import.c", &s, err, sizeof err));
     CHECK_MSG(strstr(err, "unknown format") != NULL, "%s", err);
     CHECK(!vdag_import_memory("stl", "", 0, NULL, &s, err, sizeof err));
-    CHECK_MSG(!strcmp(err, "stl: unknown format (expected .xyz, .ply, .obj, .off, .vox or .mtl)"), "%s", err);
+    CHECK_MSG(!strcmp(err, "stl: unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"), "%s", err);
     CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, err, 8)); /* the message is cut, not overflowed */
     CHECK(strlen(err) == 7);
     CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, NULL, 0));

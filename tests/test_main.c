@@ -7,6 +7,7 @@ int test_current_failed;
 extern const test_case test_core_cases[];
 extern const test_case test_voxcolor_cases[];
 extern const test_case test_import_cases[];
+extern const test_case test_import_scene_cases[];
 extern const test_case test_format_cases[];
 extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
@@ -15,6 +16,7 @@ static const test_case *const suites[] = {
     test_core_cases,
     test_voxcolor_cases,
     test_import_cases,
+    test_import_scene_cases,
     test_format_cases,
     test_voxelize_cases,
     test_raytrace_cases,

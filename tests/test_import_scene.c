@@ -1,0 +1,669 @@
+/* Game-scene importer tests (.spm, .ac): files written here from random
+   scenes round-trip to the scene the test expects (axes turned to z up,
+   AC3D transforms applied, fans triangulated), textures are found where
+   the formats put them, and broken files (cut at every length, patched
+   bytes, bad counts, indices out of range, NaN) fail with one-line messages. */
+#define _POSIX_C_SOURCE 200809L
+#include "test.h"
+#include "examples/import.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+// -- Helpers
+
+typedef struct sbytes {
+    uint8_t *p;
+    size_t n, cap;
+} sbytes;
+
+static void sput(sbytes *b, const void *data, size_t n) {
+    if (!n) return;
+    if (b->n + n > b->cap) {
+        b->cap = (b->n + n) * 2 + 64;
+        b->p = (uint8_t *)realloc(b->p, b->cap);
+    }
+    memcpy(b->p + b->n, data, n);
+    b->n += n;
+}
+
+static void sputf(sbytes *b, const char *fmt, ...) {
+    char line[1024];
+    va_list ap;
+    int n;
+    va_start(ap, fmt);
+    n = vsnprintf(line, sizeof line, fmt, ap);
+    va_end(ap);
+    sput(b, line, (size_t)n);
+}
+
+static void sput_le(sbytes *b, uint64_t v, int n) {
+    uint8_t tmp[8];
+    int i;
+    for (i = 0; i < n; i++) tmp[i] = (uint8_t)(v >> (8 * i));
+    sput(b, tmp, (size_t)n);
+}
+
+static void sput_f32(sbytes *b, float f) {
+    uint32_t u;
+    memcpy(&u, &f, 4);
+    sput_le(b, u, 4);
+}
+
+/* Half-precision bits of V, a multiple of 1/256 with |V| < 64 (exact). */
+static uint16_t half_of(double v) {
+    uint16_t sign = v < 0 ? 0x8000 : 0;
+    int e;
+    double m;
+    if (v == 0) return sign;
+    m = frexp(fabs(v), &e); /* fabs(v) = m 2^e, m in [0.5, 1) */
+    return (uint16_t)(sign | (uint16_t)((e + 14) << 10) | (uint16_t)((m * 2 - 1) * 1024));
+}
+
+static int scene_import(const char *ext, const sbytes *data, vdag_scene *s, char *err, size_t err_size) {
+    int ok = vdag_import_memory(ext, data->p, data->n, NULL, s, err, err_size);
+    if (!ok) {
+        CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
+        CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);
+    }
+    return ok;
+}
+
+static void scene_error(const char *ext, const sbytes *data, const char *want) {
+    vdag_scene s;
+    char err[256];
+    if (scene_import(ext, data, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s file accepted; expected an error with \"%s\"", ext, want);
+        vdag_scene_free(&s);
+        return;
+    }
+    CHECK_MSG(strstr(err, want) != NULL, "message \"%s\" lacks \"%s\"", err, want);
+}
+
+static void scene_error_text(const char *ext, const char *text, const char *want) {
+    sbytes b = {NULL, 0, 0};
+    sput(&b, text, strlen(text));
+    scene_error(ext, &b, want);
+    free(b.p);
+}
+
+/* Every proper prefix fails (STRICT) or returns cleanly; every byte patched
+   to 0, 0xff, +1 and -1 returns cleanly. */
+static void scene_sweep(const char *ext, const sbytes *data, int strict) {
+    static const int patches[] = {0, 0xff, 1, -1};
+    sbytes cut = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    size_t n, i, k;
+    for (n = 0; n < data->n; n++) {
+        cut.n = 0;
+        sput(&cut, data->p, n); /* exact size, so ASan sees over-reads */
+        if (scene_import(ext, &cut, &s, err, sizeof err)) {
+            CHECK_MSG(!strict, "%s cut to %zu of %zu bytes accepted", ext, n, data->n);
+            vdag_scene_free(&s);
+        }
+    }
+    for (i = 0; i < data->n; i++)
+        for (k = 0; k < 4; k++) {
+            cut.n = 0;
+            sput(&cut, data->p, data->n);
+            cut.p[i] = (uint8_t)(k < 2 ? patches[k] : cut.p[i] + patches[k]);
+            if (scene_import(ext, &cut, &s, err, sizeof err)) vdag_scene_free(&s);
+        }
+    free(cut.p);
+}
+
+static double rand_eighths(uint64_t *seed, int range) {
+    return ((double)test_rand_below(seed, (uint32_t)(16 * range)) - 8.0 * range) / 8.0;
+}
+
+// -- .spm
+
+enum { SPM_MAX_V = 300, SPM_MAX_T = 400 };
+
+/* A random SPM scene and what importing it must give. */
+typedef struct spm_case {
+    unsigned flags, nbuf, nmat;
+    unsigned vc[3], ic[3], mid[3];
+    const char *tex1[3], *tex2[3];
+    size_t nv, nt;
+    double pos[3 * SPM_MAX_V][3];   /* expected, z up */
+    float uv[3 * SPM_MAX_V][2];
+    uint8_t rgb[3 * SPM_MAX_V][3];
+    uint32_t tri[3 * SPM_MAX_T][3]; /* expected, global */
+    int32_t tmat[3 * SPM_MAX_T];
+} spm_case;
+
+static void write_spm(sbytes *b, spm_case *t, uint64_t *seed) {
+    unsigned i, k, buf;
+    sput(b, "SP", 2);
+    sput_le(b, 1 << 3 | 2, 1);
+    sput_le(b, t->flags, 1);
+    for (i = 0; i < 6; i++) sput_f32(b, (float)i);
+    sput_le(b, t->nmat, 2);
+    for (i = 0; i < t->nmat; i++) {
+        sput_le(b, strlen(t->tex1[i]), 1);
+        sput(b, t->tex1[i], strlen(t->tex1[i]));
+        sput_le(b, strlen(t->tex2[i]), 1);
+        sput(b, t->tex2[i], strlen(t->tex2[i]));
+    }
+    sput_le(b, 2, 2); /* two meshes: buffer 0, then the rest */
+    t->nv = t->nt = 0;
+    for (buf = 0; buf < t->nbuf; buf++) {
+        unsigned vc = t->vc[buf], tc = t->ic[buf] / 3, mid = t->mid[buf];
+        int tex1 = t->tex1[mid][0] != 0, tex2 = tex1 && t->tex2[mid][0] != 0;
+        size_t base = t->nv;
+        if (buf < 2) sput_le(b, buf == 0 ? 1 : t->nbuf - 1, 2);
+        sput_le(b, vc, 4);
+        sput_le(b, 3 * tc, 4);
+        sput_le(b, mid, 2);
+        for (i = 0; i < vc; i++) {
+            double *p = t->pos[t->nv], x = rand_eighths(seed, 100), y = rand_eighths(seed, 100),
+                   z = rand_eighths(seed, 100);
+            sput_f32(b, (float)x);
+            sput_f32(b, (float)y);
+            sput_f32(b, (float)z);
+            p[0] = x, p[1] = z, p[2] = y;
+            if (t->flags & 1) sput_le(b, test_rand(seed), 4);
+            if (t->flags & 2) {
+                if (test_rand_below(seed, 3) == 0) {
+                    sput_le(b, 128, 1);
+                    memset(t->rgb[t->nv], 255, 3);
+                } else {
+                    sput_le(b, test_rand_below(seed, 2) ? 0 : 200, 1);
+                    for (k = 0; k < 3; k++) t->rgb[t->nv][k] = (uint8_t)test_rand_below(seed, 256);
+                    sput(b, t->rgb[t->nv], 3);
+                }
+            }
+            t->uv[t->nv][0] = t->uv[t->nv][1] = 0;
+            if (tex1) {
+                for (k = 0; k < 2; k++) {
+                    t->uv[t->nv][k] = (float)(((double)test_rand_below(seed, 4096) - 2048) / 256.0);
+                    sput_le(b, half_of(t->uv[t->nv][k]), 2);
+                }
+                if (tex2) sput_le(b, test_rand(seed), 4);
+                if (t->flags & 4) sput_le(b, test_rand(seed), 4);
+            }
+            t->nv++;
+        }
+        for (i = 0; i < tc; i++) {
+            for (k = 0; k < 3; k++) {
+                uint32_t idx = test_rand_below(seed, vc);
+                t->tri[t->nt][k] = (uint32_t)base + idx;
+                sput_le(b, idx, vc > 255 ? 2 : 1);
+            }
+            t->tmat[t->nt++] = (int32_t)mid;
+        }
+    }
+}
+
+static void random_spm(spm_case *t, uint64_t *seed) {
+    static const char *const names[] = {"", "a.png", "b.jpg"};
+    unsigned i;
+    t->flags = test_rand_below(seed, 8);
+    t->nmat = 1 + test_rand_below(seed, 3);
+    for (i = 0; i < t->nmat; i++) {
+        t->tex1[i] = names[test_rand_below(seed, 3)];
+        t->tex2[i] = names[test_rand_below(seed, 3)];
+    }
+    t->nbuf = 2 + test_rand_below(seed, 2);
+    for (i = 0; i < t->nbuf; i++) {
+        t->vc[i] = 1 + test_rand_below(seed, i == 1 ? SPM_MAX_V : 20); /* buffer 1 may need u16 indices */
+        t->ic[i] = 3 * test_rand_below(seed, i == 1 ? SPM_MAX_T : 8);
+        t->mid[i] = test_rand_below(seed, t->nmat);
+    }
+    t->ic[0] = 3 * (1 + t->ic[0] / 3); /* at least one triangle */
+}
+
+static void check_spm(const vdag_scene *s, const spm_case *t) {
+    size_t i;
+    int any_tex = 0;
+    for (i = 0; i < t->nmat; i++) any_tex |= t->tex1[i][0] != 0;
+    CHECK(s->vertex_count == t->nv && s->triangle_count == t->nt && s->material_count == t->nmat);
+    CHECK((s->uv != NULL) == any_tex && (s->vertex_rgb != NULL) == ((t->flags & 2) != 0));
+    if (s->vertex_count != t->nv || s->triangle_count != t->nt) return;
+    for (i = 0; i < t->nv; i++) {
+        CHECK(s->positions[3 * i] == t->pos[i][0] && s->positions[3 * i + 1] == t->pos[i][1] &&
+              s->positions[3 * i + 2] == t->pos[i][2]);
+        if (s->uv) CHECK(s->uv[2 * i] == t->uv[i][0] && s->uv[2 * i + 1] == t->uv[i][1]);
+        if (s->vertex_rgb) CHECK(!memcmp(s->vertex_rgb + 3 * i, t->rgb[i], 3));
+    }
+    for (i = 0; i < t->nt; i++) {
+        CHECK(!memcmp(s->indices + 3 * i, t->tri[i], sizeof t->tri[i]));
+        CHECK(s->triangle_material[i] == t->tmat[i]);
+    }
+    for (i = 0; i < t->nmat; i++)
+        CHECK(s->materials[i].image == -1 && s->materials[i].rgb[0] == 255 && s->materials[i].rgb[2] == 255);
+}
+
+static void test_spm_roundtrip(void) {
+    static spm_case t;
+    uint64_t seed = 61;
+    int round;
+    for (round = 0; round < 40; round++) {
+        sbytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        random_spm(&t, &seed);
+        write_spm(&b, &t, &seed);
+        if (!scene_import("spm", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "round %d: %s", round, err);
+        } else {
+            check_spm(&s, &t);
+            vdag_scene_free(&s);
+        }
+        free(b.p);
+    }
+}
+
+/* A small file with every optional field, cut and patched everywhere. */
+static void test_spm_sweep(void) {
+    static spm_case t;
+    uint64_t seed = 7;
+    sbytes b = {NULL, 0, 0};
+    memset(&t, 0, sizeof t);
+    t.flags = 7;
+    t.nmat = 2;
+    t.tex1[0] = "t.png", t.tex2[0] = "u.png", t.tex1[1] = "", t.tex2[1] = "";
+    t.nbuf = 2;
+    t.vc[0] = 3, t.ic[0] = 3, t.mid[0] = 0;
+    t.vc[1] = 4, t.ic[1] = 6, t.mid[1] = 1;
+    write_spm(&b, &t, &seed);
+    scene_sweep("spm", &b, 1);
+    free(b.p);
+}
+
+static void spm_header(sbytes *b, unsigned kind, unsigned flags, const char *tex) {
+    int i;
+    sput(b, "SP", 2);
+    sput_le(b, 1 << 3 | kind, 1);
+    sput_le(b, flags, 1);
+    for (i = 0; i < 6; i++) sput_f32(b, 0);
+    sput_le(b, 1, 2);
+    sput_le(b, strlen(tex), 1);
+    sput(b, tex, strlen(tex));
+    sput_le(b, 0, 1);
+}
+
+/* One mesh, one buffer: VC vertices at (I, 0, 0), then the indices. */
+static void spm_buffer(sbytes *b, uint32_t vc, uint32_t ic, unsigned mid, const uint32_t *idx, size_t n) {
+    uint32_t i;
+    sput_le(b, 1, 2);
+    sput_le(b, 1, 2);
+    sput_le(b, vc, 4);
+    sput_le(b, ic, 4);
+    sput_le(b, mid, 2);
+    for (i = 0; i < vc && i < 16; i++) {
+        sput_f32(b, (float)i);
+        sput_f32(b, 0);
+        sput_f32(b, 0);
+    }
+    for (i = 0; i < n; i++) sput_le(b, idx[i], 1);
+}
+
+static void test_spm_errors(void) {
+    static const uint32_t tri[3] = {0, 1, 2}, bad[3] = {0, 1, 3};
+    sbytes b = {NULL, 0, 0};
+    float nan_f = (float)NAN;
+    uint32_t u;
+    scene_error_text("spm", "", "no \"SP\" header");
+    scene_error_text("spm", "PS\x0a\x03", "no \"SP\" header");
+    spm_header(&b, 1, 0, "");
+    scene_error("spm", &b, "skinned");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 3, 1, tri, 3);
+    scene_error("spm", &b, "material 1 of 1");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 3, 0, bad, 3);
+    scene_error("spm", &b, "index 3 of 3 vertices");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 2, 0, tri, 2);
+    scene_error("spm", &b, "not whole triangles");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 0xffffffffu, 3, 0, tri, 3);
+    scene_error("spm", &b, "need more bytes than remain");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 0x7ffffffeu, 0, tri, 3);
+    scene_error("spm", &b, "need more bytes than remain");
+    b.n = 0;
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 3, 0, tri, 3);
+    sput_le(&b, 0, 1);
+    scene_error("spm", &b, "1 bytes after the last mesh");
+    b.n = 0; /* NaN position: a coordinate of the second vertex */
+    spm_header(&b, 2, 0, "");
+    spm_buffer(&b, 3, 3, 0, tri, 3);
+    memcpy(&u, &nan_f, 4);
+    memcpy(b.p + 28 + 4 + 14 + 12 + 4, &u, 4); /* header, material, buffer, vertex 0, x */
+    scene_error("spm", &b, "not a finite number");
+    b.n = 0; /* an infinite half texture coordinate */
+    spm_header(&b, 2, 0, "t.png");
+    sput_le(&b, 1, 2);
+    sput_le(&b, 1, 2);
+    sput_le(&b, 3, 4);
+    sput_le(&b, 3, 4);
+    sput_le(&b, 0, 2);
+    for (u = 0; u < 3; u++) {
+        sput_f32(&b, (float)u), sput_f32(&b, 0), sput_f32(&b, 0);
+        sput_le(&b, u == 2 ? 0x7c00 : 0, 2);
+        sput_le(&b, 0, 2);
+    }
+    sput(&b, "\0\1\2", 3);
+    scene_error("spm", &b, "vertex 2: not a finite number");
+    b.n = 0; /* a colour byte other than 128 without its RGB */
+    spm_header(&b, 2, 2, "");
+    sput_le(&b, 1, 2);
+    sput_le(&b, 1, 2);
+    sput_le(&b, 1, 4);
+    sput_le(&b, 0, 4);
+    sput_le(&b, 0, 2);
+    sput_f32(&b, 0), sput_f32(&b, 0), sput_f32(&b, 0);
+    sput_le(&b, 7, 1);
+    scene_error("spm", &b, "truncated");
+    free(b.p);
+}
+
+// -- .ac
+
+/* An AC3D scene: a world with two kids, the second placed by rot and loc
+   with a kid of its own placed again (transforms compose). Expected
+   positions are computed here from the same numbers. */
+typedef struct ac_case {
+    double v[3][8][3];   /* per object, local vertices */
+    int rot[3][9], loc[3][3];
+    uint32_t poly[3][2][5]; /* per object two polygons */
+    size_t poly_n[3][2];
+    int mat[3][2];
+} ac_case;
+
+static void ac_place(const ac_case *t, int obj, const double in[3], double out[3]) {
+    /* Objects 0 and 1 are kids of the world, object 2 a kid of object 1. */
+    double p[3], q[3];
+    int k, j, o;
+    memcpy(p, in, sizeof p);
+    for (o = obj; o >= 1; o--) { /* object 2 is inside object 1 */
+        for (k = 0; k < 3; k++) {
+            q[k] = t->loc[o][k];
+            for (j = 0; j < 3; j++) q[k] += t->rot[o][3 * k + j] * p[j];
+        }
+        memcpy(p, q, sizeof p);
+    }
+    out[0] = p[0];
+    out[1] = -p[2];
+    out[2] = p[1];
+}
+
+static void random_ac(ac_case *t, uint64_t *seed) {
+    static const int perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    int o, i, k;
+    for (o = 0; o < 3; o++) {
+        const int *pm = perms[test_rand_below(seed, 6)];
+        memset(t->rot[o], 0, sizeof t->rot[o]);
+        for (k = 0; k < 3; k++) {
+            t->rot[o][3 * k + pm[k]] = test_rand_below(seed, 2) ? 1 : -1;
+            t->loc[o][k] = (int)test_rand_below(seed, 21) - 10;
+        }
+        for (i = 0; i < 8; i++)
+            for (k = 0; k < 3; k++) t->v[o][i][k] = rand_eighths(seed, 10);
+        for (i = 0; i < 2; i++) {
+            t->poly_n[o][i] = 3 + test_rand_below(seed, 3);
+            for (k = 0; k < (int)t->poly_n[o][i]; k++) t->poly[o][i][k] = test_rand_below(seed, 8);
+            t->mat[o][i] = (int)test_rand_below(seed, 2);
+        }
+    }
+}
+
+static void write_ac_object(sbytes *b, const ac_case *t, int o) {
+    int i, k;
+    sputf(b, "OBJECT poly\nname \"part %d\"\ndata 12\nline1\n#line2\n\n", o);
+    if (o > 0) {
+        sputf(b, "rot");
+        for (k = 0; k < 9; k++) sputf(b, " %d", t->rot[o][k]);
+        sputf(b, "\nloc %d %d %d\n", t->loc[o][0], t->loc[o][1], t->loc[o][2]);
+    }
+    sputf(b, "crease 45.0\nnumvert 8\n");
+    for (i = 0; i < 8; i++) sputf(b, "%g %g %g\n", t->v[o][i][0], t->v[o][i][1], t->v[o][i][2]);
+    sputf(b, "numsurf 3\nSURF 0x22\nmat 0\nrefs 2\n0 0 0\n1 0 0\n");
+    for (i = 0; i < 2; i++) {
+        sputf(b, "SURF 0x%d0\nmat %d\nrefs %zu\n", i + 1, t->mat[o][i], t->poly_n[o][i]);
+        for (k = 0; k < (int)t->poly_n[o][i]; k++) sputf(b, "%u 0.5 0.25\n", t->poly[o][i][k]);
+    }
+}
+
+static void write_ac(sbytes *b, const ac_case *t) {
+    sputf(b, "AC3Db\nMATERIAL \"red # one\" rgb 1 0 0  amb 0.2 0.2 0.2  emis 0 0 0  spec 0 0 0  shi 10  trans 0\n");
+    sputf(b, "MATERIAL \"\" rgb 0.2 0.4 1 amb 1 1 1 emis 0 0 0 spec 0 0 0 shi 0 trans 0\n");
+    sputf(b, "OBJECT world\nkids 2\n");
+    write_ac_object(b, t, 0);
+    sputf(b, "kids 0\n");
+    write_ac_object(b, t, 1);
+    sputf(b, "kids 1\n");
+    write_ac_object(b, t, 2);
+    sputf(b, "kids 0\n");
+}
+
+static void test_ac_roundtrip(void) {
+    ac_case t;
+    uint64_t seed = 5;
+    int round;
+    for (round = 0; round < 30; round++) {
+        sbytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        size_t nv = 0, nt = 0, o, i, k;
+        int first_mat = -1;
+        random_ac(&t, &seed);
+        write_ac(&b, &t);
+        if (!scene_import("ac", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "round %d: %s", round, err);
+            free(b.p);
+            continue;
+        }
+        CHECK(s.uv == NULL && s.image_count == 0);
+        for (o = 0; o < 3; o++)
+            for (i = 0; i < 2; i++) {
+                size_t n = t.poly_n[o][i];
+                int32_t want_mat;
+                if (first_mat < 0) first_mat = t.mat[o][i];
+                want_mat = t.mat[o][i] == first_mat ? 0 : 1; /* materials numbered by first use */
+                for (k = 0; k < n && nv + k < s.vertex_count; k++) {
+                    double want[3];
+                    ac_place(&t, (int)o, t.v[o][t.poly[o][i][k]], want);
+                    CHECK_MSG(s.positions[3 * (nv + k)] == want[0] && s.positions[3 * (nv + k) + 1] == want[1] &&
+                                  s.positions[3 * (nv + k) + 2] == want[2],
+                              "object %zu corner %zu", o, k);
+                }
+                for (k = 1; k + 1 < n && nt < s.triangle_count; k++, nt++) {
+                    CHECK(s.indices[3 * nt] == nv && s.indices[3 * nt + 1] == nv + k &&
+                          s.indices[3 * nt + 2] == nv + k + 1);
+                    CHECK(s.triangle_material[nt] == want_mat);
+                }
+                nv += n;
+            }
+        CHECK(s.vertex_count == nv && s.triangle_count == nt);
+        CHECK(s.material_count >= 1 && s.material_count <= 2);
+        for (i = 0; i < s.material_count; i++) {
+            int m = (int)i == 0 ? first_mat : 1 - first_mat;
+            static const uint8_t want[2][3] = {{255, 0, 0}, {51, 102, 255}};
+            CHECK(!memcmp(s.materials[i].rgb, want[m], 3) && s.materials[i].image == -1);
+        }
+        vdag_scene_free(&s);
+        free(b.p);
+    }
+}
+
+static void test_ac_sweep(void) {
+    ac_case t;
+    uint64_t seed = 3;
+    sbytes b = {NULL, 0, 0};
+    random_ac(&t, &seed);
+    write_ac(&b, &t);
+    scene_sweep("ac", &b, 0);
+    free(b.p);
+}
+
+static void test_ac_errors(void) {
+    static const char obj[] = "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n";
+    char text[512];
+    int i;
+    sbytes b = {NULL, 0, 0};
+    scene_error_text("ac", "", "no \"AC3D\" header");
+    scene_error_text("ac", "ply\n", "no \"AC3D\" header");
+    scene_error_text("ac", "AC3Db\nMATERIAL \"m\"\n", "MATERIAL without rgb");
+    scene_error_text("ac", "AC3Db\nfoo\n", "expected MATERIAL or OBJECT");
+    scene_error_text("ac", "AC3Db\nOBJECT world\nname \"w\"\n", "without kids line");
+    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 2\nOBJECT poly\nkids 0\n", "missing kids");
+    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 1\nnumvert 1\n", "expected OBJECT");
+    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 99999999\n", "bad kids count");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 4000000000\n0 0 0\n", "bad numvert count");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 nan 0\nkids 0\n", "a vertex needs 3 numbers");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 0\nkids 0\n", "a vertex needs 3 numbers");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nrot 1 0 0 0 1 0 0 0\n", "rot needs 9 numbers");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nloc 1 inf 0\n", "loc needs 3 numbers");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\nloc 1e30 0 0\nnumvert 1\n1e30 0 0\nkids 0\n", "out of range once placed");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\ndata 100\nabc\n", "bad data length");
+    scene_error_text("ac", "AC3Db\nOBJECT poly\ntexture \"a.png\nkids 0\n", "unterminated texture name");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nmat 1\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
+    scene_error_text("ac", text, "material out of range");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n3 0 0\nkids 0\n", obj);
+    scene_error_text("ac", text, "vertex index out of range");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nrefs 3\n0 0 0\n1 nan 0\n2 0 0\nkids 0\n", obj);
+    scene_error_text("ac", text, "bad texture coordinates");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0xzz\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
+    scene_error_text("ac", text, "bad SURF flags");
+    snprintf(text, sizeof text, "%snumsurf 2\nSURF 0x0\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
+    scene_error_text("ac", text, "expected SURF flags");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nrefs 3\n0 0 0\n", obj);
+    scene_error_text("ac", text, "truncated refs");
+    snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nfoo\n", obj);
+    scene_error_text("ac", text, "expected mat or refs");
+    /* Nesting deeper than any real file: an error, not a stack overflow. */
+    sputf(&b, "AC3Db\n");
+    for (i = 0; i < 300; i++) sputf(&b, "OBJECT group\nkids 1\n");
+    scene_error("ac", &b, "nested too deep");
+    free(b.p);
+}
+
+// -- Files: texture look-up
+
+static const uint8_t scene_pixels[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 9, 8, 7};
+
+static int sfile(const char *path, const void *data, size_t n) {
+    FILE *f = fopen(path, "wb");
+    size_t got;
+    if (!f) return 0;
+    got = fwrite(data, 1, n, f);
+    return fclose(f) == 0 && got == n;
+}
+
+static void ppm(const char *path, int variant) {
+    sbytes b = {NULL, 0, 0};
+    sputf(&b, "P6\n%d 2\n255\n", 2);
+    sput(&b, scene_pixels, sizeof scene_pixels);
+    b.p[b.n - 1] = (uint8_t)variant;
+    CHECK(sfile(path, b.p, b.n));
+    free(b.p);
+}
+
+/* .spm textures: beside the file, in ../../textures, in ../../library/X;
+   a missing one leaves the material white. .ac: beside the file, with
+   texrep and texoff applied to the coordinates. */
+static void test_scene_files(void) {
+    char dir[] = "/tmp/vdag-scene-XXXXXX", p[32][320], err[512];
+    static spm_case t;
+    static const char *const made[] = {"tracks", "tracks/t", "textures", "library", "library/lib1"};
+    uint64_t seed = 11;
+    sbytes b = {NULL, 0, 0};
+    vdag_scene s;
+    vdag_image probe;
+    int decodes, i, n = 0;
+    CHECK(mkdtemp(dir) != NULL);
+    for (i = 0; i < 5; i++) {
+        snprintf(p[n], sizeof p[n], "%s/%s", dir, made[i]);
+        CHECK(mkdir(p[n++], 0700) == 0);
+    }
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/near.ppm", dir), ppm(p[n++], 1);
+    snprintf(p[n], sizeof p[n], "%s/textures/shared.ppm", dir), ppm(p[n++], 2);
+    snprintf(p[n], sizeof p[n], "%s/library/lib1/lib.ppm", dir), ppm(p[n++], 3);
+    decodes = vdag_image_load(p[n - 1], &probe, err, sizeof err);
+    vdag_image_free(&probe);
+
+    memset(&t, 0, sizeof t);
+    t.flags = 0;
+    t.nmat = 3;
+    t.tex1[0] = "lib.ppm", t.tex1[1] = "near.ppm", t.tex1[2] = "missing.ppm";
+    t.tex2[0] = t.tex2[1] = t.tex2[2] = "";
+    t.nbuf = 3;
+    for (i = 0; i < 3; i++) t.vc[i] = 3, t.ic[i] = 3, t.mid[i] = (unsigned)i;
+    write_spm(&b, &t, &seed);
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/track.spm", dir);
+    CHECK(sfile(p[n], b.p, b.n));
+    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.material_count == 3 && s.triangle_count == 3 && s.uv != NULL);
+        CHECK(s.materials[2].image == -1);
+        if (decodes) {
+            CHECK(s.image_count == 2 && s.materials[0].image == 0 && s.materials[1].image == 1);
+            CHECK(s.image_count == 2 && s.images[0].rgb[11] == 3 && s.images[1].rgb[11] == 1);
+        } else {
+            CHECK(s.image_count == 0 && s.materials[0].image == -1);
+        }
+        vdag_scene_free(&s);
+    }
+    b.n = 0;
+    t.tex1[0] = "shared.ppm";
+    write_spm(&b, &t, &seed);
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/track2.spm", dir);
+    CHECK(sfile(p[n], b.p, b.n));
+    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        if (decodes) CHECK(s.image_count == 2 && s.materials[0].image == 0 && s.images[0].rgb[11] == 2);
+        vdag_scene_free(&s);
+    }
+
+    b.n = 0;
+    sputf(&b, "AC3Db\nMATERIAL \"m\" rgb 0 1 0\nOBJECT world\nkids 2\nOBJECT poly\ntexture \"near.ppm\"\n"
+              "texture \"ignored.png\"\ntexrep 2 4\ntexoff 0.5 0.25\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n"
+              "numsurf 1\nSURF 0x10\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0.5 1\nkids 0\n"
+              "OBJECT poly\ntexture empty_texture_no_mapping\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n"
+              "numsurf 1\nSURF 0x10\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0.5 1\nkids 0\n");
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/model.ac", dir);
+    CHECK(sfile(p[n], b.p, b.n));
+    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.triangle_count == 2 && s.material_count == (decodes ? 2u : 1u));
+        CHECK(s.materials[0].rgb[1] == 255 && s.materials[s.material_count - 1].image == -1);
+        if (decodes) {
+            CHECK(s.uv != NULL && s.image_count == 1 && s.materials[0].image == 0);
+            CHECK(s.uv && s.uv[0] == 0.5f && s.uv[1] == 0.25f && s.uv[2] == 2.5f && s.uv[3] == 0.25f &&
+                  s.uv[4] == 1.5f && s.uv[5] == 4.25f);
+        } else {
+            CHECK(s.uv == NULL && s.materials[0].image == -1);
+        }
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+    while (n-- > 0) remove(p[n]); /* files, then folders, deepest first */
+    rmdir(dir);
+}
+
+const test_case test_import_scene_cases[] = {
+    {"import_scene/spm roundtrip", test_spm_roundtrip},
+    {"import_scene/spm sweep", test_spm_sweep},
+    {"import_scene/spm errors", test_spm_errors},
+    {"import_scene/ac roundtrip", test_ac_roundtrip},
+    {"import_scene/ac sweep", test_ac_sweep},
+    {"import_scene/ac errors", test_ac_errors},
+    {"import_scene/texture files", test_scene_files},
+    {NULL, NULL},
+};
