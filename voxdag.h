@@ -329,8 +329,8 @@ typedef struct voxdag_ray_opts {
     double lod_factor; /* size of one pixel at distance t = 1, in grid units */
     double lod_pixels; /* stop at a full cell whose projected size, cell side /
                           (t * lod_factor), is below this; 0 = full detail. Cells
-                          are nodes: 4^3 bricks and coarser (a brick resolves
-                          to voxels) */
+                          are nodes (4^3 bricks and coarser) and the 2^3 cells
+                          of a brick (full when any of their 8 voxels is) */
 } voxdag_ray_opts;
 
 typedef struct voxdag_hit {
@@ -1984,16 +1984,31 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, uint32_
 // fewest bytes, where the paper fixes 2 and 4; with byte-aligned, unpadded
 // records this is what pays for the counts.
 
-typedef struct voxdagi_sortrec {
-    uint32_t refs, id;
-    uint64_t key;
-} voxdagi_sortrec;
-
-static int voxdagi_sortrec_cmp(const void *pa, const void *pb) {
-    const voxdagi_sortrec *a = (const voxdagi_sortrec *)pa, *b = (const voxdagi_sortrec *)pb;
-    if (a->refs != b->refs) return a->refs > b->refs ? -1 : 1;
-    if (a->key != b->key) return a->key < b->key ? -1 : 1;
-    return a->id < b->id ? -1 : a->id > b->id;
+/* Storage order of a level: most referenced first, ties by fingerprint (or
+   mask), then by id; two stable radix sorts. Fills ORDER with ids. Returns 0
+   when out of memory. */
+static int voxdagi_storage_order(voxdagi_mem *m, const voxdagi_store *s, const uint32_t *refs,
+                                 uint32_t *order) {
+    size_t n = s->n, i;
+    uint64_t *key = (uint64_t *)voxdagi_alloc(m, n * sizeof *key);
+    uint64_t *tmp_key = (uint64_t *)voxdagi_alloc(m, n * sizeof *tmp_key);
+    uint32_t *tmp_id = (uint32_t *)voxdagi_alloc(m, n * sizeof *tmp_id);
+    uint32_t max_refs = 0;
+    int ok = key && tmp_key && tmp_id;
+    if (ok) {
+        for (i = 0; i < n; i++) {
+            key[i] = s->key[i];
+            order[i] = (uint32_t)i;
+            if (refs[i] > max_refs) max_refs = refs[i];
+        }
+        voxdagi_radix_sort(key, order, tmp_key, tmp_id, n, 64);
+        for (i = 0; i < n; i++) key[i] = max_refs - refs[order[i]];
+        voxdagi_radix_sort(key, order, tmp_key, tmp_id, n, 8 * voxdagi_bytes_for(max_refs));
+    }
+    voxdagi_free(m, key, n * sizeof *key);
+    voxdagi_free(m, tmp_key, n * sizeof *tmp_key);
+    voxdagi_free(m, tmp_id, n * sizeof *tmp_id);
+    return ok;
 }
 
 /* The tag (1..3) of the smallest pointer size of the level that holds V. */
@@ -2073,19 +2088,13 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     for (l = B + 1; ok && l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
         size_t n = s->n, i;
-        voxdagi_sortrec *rec = (voxdagi_sortrec *)voxdagi_alloc(e->mem, n * sizeof *rec);
         uint64_t at = 0, max_count = 0;
-        if (!rec) {
+        if (!voxdagi_storage_order(e->mem, s, refs[l], e->order[l])) {
             ok = 0;
             break;
         }
-        for (i = 0; i < n; i++) {
-            rec[i].refs = refs[l][i];
-            rec[i].id = (uint32_t)i;
-            rec[i].key = s->key[i];
-            if (s->count && s->count[i] > max_count) max_count = s->count[i];
-        }
-        qsort(rec, n, sizeof *rec, voxdagi_sortrec_cmp);
+        for (i = 0; s->count && i < n; i++)
+            if (s->count[i] > max_count) max_count = s->count[i];
         if (l < B) {
             uint64_t need[9] = {0};
             unsigned j;
@@ -2095,8 +2104,7 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
                     need[voxdagi_bytes_for(e->pos[l + 1][s->child[i] >> 3] << 3 | (s->child[i] & 7))]++;
             voxdagi_choose_sizes(need, e->ptr_bytes[l]);
             for (i = 0; i < n; i++) {
-                uint32_t id = rec[i].id;
-                e->order[l][i] = id;
+                uint32_t id = e->order[l][i];
                 e->pos[l][id] = at;
                 at += 2 + e->count_bytes[l];
                 for (j = 0; j < 8; j++) {
@@ -2107,13 +2115,9 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
                 }
             }
         } else {
-            for (i = 0; i < n; i++) {
-                e->order[l][i] = rec[i].id;
-                e->pos[l][rec[i].id] = i;
-            }
+            for (i = 0; i < n; i++) e->pos[l][e->order[l][i]] = i;
         }
         e->size[l] = at;
-        voxdagi_free(e->mem, rec, n * sizeof *rec);
     }
     for (l = 0; l <= B; l++) voxdagi_free(e->mem, refs[l], r->store[l].n * sizeof(uint32_t));
     return ok;
@@ -2911,6 +2915,8 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 // the walk jumps straight there, like the paper's conditional push but with
 // no push: per node level it keeps only the record, header and mirror to
 // return to, which also give the voxel index at the hit in one pass.
+// A brick is walked as 4^3 voxels in one level, or, when level of detail can
+// stop inside it, as 2^3 cells (a byte of the mask each) and then voxels.
 
 #include <math.h>
 
@@ -2948,8 +2954,11 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
             if ((f[k].header >> (2 * j) & 3) && (j ^ f[k].mirror) < w)
                 idx += voxdagi_node_count(d, k + 1, voxdagi_child(&d->level[k], f[k].rec, f[k].header, j) >> 3);
     }
-    if (q == d->levels) {
-        unsigned p = voxdagi_brick_pos(c);
+    if (q > B) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
+        uint32_t v[3];
+        unsigned p;
+        for (k = 0; k < 3; k++) v[k] = c[k] << (d->levels - q);
+        p = voxdagi_brick_pos(v);
         idx += (uint64_t)voxdagi_popcount64(voxdagi_reflect_brick(mask, f[B].mirror) & ((1ull << p) - 1));
     }
     return idx;
@@ -2964,6 +2973,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
     int sgn[3];
     unsigned ae = 0, ax = 0, a, M = d->root_mirror, header = 0;
+    int split;
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
 
@@ -2986,6 +2996,10 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     if (ray->t_min >= te) te = ray->t_min, ae = 3;
     if (tx < te || (tx == te && ax < ae) || te > ray->t_max) return 0;
     t_stop = tx == HUGE_VAL ? te : ray->t_max < tx ? ray->t_max : tx;
+    /* Level of detail may stop at a 2^3 cell of a brick before t_stop: then
+       bricks are walked as two levels (l = B: 2^3 cells, l = B + 1: voxels),
+       else as one level of 4^3 voxels. */
+    split = 2.0 < lod * t_stop;
 
     for (;;) {
         /* Enter node (l, at, M), which is cell c of level q. */
@@ -2995,10 +3009,12 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             header = (unsigned)voxdagi_le(rec, 2);
             f[l].rec = rec;
             f[l].header = header;
-        } else {
+        } else if (l == B) {
             mask = voxdagi_brick(d, at);
-            halves = 2;
-        }
+            f[l].rec = NULL;
+            f[l].header = 0;
+            halves = split ? 1 : 2;
+        } /* else l == B + 1: a 2^3 cell of the same brick */
         f[l].mirror = M;
         while (halves--) { /* the child cell: which mid planes are crossed by (te, ae) */
             uint32_t sh = L - q - 1;
@@ -3023,8 +3039,10 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             int k;
             if (l < B) {
                 if (header >> (2 * (((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M)) & 3) break;
-            } else if (mask >> (voxdagi_brick_pos(c) ^ (M | M << 3)) & 1) {
-                break;
+            } else if (q == L) {
+                if (mask >> (voxdagi_brick_pos(c) ^ (M | M << 3)) & 1) break;
+            } else if (mask >> 8 * (((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M) & 0xFF) {
+                break; /* a 2^3 cell: one byte of the brick, any bit */
             }
             sh = L - q;
             t = ((double)((c[0] + up[0]) << sh) - ox[0]) * ix[0];
@@ -3058,13 +3076,13 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             hit->index = want_index ? voxdagi_ray_index(d, f, mask, c, q) : 0;
             return 1;
         }
-        {
+        if (l < B) {
             uint64_t ptr = voxdagi_child(&d->level[l], rec, header,
                                          ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M);
             M ^= (unsigned)(ptr & 7);
             at = ptr >> 3;
-            l++;
         }
+        l++;
     }
 }
 
