@@ -4,6 +4,7 @@
 # dpkg-deb -x, npm packages with npm pack. Safe to run again (skips what is
 # already there).
 #   bench/fetch.sh DEST        (the Makefile uses bench/data)
+#   bench/fetch.sh DEST scenes (also the game scenes of bench/real_scenes.md)
 # Result, under DEST:
 #   tree.vox      MagicaVoxel scene (npm vox-reader, MIT)
 #   liver.inr     CGAL liver label volume, decompressed (Debian libcgal-demo, CC0)
@@ -36,5 +37,15 @@ if [ ! -s tree.vox ]; then
           mkdir -p vox-reader && tar xzf "$f" -C vox-reader
       } )
     cp npm/vox-reader/package/test/tree.vox tree.vox
+fi
+# Game scenes, left in their package trees so that their textures are found:
+# x/supertuxkart-data/.../tracks/abyss/abyss_track.spm (CC-BY-SA-4.0) and
+# x/flightgear-data-models/.../CG-57-high-detail/CG-57.ac (GPL-2+); ~900 MB.
+if [ "${2:-}" = scenes ]; then
+    for p in supertuxkart-data flightgear-data-models; do
+        [ -d "x/$p" ] && continue
+        ls debs/${p}_*.deb >/dev/null 2>&1 || ( cd debs && apt-get download -q "$p" ) || { echo "cannot fetch $p" >&2; continue; }
+        dpkg-deb -x debs/${p}_*.deb "x/$p"
+    done
 fi
 ls -l tree.vox liver.inr bunny.off armadillo.off dragon.off

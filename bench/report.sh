@@ -40,6 +40,7 @@ cpu=$(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1)
         fi
     done
     if [ -f bench/reading.md ]; then cat bench/reading.md; echo; fi
+    if [ -f bench/real_scenes.md ]; then cat bench/real_scenes.md; echo; fi
     echo "Total benchmark time: $(( $(date +%s) - start )) s."
 } > "$tmp"
 mv "$tmp" BENCHMARKS.md
