@@ -65,7 +65,9 @@
 #endif
 
 #ifndef VOXDAG_API
-#ifdef VOXDAG_STATIC
+#if defined(VOXDAG_STATIC) && (defined(__GNUC__) || defined(__clang__))
+#define VOXDAG_API static __attribute__((unused)) /* a unit may use only some */
+#elif defined(VOXDAG_STATIC)
 #define VOXDAG_API static
 #else
 #define VOXDAG_API extern
