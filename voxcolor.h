@@ -81,7 +81,9 @@
 #define VOXCOLOR_DEFAULT_PAGE_SHIFT 8
 
 #ifndef VOXCOLOR_API
-#ifdef VOXCOLOR_STATIC
+#if defined(VOXCOLOR_STATIC) && (defined(__GNUC__) || defined(__clang__))
+#define VOXCOLOR_API static __attribute__((unused)) /* a unit may use only some */
+#elif defined(VOXCOLOR_STATIC)
 #define VOXCOLOR_API static
 #else
 #define VOXCOLOR_API extern
