@@ -118,5 +118,101 @@ assert all(p[3:] == (255, 0, 0) for p in v)
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
 
+# -- vdag rays / vdag render: answers from an independent python3 oracle
+# Scene: 400 random voxels in 16^3; rays along the axes (unit and non-unit
+# directions) from outside the grid and from inside voxels, whose first hit,
+# distance and entry normal follow from the sorted voxels along the line.
+python3 - "$T" <<'EOF'
+import math, random, sys
+t = sys.argv[1]
+random.seed(11)
+n = 16
+vox = {}
+while len(vox) < 400:
+    vox[tuple(random.randrange(n) for _ in range(3))] = tuple(random.randrange(256) for _ in range(3))
+with open(t + "/r.xyz", "w") as f:
+    for p, c in vox.items():
+        f.write("%d %d %d %d %d %d\n" % (p + c))
+def morton(p):
+    return sum(((p[a] >> b) & 1) << (3 * b + a) for b in range(4) for a in range(3))
+rank = {p: i for i, p in enumerate(sorted(vox, key=morton))}
+rays, want = [], []
+def expect(o, d):
+    a = next(k for k in range(3) if d[k])
+    s = d[a]
+    cell = [int(o[k]) for k in range(3)]  # o off the planes on the fixed axes
+    # the voxel the ray starts in: on a face plane, the one it moves into
+    cell[a] = math.floor(o[a]) if s > 0 else math.ceil(o[a]) - 1
+    hits = []
+    for x in range(n):
+        q = list(cell); q[a] = x; q = tuple(q)
+        if q not in vox or (x - cell[a]) * s < 0:
+            continue  # empty or behind the start
+        if x == cell[a]:
+            hits.append((0.0, q, (0, 0, 0)))
+        else:
+            plane = x if s > 0 else x + 1
+            nrm = [0, 0, 0]; nrm[a] = -1 if s > 0 else 1
+            hits.append(((plane - o[a]) * (1.0 / s), q, tuple(nrm)))  # t as voxdag.h defines it
+    if not hits:
+        return "miss"
+    tt, q, nrm = min(hits)
+    return (tt, q, nrm, rank[q], vox[q])
+for i in range(300):
+    a = random.randrange(3)
+    s = random.choice([1, -1, 2.5, -0.5])
+    o = [random.randrange(n) + random.choice([0.5, 0.25]) for _ in range(3)]
+    kind = random.randrange(3)
+    if kind == 0:
+        o[a] = -3.0 if s > 0 else n + 3.0   # from outside
+    elif kind == 1:
+        o[a] = float(random.randrange(n + 1))  # on a face plane
+    d = [0, 0, 0]; d[a] = s
+    rays.append("%r %r %r %r %r %r" % (*o, *d))
+    want.append(expect(o, d))
+for p in list(vox)[:20]:  # from inside each of these voxels, along +y
+    o = [p[0] + 0.5, p[1] + 0.5, p[2] + 0.5]
+    rays.append("%r %r %r 0 1 0" % tuple(o))
+    want.append((0.0, p, (0, 0, 0), rank[p], vox[p]))
+open(t + "/rays.txt", "w").write("\n".join(rays) + "\n")
+import json
+json.dump(want, open(t + "/rays.json", "w"))
+EOF
+check "build the ray scene" "$VDAG" build "$T/r.xyz" "$T/r.vdag" --levels 4 2>/dev/null
+check "rays: format and answers of DESIGN 7" sh -c "'$VDAG' rays '$T/r.vdag' <'$T/rays.txt' >'$T/rays.out' && python3 - '$T' <<'EOF'
+import json, re, sys
+t = sys.argv[1]
+want = json.load(open(t + '/rays.json'))
+got = open(t + '/rays.out').read().split('\n')
+assert got[-1] == '' and len(got) == len(want) + 1, (len(got), len(want))
+pat = re.compile(r'^hit (\S+) (\d+) (\d+) (\d+) (-?[01]) (-?[01]) (-?[01]) (\d+) (\d+) (\d+) (\d+)$')
+misses = 0
+for i, (g, w) in enumerate(zip(got, want)):
+    if w == 'miss':
+        assert g == 'miss', (i, g)
+        misses += 1
+        continue
+    m = pat.match(g)
+    assert m, (i, g)
+    v = m.groups()
+    assert float(v[0]) == w[0], (i, g, w)
+    assert [int(x) for x in v[1:4]] == w[1] and [int(x) for x in v[4:7]] == w[2], (i, g, w)
+    assert int(v[7]) == w[3] and [int(x) for x in v[8:11]] == w[4], (i, g, w)
+assert 20 < misses < len(want) - 150, misses
+EOF"
+check "rays: a malformed line fails with one line" sh -c "! printf '1 2 3 0 0 1\n1 2 x 0 0 1\n' |
+    '$VDAG' rays '$T/r.vdag' >/dev/null 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
+check "rays: trailing text fails" sh -c "! echo '1 2 3 0 0 1 7' | '$VDAG' rays '$T/r.vdag' >/dev/null 2>&1"
+check "render: a PNG of the requested size" sh -c "'$VDAG' render '$T/r.vdag' '$T/r.png' --size 37x23 --threads 2 2>/dev/null &&
+    python3 -c \"
+import struct, sys
+b = open('$T/r.png', 'rb').read()
+assert b[:8] == b'\\\\x89PNG\\\\r\\\\n\\\\x1a\\\\n' and b[12:16] == b'IHDR', b[:16]
+assert struct.unpack('>II', b[16:24]) == (37, 23) and b[24:26] == bytes([8, 2])
+assert b[-8:-4] == b'IEND'
+\""
+check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
+
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]
