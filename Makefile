@@ -144,16 +144,18 @@ bench-geometry: bench-data $(BUILD)/bench/bench_geometry
 	$(BUILD)/bench/bench_geometry bench/data $(BENCH_FLAGS)
 
 # bench-rays: primary-ray throughput next to NanoVDB (libnanovdb-dev headers,
-# when installed: the peer is compiled with $(CXX), else voxdag alone).
+# when installed: the peer is compiled with $(CXX), else voxdag alone) and
+# Embree on the source triangles (libembree-dev, when installed).
 NANOVDB = $(shell test -f /usr/include/nanovdb/NanoVDB.h && echo 1)
+EMBREE  = $(shell test -f /usr/include/embree3/rtcore.h && echo 1)
 $(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench/bench_rays_peer.h $(BENCH_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) -c -o $(BUILD)/bench/import.o examples/import.c
 	$(CC) $(BENCH_CFLAGS) -c -o $(BUILD)/bench/image_none.o examples/image_none.c
-	$(CC) $(BENCH_CFLAGS) $(if $(NANOVDB),-DBENCH_NANOVDB) -c -o $(BUILD)/bench/bench_rays.o bench/bench_rays.c
+	$(CC) $(BENCH_CFLAGS) $(if $(NANOVDB),-DBENCH_NANOVDB) $(if $(EMBREE),-DBENCH_EMBREE) -c -o $(BUILD)/bench/bench_rays.o bench/bench_rays.c
 	$(if $(NANOVDB),$(CXX) -std=c++17 -O2 -c -o $(BUILD)/bench/bench_rays_nanovdb.o bench/bench_rays_nanovdb.cpp)
 	$(if $(NANOVDB),$(CXX),$(CC)) -o $@ $(BUILD)/bench/bench_rays.o $(if $(NANOVDB),$(BUILD)/bench/bench_rays_nanovdb.o) \
-	    $(BUILD)/bench/import.o $(BUILD)/bench/image_none.o $(THREADS) -lm
+	    $(BUILD)/bench/import.o $(BUILD)/bench/image_none.o $(if $(EMBREE),-lembree3) $(THREADS) -lm
 .PHONY: bench-rays
 bench-rays: bench-data $(BUILD)/bench/bench_rays
 	$(BUILD)/bench/bench_rays bench/data $(BENCH_FLAGS)

@@ -1,19 +1,28 @@
 /* Primary-ray throughput of voxdag_raycast, one thread and all threads, next
    to NanoVDB's hierarchical DDA over the same voxels when its headers are
-   installed (BENCH_NANOVDB). Prints a markdown table.
+   installed (BENCH_NANOVDB) and to Embree on the source triangles of mesh
+   scenes (BENCH_EMBREE). Prints a markdown table.
      bench_rays DATA_DIR [--quick] [--size N]
    Every scene is viewed from the same diagonal direction, framed on its
-   voxels' bounding sphere (fov 40 degrees), N x N rays (default 512). Agreement
-   = share of rays on which both give the same hit voxel or both miss
-   (NanoVDB marches in float with a small forward nudge, so near edges and
-   corners it may pick a neighbour). */
+   voxels' bounding sphere (fov 40 degrees), N x N rays (default 512). Meshes
+   are voxelized by the library (voxdag_builder_add_mesh, the grid fitted to
+   the bounding box as `vdag build` does); Embree traces the same triangles in
+   the same grid units. Agreement = share of rays on which a voxel peer gives
+   the same hit voxel or both miss (NanoVDB marches in float with a small
+   forward nudge, so near edges and corners it may pick a neighbour). Besides
+   wall-clock rays/s, rays per CPU-second (getrusage: user + system time of
+   the process) are reported, which other load on the machine disturbs less. */
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "bench/scenes.h"
 #include "bench/bench_rays_peer.h"
 
 #include <pthread.h>
+#include <sys/resource.h>
 #include <unistd.h>
+#ifdef BENCH_EMBREE
+#include <embree3/rtcore.h>
+#endif
 
 typedef struct rays {
     size_t n;
@@ -56,6 +65,7 @@ typedef struct run {
     const rays *r;
     const voxdag *dag;
     const bench_peer *peer;
+    const void *embree; /* an RTCScene */
     uint32_t *hit_xyz; /* 3 per ray; UINT32_MAX = miss */
     unsigned thread, threads;
     size_t hits;
@@ -76,8 +86,25 @@ static void *run_worker(void *arg) {
             ray.t_min = 0, ray.t_max = HUGE_VAL;
             got = voxdag_raycast(w->dag, &ray, NULL, &hit);
             if (got) memcpy(out, hit.xyz, sizeof hit.xyz);
-        } else {
+        } else if (w->peer) {
             got = bench_peer_trace(w->peer, w->r->eye, w->r->dir + 3 * i, out);
+        } else {
+#ifdef BENCH_EMBREE
+            struct RTCIntersectContext ctx;
+            struct RTCRayHit rh;
+            const double *d = w->r->dir + 3 * i;
+            rtcInitIntersectContext(&ctx);
+            memset(&rh, 0, sizeof rh);
+            rh.ray.org_x = (float)w->r->eye[0], rh.ray.org_y = (float)w->r->eye[1], rh.ray.org_z = (float)w->r->eye[2];
+            rh.ray.dir_x = (float)d[0], rh.ray.dir_y = (float)d[1], rh.ray.dir_z = (float)d[2];
+            rh.ray.tnear = 0, rh.ray.tfar = INFINITY, rh.ray.mask = ~0u;
+            rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            rtcIntersect1((RTCScene)(uintptr_t)w->embree, &ctx, &rh);
+            got = rh.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+            out[0] = out[1] = out[2] = 0;
+#else
+            got = 0;
+#endif
         }
         if (!got) out[0] = out[1] = out[2] = UINT32_MAX;
         w->hits += (size_t)got;
@@ -85,19 +112,30 @@ static void *run_worker(void *arg) {
     return NULL;
 }
 
-/* Best of 3 runs, in rays per second; fills HIT_XYZ. */
-static double timed(const rays *r, const voxdag *dag, const bench_peer *peer, unsigned threads, uint32_t *hit_xyz,
-                    size_t *hits) {
-    double best = 0;
+static double cpu_seconds(void) {
+    struct rusage u;
+    getrusage(RUSAGE_SELF, &u);
+    return (double)u.ru_utime.tv_sec + u.ru_utime.tv_usec * 1e-6 + (double)u.ru_stime.tv_sec +
+           u.ru_stime.tv_usec * 1e-6;
+}
+
+typedef struct speed {
+    double wall, cpu; /* rays per wall-clock second and per CPU-second, best of 3 */
+} speed;
+
+/* Best of 3 runs; fills HIT_XYZ. */
+static speed timed(const rays *r, const voxdag *dag, const bench_peer *peer, const void *embree, unsigned threads,
+                   uint32_t *hit_xyz, size_t *hits) {
+    speed best = {0, 0};
     int rep;
     for (rep = 0; rep < 3; rep++) {
         run w[64];
         pthread_t tid[64];
         unsigned t;
-        double t0 = bench_now(), secs;
+        double t0 = bench_now(), c0 = cpu_seconds(), secs, cpu;
         *hits = 0;
         for (t = 0; t < threads; t++) {
-            w[t].r = r, w[t].dag = dag, w[t].peer = peer, w[t].hit_xyz = hit_xyz;
+            w[t].r = r, w[t].dag = dag, w[t].peer = peer, w[t].embree = embree, w[t].hit_xyz = hit_xyz;
             w[t].thread = t, w[t].threads = threads;
             if (threads == 1) run_worker(&w[0]);
             else pthread_create(&tid[t], NULL, run_worker, &w[t]);
@@ -107,9 +145,135 @@ static double timed(const rays *r, const voxdag *dag, const bench_peer *peer, un
             *hits += w[t].hits;
         }
         secs = bench_now() - t0;
-        if (r->n / secs > best) best = (double)r->n / secs;
+        cpu = cpu_seconds() - c0;
+        if (r->n / secs > best.wall) best.wall = (double)r->n / secs;
+        if (cpu > 0 && r->n / cpu > best.cpu) best.cpu = (double)r->n / cpu;
     }
     return best;
+}
+
+// -- Scenes: the DAG, the voxels (for NanoVDB), the source triangles (for Embree)
+
+typedef struct scene {
+    bscene v;
+    voxdag *dag;
+    double *pos; /* source triangles in grid units, or NULL */
+    uint32_t *idx;
+    size_t verts, tris;
+} scene;
+
+typedef struct codes {
+    uint64_t *c;
+    size_t n;
+} codes;
+
+static int collect(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    codes *k = (codes *)user;
+    k->c[index] = voxdag_morton_encode(x, y, z);
+    k->n++;
+    return 0;
+}
+
+static void scene_voxels_from_dag(scene *s, const char *name, uint32_t L) {
+    voxdag_info info;
+    codes k;
+    voxdag_get_info(s->dag, &info);
+    k.c = (uint64_t *)bench_xmalloc((info.voxels ? info.voxels : 1) * sizeof *k.c);
+    k.n = 0;
+    voxdag_for_each_voxel(s->dag, collect, &k);
+    s->v.levels = L;
+    snprintf(s->v.name, sizeof s->v.name, "%s", name);
+    bscene_from_codes(&s->v, k.c, k.n);
+}
+
+static int build_dag(scene *s, unsigned threads) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    memset(&o, 0, sizeof o);
+    o.levels = s->v.levels;
+    o.threads = threads;
+    return voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK && voxdag_builder_add(b, s->v.xyz, NULL, s->v.n, NULL) == VOXDAG_OK &&
+           voxdag_builder_finish(b, &s->dag, NULL, NULL) == VOXDAG_OK;
+}
+
+/* A mesh voxelized by the library into 2^L, fitted to its bounding box. */
+static int scene_mesh(scene *s, const char *path, const char *name, uint32_t L, unsigned threads) {
+    vdag_scene sc;
+    char err[256];
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, ext = 0, scale;
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag_mesh m;
+    size_t i;
+    memset(s, 0, sizeof *s);
+    memset(&sc, 0, sizeof sc);
+    if (!vdag_import_file(path, &sc, err, sizeof err)) {
+        fprintf(stderr, "bench_rays: %s: %s\n", path, err);
+        return 0;
+    }
+    for (i = 0; i < 3 * sc.vertex_count; i++) {
+        if (sc.positions[i] < lo[i % 3]) lo[i % 3] = sc.positions[i];
+        if (sc.positions[i] > hi[i % 3]) hi[i % 3] = sc.positions[i];
+    }
+    for (i = 0; i < 3; i++)
+        if (hi[i] - lo[i] > ext) ext = hi[i] - lo[i];
+    scale = ext > 0 ? (double)(1u << L) / ext : 1;
+    s->verts = sc.vertex_count, s->tris = sc.triangle_count;
+    s->pos = (double *)bench_xmalloc(3 * s->verts * sizeof *s->pos + 1);
+    s->idx = (uint32_t *)bench_xmalloc(3 * s->tris * sizeof *s->idx + 1);
+    for (i = 0; i < 3 * s->verts; i++) s->pos[i] = (sc.positions[i] - lo[i % 3]) * scale;
+    memcpy(s->idx, sc.indices, 3 * s->tris * sizeof *s->idx);
+    vdag_scene_free(&sc);
+    memset(&o, 0, sizeof o);
+    o.levels = L;
+    o.threads = threads;
+    memset(&m, 0, sizeof m);
+    m.positions = s->pos, m.vertex_count = s->verts, m.indices = s->idx, m.triangle_count = s->tris;
+    if (voxdag_builder_create(&o, &b, NULL) != VOXDAG_OK) return 0;
+    if (voxdag_builder_add_mesh(b, &m, NULL) != VOXDAG_OK) {
+        voxdag_builder_free(b);
+        return 0;
+    }
+    if (voxdag_builder_finish(b, &s->dag, NULL, NULL) != VOXDAG_OK) return 0;
+    scene_voxels_from_dag(s, name, L);
+    return 1;
+}
+
+#ifdef BENCH_EMBREE
+static bool embree_memory(void *user, ssize_t bytes, bool post) {
+    (void)post;
+    *(long long *)user += (long long)bytes;
+    return true;
+}
+
+/* The triangles of S in an Embree scene (default build quality); *BYTES: the
+   memory Embree reported allocating for it. */
+static RTCScene embree_scene(RTCDevice dev, const scene *s) {
+    RTCScene sc = rtcNewScene(dev);
+    RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
+    float *v = (float *)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
+                                                s->verts);
+    unsigned *t = (unsigned *)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                      3 * sizeof(unsigned), s->tris);
+    size_t i;
+    for (i = 0; i < 3 * s->verts; i++) v[i] = (float)s->pos[i];
+    for (i = 0; i < 3 * s->tris; i++) t[i] = s->idx[i];
+    rtcCommitGeometry(g);
+    rtcAttachGeometry(sc, g);
+    rtcReleaseGeometry(g);
+    rtcCommitScene(sc);
+    return sc;
+}
+#endif
+
+static void row(const char *scene_name, uint32_t L, size_t voxels, const char *engine, double mb, size_t hits,
+                size_t n, speed one, speed all, const speed *ref, double agree) {
+    printf("| %s | %u | %zu | %s | %.2f | %.1f%% | %.2f | %.2f | %.2f | %.2f |", scene_name, L, voxels, engine, mb,
+           100.0 * hits / n, one.wall * 1e-6, one.cpu * 1e-6, all.wall * 1e-6, all.cpu * 1e-6);
+    if (ref) printf(" %.2f | %.2f |", ref->cpu / one.cpu, ref[1].cpu / all.cpu);
+    else printf(" | |");
+    if (agree >= 0) printf(" %.2f%% |\n", agree);
+    else printf(" |\n");
 }
 
 int main(int argc, char **argv) {
@@ -118,83 +282,114 @@ int main(int argc, char **argv) {
     uint32_t size = 512;
     unsigned threads;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
-    bscene scenes[8];
-    size_t ns = 0, k;
+    size_t k;
     char path[512];
+    static const struct {
+        const char *file;
+        uint32_t L;
+        int full_only;
+    } plan[] = {{"tree.vox", 0, 0}, {"bunny.off", 11, 0}, {"bunny.off", 13, 1}, {"dragon.off", 11, 1},
+                {"terrain", 11, 1}, {"terrain", 10, 0}};
+#ifdef BENCH_EMBREE
+    RTCDevice dev = rtcNewDevice(NULL);
+    long long embree_bytes = 0;
+    rtcSetDeviceMemoryMonitorFunction(dev, embree_memory, &embree_bytes);
+#endif
     for (i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
         else if (!strcmp(argv[i], "--size") && i + 1 < argc) size = (uint32_t)atoi(argv[++i]);
     }
     threads = cpus < 1 ? 1 : cpus > 64 ? 64 : (unsigned)cpus;
-    snprintf(path, sizeof path, "%s/tree.vox", dir);
-    if (bscene_vox(&scenes[ns], path, "tree.vox")) ns++;
-    snprintf(path, sizeof path, "%s/bunny.off", dir);
-    if (bscene_mesh(&scenes[ns], path, "bunny.off", 10)) ns++;
-    if (!quick) {
-        snprintf(path, sizeof path, "%s/dragon.off", dir);
-        if (bscene_mesh(&scenes[ns], path, "dragon.off", 11)) ns++;
-    }
-    bscene_terrain(&scenes[ns++], quick ? 10 : 11);
 
-    printf("### Primary rays (%ux%u per scene, best of 3; %u threads)\n\n", size, size, threads);
+    printf("### Primary rays (%ux%u per scene, best of 3; 1 and %u threads)\n\n", size, size, threads);
 #ifdef BENCH_NANOVDB
-    printf("Peer: %s.\n\n", bench_peer_name());
-    printf("| scene | L | voxels | hit rays | voxdag Mrays/s, 1 thread | voxdag Mrays/s, %u threads "
-           "| NanoVDB Mrays/s, 1 thread | NanoVDB Mrays/s, %u threads | 1-thread ratio | voxdag MB | NanoVDB MB "
-           "| agreement |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n", threads, threads);
+    printf("Voxel peer: %s.", bench_peer_name());
 #else
-    printf("(NanoVDB headers not installed: voxdag only.)\n\n");
-    printf("| scene | L | voxels | hit rays | voxdag Mrays/s, 1 thread | voxdag Mrays/s, %u threads | voxdag MB |\n"
-           "|---|---|---|---|---|---|---|\n", threads);
+    printf("(NanoVDB headers not installed: no voxel peer.)");
 #endif
-    for (k = 0; k < ns; k++) {
-        const bscene *s = &scenes[k];
-        voxdag_build_opts o;
-        voxdag_builder *b;
-        voxdag *dag;
+#ifdef BENCH_EMBREE
+    printf(" Triangle peer: Embree %d.%d.%d (`rtcIntersect1`, default BVH) on the source triangles of the mesh scenes.\n\n",
+           RTC_VERSION_MAJOR, RTC_VERSION_MINOR, RTC_VERSION_PATCH);
+#else
+    printf(" (Embree headers not installed: no triangle peer.)\n\n");
+#endif
+    printf("| scene | L | voxels | engine | MB | hit rays | Mrays/s, 1 thread | Mrays/CPU-s, 1 thread | Mrays/s, %u threads "
+           "| Mrays/CPU-s, %u threads | voxdag speed-up, 1 thread (CPU-s) | voxdag speed-up, %u threads (CPU-s) "
+           "| agreement with voxdag |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+           threads, threads, threads);
+    for (k = 0; k < sizeof plan / sizeof plan[0]; k++) {
+        scene s;
         voxdag_info info;
         rays r;
         uint32_t *mine;
         size_t hits;
-        double one, all;
-        memset(&o, 0, sizeof o);
-        o.levels = s->levels;
-        o.threads = threads;
-        if (voxdag_builder_create(&o, &b, NULL) != VOXDAG_OK || voxdag_builder_add(b, s->xyz, NULL, s->n, NULL) ||
-            voxdag_builder_finish(b, &dag, NULL, NULL) != VOXDAG_OK) {
-            fprintf(stderr, "bench_rays: cannot build %s\n", s->name);
-            return 1;
+        speed mine_speed[2];
+        if (quick ? plan[k].full_only : plan[k].L == 10) continue;
+        memset(&s, 0, sizeof s);
+        snprintf(path, sizeof path, "%s/%s", dir, plan[k].file);
+        if (!strcmp(plan[k].file, "terrain")) {
+            bscene_terrain(&s.v, plan[k].L);
+            if (!build_dag(&s, threads)) return 1;
+        } else if (!strcmp(plan[k].file, "tree.vox")) {
+            if (!bscene_vox(&s.v, path, "tree.vox")) continue;
+            if (!build_dag(&s, threads)) return 1;
+        } else if (!scene_mesh(&s, path, plan[k].file, plan[k].L, threads)) {
+            continue;
         }
-        fprintf(stderr, "bench_rays: %s (L=%u, %zu voxels)\n", s->name, s->levels, s->n);
-        voxdag_get_info(dag, &info);
-        make_rays(s, size, &r);
+        fprintf(stderr, "bench_rays: %s (L=%u, %zu voxels)\n", s.v.name, s.v.levels, s.v.n);
+        voxdag_get_info(s.dag, &info);
+        make_rays(&s.v, size, &r);
         mine = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
-        one = timed(&r, dag, NULL, 1, mine, &hits);
-        all = timed(&r, dag, NULL, threads, mine, &hits);
-        printf("| %s | %u | %zu | %.1f%% | %.2f | %.2f |", s->name, s->levels, s->n, 100.0 * hits / r.n, one * 1e-6,
-               all * 1e-6);
+        mine_speed[0] = timed(&r, s.dag, NULL, NULL, 1, mine, &hits);
+        mine_speed[1] = timed(&r, s.dag, NULL, NULL, threads, mine, &hits);
+        row(s.v.name, s.v.levels, s.v.n, "voxdag", (info.node_bytes + info.brick_bytes) / 1e6, hits, r.n,
+            mine_speed[0], mine_speed[1], NULL, -1);
+        fflush(stdout);
 #ifdef BENCH_NANOVDB
         {
             size_t bytes, same = 0, j, peer_hits;
             uint32_t *theirs = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
-            bench_peer *p = bench_peer_build(s->xyz, s->n, &bytes);
-            double pone = timed(&r, NULL, p, 1, theirs, &peer_hits), pall = timed(&r, NULL, p, threads, theirs, &peer_hits);
+            bench_peer *p = bench_peer_build(s.v.xyz, s.v.n, &bytes);
+            speed one = timed(&r, NULL, p, NULL, 1, theirs, &peer_hits);
+            speed all = timed(&r, NULL, p, NULL, threads, theirs, &peer_hits);
             for (j = 0; j < r.n; j++) same += !memcmp(mine + 3 * j, theirs + 3 * j, 3 * sizeof(uint32_t));
-            printf(" %.2f | %.2f | %.2f | %.2f | %.2f | %.2f%% |", pone * 1e-6, pall * 1e-6, one / pone,
-                   (info.node_bytes + info.brick_bytes) / 1e6, bytes / 1e6, 100.0 * same / r.n);
+            row(s.v.name, s.v.levels, s.v.n, "NanoVDB", bytes / 1e6, peer_hits, r.n, one, all, mine_speed,
+                100.0 * same / r.n);
             bench_peer_free(p);
             free(theirs);
         }
-#else
-        printf(" %.2f |", (info.node_bytes + info.brick_bytes) / 1e6);
 #endif
-        printf("\n");
+#ifdef BENCH_EMBREE
+        if (s.pos) {
+            size_t peer_hits;
+            uint32_t *theirs = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
+            RTCScene es;
+            speed one, all;
+            embree_bytes = 0;
+            es = embree_scene(dev, &s);
+            one = timed(&r, NULL, NULL, es, 1, theirs, &peer_hits);
+            all = timed(&r, NULL, NULL, es, threads, theirs, &peer_hits);
+            row(s.v.name, s.v.levels, s.v.n, "Embree (triangles)", embree_bytes / 1e6, peer_hits, r.n, one, all,
+                mine_speed, -1);
+            rtcReleaseScene(es);
+            free(theirs);
+        }
+#endif
         fflush(stdout);
         free(mine);
         free(r.dir);
-        voxdag_free(dag);
+        free(s.pos);
+        free(s.idx);
+        voxdag_free(s.dag);
+        bscene_free(&s.v);
     }
-    printf("\nvoxdag MB: encoded nodes and bricks (geometry only); NanoVDB MB: the grid buffer.\n");
-    for (k = 0; k < ns; k++) bscene_free(&scenes[k]);
+    printf("\nMB: voxdag, encoded nodes and bricks (geometry only); NanoVDB, the grid buffer; Embree, the bytes its "
+           "memory monitor reported for the scene (BVH and copies of the triangles). Mrays/CPU-s: rays per second of "
+           "process CPU time (getrusage), less sensitive than wall-clock time to other jobs on a shared machine. "
+           "Speed-up: voxdag's rays per CPU-second divided by the peer's. Mesh voxels come from "
+           "`voxdag_builder_add_mesh` (exact conservative voxelization, the grid fitted to the bounding box).\n");
+#ifdef BENCH_EMBREE
+    rtcReleaseDevice(dev);
+#endif
     return 0;
 }
