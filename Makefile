@@ -1,6 +1,7 @@
 # voxdag: examples, tests, demo and benchmarks.
 #   make          build the vdag tool (build/vdag)
 #   make test     install missing test packages, run every test
+#   make check-all build matrix, link/symbol checks, determinism (in make test)
 #   make demo     build, colour-compress, save and render the default scene
 #   make bench    regenerate BENCHMARKS.md
 
@@ -113,6 +114,13 @@ demo: $(BUILD)/vdag
 
 deps:
 	@sh tests/deps.sh
+
+# Build matrix (gcc/clang, C99/C++11, -O0/-O2, NDEBUG, configuration macros,
+# -m32), link and exported-symbol checks, the README's code and determinism
+# across compilers; `make test` runs it through tests/run.sh.
+.PHONY: check-all
+check-all:
+	@sh tests/check_all.sh $(BUILD)
 
 test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load
 	@sh tests/run.sh $(BUILD)
