@@ -9,9 +9,11 @@
    Each block is one of: a single colour, two endpoints with a 1..4-bit weight
    per colour interpolating between them, or raw colours. Endpoints are RGB565
    or RGB888, chosen per block. Blocks never cross a page (2^page_shift
-   colours); each page starts with a directory of its blocks, and a page
-   table gives each page's start, so a lookup reads one table entry and walks
-   one page's directory. voxcolor_view_get_many overlaps the memory accesses
+   colours); each page starts with checkpoints (every 8th block's first
+   colour and payload offset) and a directory of its blocks, and a page table
+   gives each page's start, so a lookup reads one table entry, binary-searches
+   the page's checkpoints and walks at most 8 directory entries.
+   voxcolor_view_get_many overlaps the memory accesses
    of many lookups. The encoder is a fast greedy heuristic (Dolonius et al.'s
    Algorithm 1 and HashDAG's layout are reimplemented in bench/ to compare).
 
@@ -65,7 +67,7 @@
     (VOXCOLOR_VERSION_MAJOR * 10000 + VOXCOLOR_VERSION_MINOR * 100 + VOXCOLOR_VERSION_PATCH)
 
 /* Stream layout version, stored in every stream (FORMAT.md). */
-#define VOXCOLOR_FORMAT_VERSION 1
+#define VOXCOLOR_FORMAT_VERSION 2
 
 /* Byte offsets of the stream header fields (FORMAT.md). */
 #define VOXCOLOR_OFF_MAGIC 0      /* 4 bytes "VXC1" */
@@ -167,7 +169,8 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
                                                 size_t size);
 
 /* Writes the colour at INDEX (< view->count) to RGB_OUT[0..2]. Reads one page
-   table entry and walks the headers of one page. Thread-safe. */
+   table entry, binary-searches the page's checkpoints and walks at most 8
+   block entries. Thread-safe. */
 VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
                                     uint8_t rgb_out[3]);
 
@@ -230,12 +233,16 @@ VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t
 #endif
 
 // -- Block modes
-/* A page is its block count - 1 (page_shift bits), a directory entry per
-   block: MODE (3 bits), PRECISION (1 bit: 0 RGB565, 1 RGB888 endpoints) and
-   LENGTH - 1 (page_shift bits), then each block's payload: its endpoints and
-   a weight per colour. Modes 0..4: weight width in bits (0 = one colour);
-   mode 5: raw RGB888 colours. */
+/* A page is its block count - 1 (page_shift bits), a checkpoint per group
+   of 8 blocks but the first: the index in the page of the group's first
+   colour (page_shift bits) and the payload bit offset of the group's first
+   block (page_shift + 6 bits), then a directory entry per block: MODE (3
+   bits), PRECISION (1 bit: 0 RGB565, 1 RGB888 endpoints) and the index in the
+   page of the block's last colour (page_shift bits), then each block's payload:
+   its endpoints and a weight per colour. Modes 0..4: weight width in bits
+   (0 = one colour); mode 5: raw RGB888 colours. */
 #define VOXCOLORI_MODE_RAW 5u
+#define VOXCOLORI_GROUP_SHIFT 3u /* checkpoints every 8 blocks */
 #define VOXCOLORI_MAX_WEIGHT_BITS 4u
 
 /* Interpolation weights in 64ths for weight k of width w: round(64 k / (2^w - 1)).
@@ -280,6 +287,14 @@ static unsigned voxcolori_channel_shift(unsigned channel, unsigned precision) {
     return precision ? 8 * channel : shift565[channel];
 }
 
+#if defined(__cplusplus) || (defined(__STDC_VERSION__) && __STDC_VERSION__ >= 199901L)
+#define VOXCOLORI_INLINE inline
+#elif defined(_MSC_VER)
+#define VOXCOLORI_INLINE __inline
+#else
+#define VOXCOLORI_INLINE
+#endif
+
 // -- Little-endian bytes
 
 static uint64_t voxcolori_load_le(const uint8_t *p, unsigned n) {
@@ -294,7 +309,7 @@ static void voxcolori_store_le(uint8_t *p, uint64_t v, unsigned n) {
 }
 
 /* Written out so that compilers turn it into one load. */
-static uint64_t voxcolori_load64(const uint8_t *p) {
+static VOXCOLORI_INLINE uint64_t voxcolori_load64(const uint8_t *p) {
     return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24 |
            (uint64_t)p[4] << 32 | (uint64_t)p[5] << 40 | (uint64_t)p[6] << 48 |
            (uint64_t)p[7] << 56;
@@ -302,7 +317,7 @@ static uint64_t voxcolori_load64(const uint8_t *p) {
 
 /* N (<= 56) bits at bit position POS of DATA, least significant bit first.
    The stream ends with 8 zero bytes, so the 8-byte load stays inside it. */
-static uint64_t voxcolori_bits(const uint8_t *data, uint64_t pos, unsigned n) {
+static VOXCOLORI_INLINE uint64_t voxcolori_bits(const uint8_t *data, uint64_t pos, unsigned n) {
     uint64_t w = voxcolori_load64(data + (size_t)(pos >> 3)) >> (pos & 7);
     return w & ((1ull << n) - 1);
 }
@@ -310,14 +325,21 @@ static uint64_t voxcolori_bits(const uint8_t *data, uint64_t pos, unsigned n) {
 // -- Decoding one block
 
 /* Reads an endpoint colour of PRECISION at bit POS into E (8-bit channels). */
-static void voxcolori_read_endpoint(const uint8_t *data, uint64_t pos, unsigned precision,
-                                    unsigned e[3]) {
-    uint64_t v = voxcolori_bits(data, pos, precision ? 24u : 16u);
-    unsigned c;
-    for (c = 0; c < 3; c++) {
-        unsigned b = voxcolori_channel_bits(c, precision);
-        e[c] = voxcolori_expand((unsigned)(v >> voxcolori_channel_shift(c, precision)) & ((1u << b) - 1), b);
+static VOXCOLORI_INLINE void voxcolori_read_endpoint(const uint8_t *data, uint64_t pos,
+                                                     unsigned precision, unsigned e[3]) {
+    unsigned v = (unsigned)voxcolori_bits(data, pos, precision ? 24u : 16u), r, g, b;
+    if (precision) {
+        e[0] = v & 255;
+        e[1] = (v >> 8) & 255;
+        e[2] = v >> 16;
+        return;
     }
+    r = v & 31;
+    g = (v >> 5) & 63;
+    b = v >> 11;
+    e[0] = r << 3 | r >> 2;
+    e[1] = g << 2 | g >> 4;
+    e[2] = b << 3 | b >> 2;
 }
 
 /* Interpolated colour for weight index K of a width-W block. */
@@ -339,8 +361,8 @@ typedef struct voxcolori_block {
 } voxcolori_block;
 
 /* Colour number I (< length) of block B. */
-static void voxcolori_block_color(const uint8_t *data, const voxcolori_block *b, uint64_t i,
-                                  uint8_t out[3]) {
+static VOXCOLORI_INLINE void voxcolori_block_color(const uint8_t *data, const voxcolori_block *b,
+                                                   uint64_t i, uint8_t out[3]) {
     unsigned e0[3], e1[3];
     if (b->mode == VOXCOLORI_MODE_RAW) {
         uint64_t v = voxcolori_bits(data, b->payload + 24 * i, 24);
@@ -381,23 +403,34 @@ VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status) {
 VOXCOLOR_API uint32_t voxcolor_version(void) { return VOXCOLOR_VERSION; }
 
 static uint64_t voxcolori_page_offset(const voxcolor_view *v, uint64_t page) {
-    unsigned n = v->wide ? 8u : 4u;
-    return voxcolori_load_le(v->table + (size_t)(page * n), n);
+    const uint8_t *p;
+    if (v->wide) return voxcolori_load64(v->table + (size_t)(page * 8));
+    p = v->table + (size_t)(page * 4);
+    return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24;
 }
 
 /* Walks the block directory of one page. */
 typedef struct voxcolori_page {
-    uint64_t entry;   /* bit position of the next directory entry */
-    uint64_t payload; /* bit position of that block's payload */
+    uint64_t entry;       /* bit position of the next directory entry */
+    uint64_t checkpoints; /* bit position of the checkpoints */
+    uint64_t payload;     /* bit position of that block's payload */
+    uint64_t start;       /* index in the page of that block's first colour */
     unsigned entry_bits;
 } voxcolori_page;
+
+/* Checkpoints of a page of BLOCKS blocks. */
+static uint64_t voxcolori_checkpoint_count(uint64_t blocks) {
+    return (blocks - 1) >> VOXCOLORI_GROUP_SHIFT;
+}
 
 /* Starts walking the page that begins at bit POS. Returns its block count. */
 static uint64_t voxcolori_page_open(const voxcolor_view *v, uint64_t pos, voxcolori_page *p) {
     uint64_t blocks = voxcolori_bits(v->data, pos, v->page_shift) + 1;
     p->entry_bits = 4 + v->page_shift;
-    p->entry = pos + v->page_shift;
+    p->checkpoints = pos + v->page_shift;
+    p->entry = p->checkpoints + voxcolori_checkpoint_count(blocks) * (2 * v->page_shift + 6);
     p->payload = p->entry + blocks * p->entry_bits;
+    p->start = 0;
     return blocks;
 }
 
@@ -407,8 +440,9 @@ static void voxcolori_page_next(const uint8_t *data, voxcolori_page *p, voxcolor
     uint64_t h = voxcolori_bits(data, p->entry, p->entry_bits);
     b->mode = (unsigned)(h & 7);
     b->precision = (unsigned)(h >> 3) & 1;
-    b->length = (h >> 4) + 1;
+    b->length = (h >> 4) + 1 - p->start; /* wraps when the ends do not grow */
     b->payload = p->payload;
+    p->start = (h >> 4) + 1;
     p->entry += p->entry_bits;
     p->payload += voxcolori_block_bits(b->mode, b->precision, b->length);
 }
@@ -418,7 +452,7 @@ static void voxcolori_page_next(const uint8_t *data, voxcolori_page *p, voxcolor
    data must end with the 8 zero bytes. DATA_SIZE >= 8. */
 static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t data_size) {
     uint64_t limit = (data_size - 8) * 8, pos = 0, page, pages;
-    uint64_t page_size = 1ull << v->page_shift;
+    uint64_t page_size = 1ull << v->page_shift, k, first_payload;
     size_t i;
     pages = v->count ? ((v->count - 1) >> v->page_shift) + 1 : 0;
     for (page = 0; page < pages; page++) {
@@ -427,18 +461,25 @@ static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t da
         if (voxcolori_page_offset(v, page) != pos / 8 || limit - pos < v->page_shift)
             return VOXCOLOR_ERR_CORRUPT;
         blocks = voxcolori_page_open(v, pos, &p);
-        if (blocks > left || (limit - p.entry) / p.entry_bits < blocks) return VOXCOLOR_ERR_CORRUPT;
-        while (blocks--) {
+        if (blocks > left || p.payload > limit) return VOXCOLOR_ERR_CORRUPT;
+        first_payload = p.payload;
+        for (k = 0; k < blocks; k++) {
             voxcolori_block b;
-            voxcolori_page_next(v->data, &p, &b);
-            if (b.mode > VOXCOLORI_MODE_RAW || (b.mode == VOXCOLORI_MODE_RAW && b.precision) ||
-                b.length > left)
+            uint64_t start = p.start;
+            if (k && !(k & ((1u << VOXCOLORI_GROUP_SHIFT) - 1)) &&
+                voxcolori_bits(v->data,
+                               p.checkpoints + ((k >> VOXCOLORI_GROUP_SHIFT) - 1) * (2 * v->page_shift + 6),
+                               2 * v->page_shift + 6) != (p.start | (p.payload - first_payload) << v->page_shift))
                 return VOXCOLOR_ERR_CORRUPT;
-            left -= b.length;
-            /* A block has at most 1024 * 24 bits: no overflow before this. */
+            voxcolori_page_next(v->data, &p, &b);
+            /* Ends grow, and stay inside the page. */
+            if (b.mode > VOXCOLORI_MODE_RAW || (b.mode == VOXCOLORI_MODE_RAW && b.precision) ||
+                p.start <= start || p.start > left)
+                return VOXCOLOR_ERR_CORRUPT;
+            /* A block has at most 1024 * 24 + 48 bits: no overflow before this. */
             if (p.payload > limit) return VOXCOLOR_ERR_CORRUPT;
         }
-        if (left) return VOXCOLOR_ERR_CORRUPT;
+        if (p.start != left) return VOXCOLOR_ERR_CORRUPT;
         /* Pages start on a byte; the bits up to it must be zero. */
         pos = p.payload;
         if (pos & 7) {
@@ -490,25 +531,41 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
 
 VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
                                     uint8_t rgb_out[3]) {
+    const uint8_t *data = view->data;
     voxcolori_page p;
     voxcolori_block b;
-    uint64_t i, h, length;
+    uint64_t j, blocks, g, n, h, start, cp, k;
+    unsigned s = view->page_shift, eb = 4 + s, cb = 2 * s + 6;
     VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
-    i = index & ((1ull << view->page_shift) - 1);
-    voxcolori_page_open(view, voxcolori_page_offset(view, index >> view->page_shift) * 8, &p);
-    /* voxcolori_page_next, with only what the walk needs. */
-    for (;; p.entry += p.entry_bits) {
-        h = voxcolori_bits(view->data, p.entry, p.entry_bits);
-        length = (h >> 4) + 1;
-        if (i < length) break;
-        i -= length;
-        p.payload += voxcolori_endpoint_table[h & 15] + length * voxcolori_colour_table[h & 7];
+    j = index & ((1ull << s) - 1);
+    blocks = voxcolori_page_open(view, voxcolori_page_offset(view, index >> s) * 8, &p);
+    /* The group holding colour j: the last whose first colour is at or
+       before j (group 0 starts at 0), by a binary search over the compact
+       checkpoints, without data-dependent branches. */
+    for (g = 0, n = voxcolori_checkpoint_count(blocks) + 1; n > 1; n -= n >> 1) {
+        uint64_t first = voxcolori_bits(data, p.checkpoints + (g + (n >> 1) - 1) * cb, s);
+        g += first <= j ? n >> 1 : 0;
+    }
+    /* Its first colour and payload offset (group 0: 0 and 0; the read then
+       takes the first checkpoint or directory entry, unused). */
+    cp = voxcolori_bits(data, p.checkpoints + (g - (g != 0)) * cb, cb) & (g ? ~0ull : 0);
+    start = cp & ((1ull << s) - 1);
+    p.payload += cp >> s;
+    /* The block: the first in the group ending at or after j; the payloads
+       of the (at most 7) blocks before it are added up on the way. */
+    for (k = g << VOXCOLORI_GROUP_SHIFT;; k++) {
+        uint64_t end;
+        h = voxcolori_bits(data, p.entry + k * eb, eb);
+        end = (h >> 4) + 1;
+        if (end > j) break;
+        p.payload += voxcolori_endpoint_table[h & 15] + (end - start) * voxcolori_colour_table[h & 7];
+        start = end;
     }
     b.mode = (unsigned)(h & 7);
     b.precision = (unsigned)(h >> 3) & 1;
-    b.length = length;
+    b.length = (h >> 4) + 1 - start;
     b.payload = p.payload;
-    voxcolori_block_color(view->data, &b, i, rgb_out);
+    voxcolori_block_color(data, &b, j - start, rgb_out);
 }
 
 #if defined(__GNUC__) || defined(__clang__)
@@ -563,6 +620,7 @@ typedef struct voxcolori_enc {
     uint32_t thr2;          /* RGB: largest squared distance allowed */
     int lab;                /* 1: CIELAB metric */
     double lab_thr2;        /* CIELAB: largest squared delta E allowed */
+    double line2;           /* RGB: squared bound plus interpolation rounding */
     double linear[256];     /* CIELAB: sRGB channel value to linear light */
     unsigned page_shift;
     unsigned modes[VOXCOLORI_MAX_WEIGHT_BITS + 1], mode_count;
@@ -646,6 +704,8 @@ static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) 
         while ((double)(e->thr2 + 1) <= x * x) e->thr2++;
         while (e->thr2 && (double)e->thr2 > x * x) e->thr2--;
     }
+    /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line. */
+    e->line2 = (x + 0.87) * (x + 0.87);
     if (e->lab)
         for (i = 0; i < 256; i++) {
             double c = i / 255.0, s = (c + 0.055) / 1.055;
@@ -734,12 +794,57 @@ static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const 
     return voxcolori_close(e, c, d);
 }
 
-/* Chooses endpoints for the N colours RGB and checks every colour; returns
-   1 when all fit. Mode 0: the centre of their bounding box. Else the extreme
+/* 1 when no block of MODE can hold N colours with sums S and products SS
+   (RGB metric): their root-mean-square distance from the mean (mode 0), or
+   from any line (the sum of the covariance's two smaller eigenvalues, at
+   least its trace minus its Frobenius norm), exceeds what the bound allows.
+   Rejects most failing windows before any endpoint is fitted. */
+static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, const uint64_t s[3],
+                              uint64_t ss[3][3], size_t n, unsigned mode) {
+    double c[3][3], tr, fro = 0, m[3], inv = 1.0 / (double)n;
+    unsigned a, b;
+    size_t i;
+    for (a = 0; a < 3; a++) m[a] = (double)s[a] * inv;
+    for (a = 0; a < 3; a++)
+        for (b = a; b < 3; b++) c[a][b] = c[b][a] = (double)ss[a][b] * inv - m[a] * m[b];
+    tr = c[0][0] + c[1][1] + c[2][2];
+    if (mode == 0) return tr > (double)e->thr2 + 1e-6;
+    if (n <= 2) return 0;
+    /* No line passes within R of three colours whose triangle has area A and
+       longest side L when A / L > R: |cross|^2 > 4 R^2 L^2. Short windows
+       only (longer ones are refits of blocks that mostly pass). */
+    for (i = 0; i + 2 < n && n <= 8; i++) {
+        const uint8_t *p = rgb + 3 * i;
+        int64_t u[3], v[3], w[3], x[3], l2, m2;
+        for (a = 0; a < 3; a++) {
+            u[a] = (int64_t)p[3 + a] - p[a];
+            v[a] = (int64_t)p[6 + a] - p[a];
+            w[a] = v[a] - u[a];
+        }
+        x[0] = u[1] * v[2] - u[2] * v[1];
+        x[1] = u[2] * v[0] - u[0] * v[2];
+        x[2] = u[0] * v[1] - u[1] * v[0];
+        l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
+        m2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        if (m2 > l2) l2 = m2;
+        m2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        if (m2 > l2) l2 = m2;
+        if ((double)(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) > 4 * (e->line2 + 1e-6) * (double)l2)
+            return 1;
+    }
+    tr -= e->line2 + 1e-6;
+    if (tr <= 0) return 0;
+    for (a = 0; a < 3; a++)
+        for (b = 0; b < 3; b++) fro += c[a][b] * c[a][b];
+    return tr * tr > fro;
+}
+
+/* Chooses endpoints for the N colours RGB; returns 0 when no block of F's
+   mode can hold them (voxcolori_hopeless), else 1. Mode 0: the centre of their bounding box. Else the extreme
    projections on their principal axis (power iteration on the covariance;
    two colours are their own extremes). */
-static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
-                               voxcolori_fit *f) {
+static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                                   voxcolori_fit *f) {
     double mean[3], cov[3][3], v[3] = {1, 1, 1}, lo[3], hi[3], tmin = 0, tmax = 0, vv;
     uint64_t s[3] = {0, 0, 0}, ss[3][3];
     unsigned a, b, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
@@ -754,6 +859,7 @@ static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_
             for (b = a; b < 3; b++) ss[a][b] += (uint64_t)c[a] * c[b];
         }
     }
+    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, s, ss, n, f->mode)) return 0;
     if (f->mode == 0) {
         for (a = 0; a < 3; a++) lo[a] = (mn[a] + mx[a]) * 0.5;
         voxcolori_quantize(lo, f->precision, f->q0, f->e0);
@@ -797,9 +903,21 @@ static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_
         voxcolori_quantize(lo, f->precision, f->q0, f->e0);
         voxcolori_quantize(hi, f->precision, f->q1, f->e1);
     }
+    return 1;
+}
+
+/* 1 when all N colours RGB decode within the bound under F. */
+static int voxcolori_fits_all(const voxcolori_enc *e, const voxcolori_fit *f, const uint8_t *rgb,
+                              size_t n) {
+    size_t i;
     for (i = 0; i < n; i++)
         if (!voxcolori_fits(e, f, rgb + 3 * i)) return 0;
     return 1;
+}
+
+static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                               voxcolori_fit *f) {
+    return voxcolori_fit_endpoints(e, rgb, n, f) && voxcolori_fits_all(e, f, rgb, n);
 }
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
@@ -876,10 +994,12 @@ static uint64_t voxcolori_plan(unsigned mode, const voxcolori_fit *f, size_t len
    then takes at most as many bits as one raw block. */
 static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                   uint64_t *plan) {
-    size_t pos = 0, raw_start = 0, blocks = 0, entry = 4 + e->page_shift;
+    /* A block's directory entry and its share of the checkpoints (one per 8
+       blocks, rounded up). */
+    size_t pos = 0, raw_start = 0, blocks = 0, entry = 4 + e->page_shift + (2 * e->page_shift + 6 + 7) / 8;
     while (pos < n) {
-        voxcolori_fit best, f;
-        size_t best_len = 0, best_bits = 0, len;
+        voxcolori_fit best, f, shared[2];
+        size_t best_len = 0, best_bits = 0, len, shared_len[2] = {0, 0};
         unsigned m, p;
         memset(&best, 0, sizeof best);
         for (m = 0; m < e->mode_count; m++) {
@@ -891,8 +1011,23 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
                 f.precision = e->precisions[p];
                 /* Blocks shorter than this cost more than raw colours. */
                 fixed = 2 * entry + voxcolori_endpoint_bits(f.mode, f.precision);
-                len = voxcolori_extend(e, rgb + 3 * pos, n - pos,
-                                       (fixed + 23 - f.mode) / (24 - f.mode), &f);
+                len = (fixed + 23 - f.mode) / (24 - f.mode);
+                if (len > n - pos) len = n - pos;
+                /* Modes 1..4 fit the same endpoints to the same colours: fit
+                   once per precision, then only check each mode. */
+                if (f.mode) {
+                    if (shared_len[p] != len) {
+                        shared[p] = f;
+                        shared[p].mode = 1;
+                        shared_len[p] = len;
+                        if (!voxcolori_fit_endpoints(e, rgb + 3 * pos, len, &shared[p]))
+                            shared[p].mode = 0;
+                    }
+                    if (!shared[p].mode) continue;
+                    shared[p].mode = f.mode;
+                    if (!voxcolori_fits_all(e, &shared[p], rgb + 3 * pos, len)) continue;
+                }
+                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f);
                 if (!len) continue;
                 bits = entry + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
                 if (!best_len || bits * best_len < best_bits * len ||
@@ -920,9 +1055,25 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
 /* Writes a planned page: block count, directory, payloads. */
 static void voxcolori_write_page(voxcolori_writer *w, const uint8_t *rgb, const uint64_t *plan,
                                  size_t blocks, unsigned page_shift) {
-    size_t b, i;
+    size_t b, i, end = 0;
+    uint64_t payload = 0;
     voxcolori_put(w, blocks - 1, page_shift);
-    for (b = 0; b < blocks; b++) voxcolori_put(w, plan[b] & 0xffff, 4 + page_shift);
+    /* Checkpoints: first colour and payload offset of every 8th block after
+       the first. */
+    for (b = 0; b < blocks; b++) {
+        unsigned mode = (unsigned)(plan[b] & 7), precision = (unsigned)(plan[b] >> 3) & 1;
+        if (b && !(b & ((1u << VOXCOLORI_GROUP_SHIFT) - 1))) {
+            voxcolori_put(w, end, page_shift);
+            voxcolori_put(w, payload, page_shift + 6);
+        }
+        end += (size_t)((plan[b] >> 4) & 0xfff) + 1;
+        payload += voxcolori_block_bits(mode, precision, ((plan[b] >> 4) & 0xfff) + 1);
+    }
+    /* Directory: mode, precision, index of the block's last colour. */
+    for (b = 0, end = 0; b < blocks; b++) {
+        end += (size_t)((plan[b] >> 4) & 0xfff) + 1;
+        voxcolori_put(w, (plan[b] & 15) | (uint64_t)(end - 1) << 4, 4 + page_shift);
+    }
     for (b = 0; b < blocks; b++) {
         unsigned mode = (unsigned)(plan[b] & 7), k;
         size_t n = (size_t)((plan[b] >> 4) & 0xfff) + 1;

@@ -44,7 +44,7 @@ static void fuzz_decode(const uint8_t *data, size_t size) {
     }
     /* Batched lookups, backwards. */
     {
-        uint64_t *idx = (uint64_t *)malloc(n * sizeof *idx + 1);
+        uint64_t *idx = (uint64_t *)calloc(n + 1, sizeof *idx);
         uint8_t *many = (uint8_t *)malloc(3 * n + 3);
         for (i = 0; i < n; i++) idx[i] = n - 1 - i;
         voxcolor_view_get_many(&v, idx, n, many);

@@ -112,13 +112,23 @@ static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6]) {
     uint64_t page, i = 0;
     for (page = 0; page < pages; page++) {
         uint64_t pos = 8 * ref_le(s + 24 + page * (wide ? 8 : 4), wide ? 8 : 4);
-        uint32_t blocks = ref_bits(data, &pos, ps) + 1, block;
-        uint64_t dir = pos;
-        pos += blocks * (4 + ps); /* payloads follow the directory */
+        uint32_t blocks = ref_bits(data, &pos, ps) + 1, block, first = 0;
+        uint64_t cps = pos, dir = pos + (blocks - 1) / 8 * (2 * ps + 6), payload0;
+        pos = dir + blocks * (4 + ps); /* payloads follow the directory */
+        payload0 = pos;
         for (block = 0; block < blocks; block++) {
-            int mode = (int)ref_bits(data, &dir, 3), prec = (int)ref_bits(data, &dir, 1);
-            uint32_t len = ref_bits(data, &dir, ps) + 1, j;
+            int mode, prec;
+            uint32_t len, j;
             int e0[3], e1[3], k;
+            if (block && block % 8 == 0) {
+                /* A checkpoint: this block's first colour and payload offset. */
+                uint32_t at = ref_bits(data, &cps, ps), off = ref_bits(data, &cps, ps + 6);
+                CHECK(at == first && off == pos - payload0);
+            }
+            mode = (int)ref_bits(data, &dir, 3);
+            prec = (int)ref_bits(data, &dir, 1);
+            len = ref_bits(data, &dir, ps) + 1 - first; /* from the last colour */
+            first += len;
             if (modes) modes[mode]++;
             if (mode == 5) {
                 for (j = 0; j < len; j++, i++)
@@ -422,12 +432,12 @@ static void test_deterministic(void) {
 static void test_golden(void) {
     static const uint8_t rgb[9] = {0x12, 0x34, 0x56, 0x12, 0x34, 0x56, 0x12, 0x34, 0x56};
     static const uint8_t expect[] = {
-        'V', 'X', 'C', '1', 1, 0, 8, 0,   /* magic, version 1, page shift 8, flags */
+        'V', 'X', 'C', '1', 2, 0, 8, 0,   /* magic, version 2, page shift 8, flags */
         3, 0, 0, 0, 0, 0, 0, 0,           /* 3 colours */
         14, 0, 0, 0, 0, 0, 0, 0,          /* 14 bytes of block data */
         0, 0, 0, 0,                       /* page 0 starts at byte 0 */
-        /* blocks - 1 = 0 (8 bits); entry: mode 0 (3 bits), RGB888 (1 bit),
-           length - 1 = 2 (8 bits); payload R G B:
+        /* blocks - 1 = 0 (8 bits); no checkpoints (one block); entry: mode 0
+           (3 bits), RGB888 (1 bit), last colour 2 (8 bits); payload R G B:
            bits 0 | 0x028 << 8 | 0x12 << 20 | 0x34 << 28 | 0x56 << 36 */
         0x00, 0x28, 0x20, 0x41, 0x63, 0x05,
         0, 0, 0, 0, 0, 0, 0, 0, /* closing zero bytes */
@@ -446,22 +456,24 @@ static void put_bits(uint8_t *buf, unsigned *pos, uint64_t v, unsigned n) {
 }
 
 /* A stream of 5 colours in one page of 16 assembled by hand from FORMAT.md:
-   an interpolated RGB565 block of 3 colours and a raw block of 2. The
-   arguments break it in one place. Returns the stream size. */
+   an interpolated RGB565 block of 3 colours and a raw block of 2 (no
+   checkpoints: fewer than 9 blocks). The arguments break it in one place.
+   Returns the stream size. */
 static size_t handmade(uint8_t *s, unsigned mode1, unsigned raw_precision, unsigned length1,
                        unsigned extra_bytes, unsigned table_entry) {
     uint8_t *data = s + 28;
     unsigned pos = 0, k;
     memset(s, 0, 64);
     memcpy(s, "VXC1", 4);
-    s[4] = 1;                             /* format version */
+    s[4] = 2;                             /* format version */
     s[6] = 4;                             /* pages of 16 colours */
     s[8] = 5;                             /* 5 colours */
     s[24] = (uint8_t)table_entry;         /* page 0 starts at data byte 0 */
     put_bits(data, &pos, 2 - 1, 4); /* 2 blocks */
-    /* Directory: mode 2, RGB565, 3 colours; mode 5 (raw), 2 colours. */
+    /* Directory: mode 2, RGB565, colours 0..2; mode 5 (raw), colours 3..4
+       (each entry holds the block's last colour). */
     put_bits(data, &pos, mode1 | 0 << 3 | (length1 - 1) << 4, 3 + 1 + 4);
-    put_bits(data, &pos, 5 | raw_precision << 3 | 1 << 4, 3 + 1 + 4);
+    put_bits(data, &pos, 5 | raw_precision << 3 | 4 << 4, 3 + 1 + 4);
     /* e0 = (31,0,0), e1 = (0,63,31); weights 0 2 3 */
     put_bits(data, &pos, 31 | 0 << 5 | 0 << 11, 16);
     put_bits(data, &pos, 0 | 63 << 5 | 31 << 11, 16);
@@ -495,7 +507,11 @@ static void test_handmade_stream(void) {
     }
     size = handmade(s, 2, 1, 3, 0, 0);
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
-    size = handmade(s, 2, 0, 4, 0, 0); /* blocks would cover 6 colours */
+    size = handmade(s, 2, 0, 4, 0, 0); /* blocks of 4 and 1: payloads do not match */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 6, 0, 0); /* last colours 5 then 4: not growing */
+    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    size = handmade(s, 2, 0, 5, 0, 0); /* last colours 4 and 4 */
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 1, 0); /* 9 closing bytes */
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
@@ -593,7 +609,7 @@ static void test_rejects_garbage(void) {
         free(t);                                                           \
     } while (0)
     WITH(0, 'W', VOXCOLOR_ERR_BAD_MAGIC);
-    WITH(4, 2, VOXCOLOR_ERR_VERSION);
+    WITH(4, 1, VOXCOLOR_ERR_VERSION); /* the previous layout */
     WITH(5, 1, VOXCOLOR_ERR_VERSION);
     WITH(6, 3, VOXCOLOR_ERR_CORRUPT);
     WITH(6, 11, VOXCOLOR_ERR_CORRUPT);
@@ -609,7 +625,7 @@ static void test_rejects_garbage(void) {
         uint64_t count = test_rand_below(&r, 60);
         n = 24 + test_rand_below(&r, 200);
         for (k = 0; k < n; k++) buf[k] = (uint8_t)test_rand(&r);
-        memcpy(buf, "VXC1\1\0", 6);
+        memcpy(buf, "VXC1\2\0", 6);
         buf[6] = (uint8_t)(4 + test_rand_below(&r, 3));
         buf[7] = 0;
         pages = count ? (size_t)((count - 1) >> buf[6]) + 1 : 0;
