@@ -175,10 +175,11 @@ bench-quick: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry
 
 # bench-color: the colour codec against the reimplemented baselines on real
 # textures and a photograph (bench/color_fetch.sh); prints markdown tables.
-# BENCH_COLOR_FLAGS=--quick skips the slowest baseline setting.
+# BENCH_COLOR_FLAGS=--quick skips the slowest baseline setting. External image
+# codecs (JPEG, PNG, pngquant, ASTC, BC1, BC7) run through bench/color_peers.sh.
 .PHONY: bench-color
 $(BUILD)/bench/bench_color: bench/bench_color.c bench/color_baselines.c bench/color_baselines.h voxcolor.h
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -o $@ bench/bench_color.c bench/color_baselines.c -lm
 bench-color: $(BUILD)/bench/bench_color
-	$(BUILD)/bench/bench_color $(BENCH_COLOR_FLAGS) $$(sh bench/color_fetch.sh bench/data/color)
+	$(BUILD)/bench/bench_color $(BENCH_COLOR_FLAGS) --peers bench/color_peers.sh $$(sh bench/color_fetch.sh bench/data/color)

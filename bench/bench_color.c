@@ -4,12 +4,15 @@
    2017, Tables 2-4: size (% of 24-bit), global MSE, PSNR, largest error,
    encode speed, random and coherent lookup speed.
 
-   Usage: bench_color [--max N] [--quick] NAME=IMAGE.ppm[,IMAGE.ppm...] ...
+   Usage: bench_color [--max N] [--quick] [--peers SCRIPT] NAME=IMAGE.ppm[,...] ...
    Each image (binary PPM, as bench/color_fetch.sh makes them) is read along
    a 2D Morton curve, as a voxelized surface's colours would be, and the
    images of one NAME are concatenated into one colour array. Speeds are per
-   core: single-threaded, in CPU time. */
-#define _POSIX_C_SOURCE 199309L /* clock_gettime */
+   core: single-threaded, in CPU time. With --peers, the array is also mapped
+   to a 2D Morton image (voxcolor_to_image) and run through external image
+   codecs by SCRIPT (bench/color_peers.sh); their decoded output is mapped
+   back and measured like ours. */
+#define _POSIX_C_SOURCE 200809L /* clock_gettime, popen */
 #define VOXCOLOR_IMPLEMENTATION
 #include "../voxcolor.h"
 #include "color_baselines.h"
@@ -185,6 +188,96 @@ static void run_baseline(result *r, const uint8_t *rgb, size_t n, int kind, doub
     color_codec_free(c);
 }
 
+// -- External codecs on the 2D-mapped array
+
+static int write_ppm(const char *path, const uint8_t *img, uint32_t w, uint32_t h) {
+    FILE *f = fopen(path, "wb");
+    int ok;
+    if (!f) return 0;
+    fprintf(f, "P6\n%u %u\n255\n", (unsigned)w, (unsigned)h);
+    ok = fwrite(img, 3, (size_t)w * h, f) == (size_t)w * h;
+    return fclose(f) == 0 && ok;
+}
+
+static uint8_t *read_ppm(const char *path, uint32_t *w, uint32_t *h) {
+    FILE *f = fopen(path, "rb");
+    unsigned ww, hh, maxval;
+    uint8_t *img = NULL;
+    if (!f) return NULL;
+    if (fscanf(f, "P6 %u %u %u", &ww, &hh, &maxval) == 3 && maxval == 255 && fgetc(f) != EOF) {
+        img = (uint8_t *)malloc(3 * (size_t)ww * hh);
+        if (img && fread(img, 3, (size_t)ww * hh, f) != (size_t)ww * hh) {
+            free(img);
+            img = NULL;
+        }
+    }
+    fclose(f);
+    *w = ww;
+    *h = hh;
+    return img;
+}
+
+/* Maps the array to an image, has SCRIPT compress and decode it with each
+   external codec, and prints a row per codec setting: size of the compressed
+   file against 24 bits per colour, and the errors of the decoded colours. */
+static void run_peers(const char *script, const uint8_t *rgb, size_t n, int quick) {
+    static const char *dir = "bench/out/color_peers";
+    char cmd[1024], line[1024], path[256];
+    uint32_t w, h;
+    uint8_t *img, *back = (uint8_t *)malloc(3 * n);
+    FILE *p;
+    voxcolor_image_size(n, &w, &h);
+    img = (uint8_t *)malloc(3 * (size_t)w * h);
+    voxcolor_to_image(img, w, h, rgb, n);
+    snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
+    snprintf(path, sizeof path, "%s/morton.ppm", dir);
+    if (system(cmd) != 0 || !write_ppm(path, img, w, h)) {
+        printf("| (external codecs) | cannot write %s | | | | | | | | |\n", path);
+        free(img);
+        free(back);
+        return;
+    }
+    free(img);
+    snprintf(cmd, sizeof cmd, "sh %s %s %s %s", script, dir, path, quick ? "quick" : "");
+    p = popen(cmd, "r");
+    while (p && fgets(line, sizeof line, p)) {
+        char *codec = strtok(line, "|"), *setting = strtok(NULL, "|"), *bytes = strtok(NULL, "|"),
+             *file = strtok(NULL, "|\n");
+        uint32_t dw, dh;
+        uint8_t *dec;
+        double se = 0, worst = 0, mse;
+        size_t i;
+        if (!codec || !setting || !bytes || !file) continue;
+        if (!strcmp(bytes, "skip")) {
+            printf("| %s | %s | skipped: %s | | | | | | | |\n", codec, setting, file);
+            continue;
+        }
+        dec = read_ppm(file, &dw, &dh);
+        if (!dec || dw < w || dh < h) {
+            printf("| %s | %s | skipped: unreadable output | | | | | | | |\n", codec, setting);
+            free(dec);
+            continue;
+        }
+        voxcolor_from_image(back, n, dec, dw, dh);
+        free(dec);
+        for (i = 0; i < 3 * n; i += 3) {
+            int e0 = back[i] - rgb[i], e1 = back[i + 1] - rgb[i + 1], e2 = back[i + 2] - rgb[i + 2];
+            double e = e0 * e0 + e1 * e1 + e2 * e2;
+            se += e;
+            if (e > worst) worst = e;
+        }
+        mse = se / (3.0 * (double)n);
+        printf("| %s | %s | %.2f%% | %.2f | ", codec, setting,
+               100.0 * 8.0 * strtod(bytes, NULL) / (24.0 * (double)n), mse);
+        if (mse > 0) printf("%.1f", 10 * log10(255.0 * 255.0 / mse));
+        else printf("lossless");
+        printf(" | %.4f | - | - | - | - |\n", sqrt(worst) / 255.0);
+        fflush(stdout);
+    }
+    if (p) pclose(p);
+    free(back);
+}
+
 static void machine(char *out, size_t size) {
     FILE *f = fopen("/proc/cpuinfo", "r");
     char line[256];
@@ -204,6 +297,7 @@ int main(int argc, char **argv) {
     static const uint32_t dado_k[] = {0, 4096, 2048, 256};
     size_t max = 0, a, k;
     int quick = 0;
+    const char *peers = NULL;
     char cpu[128];
     machine(cpu, sizeof cpu);
     printf("Machine: %s; compiler: %s; voxcolor %d.%d.%d (stream format %d). "
@@ -222,6 +316,10 @@ int main(int argc, char **argv) {
         }
         if (!strcmp(spec, "--quick")) {
             quick = 1;
+            continue;
+        }
+        if (!strcmp(spec, "--peers") && a + 1 < (size_t)argc) {
+            peers = argv[++a];
             continue;
         }
         files = strchr(spec, '=');
@@ -291,6 +389,7 @@ int main(int argc, char **argv) {
             run_baseline(&r, rgb, n, 2, 0, dado_k[k], idx, lookups);
             print_row(&r, n);
         }
+        if (peers) run_peers(peers, rgb, n, quick);
         printf("\n");
         free(idx);
         free(rgb);
