@@ -227,6 +227,13 @@ VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t
 
 #include <string.h>
 
+/* The encoder's error checks decide the stream's bytes: fused multiply-adds
+   would change them between compilers, so contraction is off where the
+   compiler honours the standard pragma (GCC: compile with -ffp-contract=off). */
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+
 #ifndef VOXCOLOR_ASSERT
 #include <assert.h>
 #define VOXCOLOR_ASSERT(x) assert(x)

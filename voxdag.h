@@ -17,7 +17,7 @@
        uint32_t xyz[] = { 1,2,3,  4,5,6 };
        uint8_t  rgb[] = { 255,0,0,  0,255,0 };
        voxdag_builder_add(b, xyz, rgb, 2, NULL);
-       voxdag_builder_finish(b, &dag, NULL);     // b is freed
+       voxdag_builder_finish(b, &dag, NULL, NULL); // b is freed
        if (voxdag_lookup(dag, 4, 5, 6, &index)) { ... voxdag_color(dag, index, out_rgb) ... }
        voxdag_save_file(dag, "scene.vdag", NULL);
        voxdag_free(dag);
@@ -36,6 +36,7 @@
      VOXDAG_ASSERT(x)     caller-contract checks (default: assert)
      VOXDAG_NO_STDIO      leave out the file helpers
      VOXDAG_NO_THREADS    single-threaded build (no pthreads)
+     VOXDAG_NO_RAYTRACE   leave out ray casting
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
@@ -2878,7 +2879,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
             unsigned header = (unsigned)voxdagi_le(rec, 2);
-            uint32_t half = 1u << (L - 1 - depth);
+            uint32_t half = 1u << (L - 1 - (uint32_t)depth);
             while (f->next < 8 && !(header >> (2 * (f->next ^ f->mirror)) & 3)) f->next++;
             if (f->next == 8) {
                 depth--;

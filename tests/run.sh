@@ -3,6 +3,7 @@
 # Usage: tests/run.sh BUILD_DIR
 set -u
 build=${1:-build}
+export VDAG="$build/vdag" # the tool the tests run, from the same build
 total_pass=0
 total_fail=0
 run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed"
