@@ -64,7 +64,7 @@ $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
 $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
 	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
-$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import_scene.c examples/import.h examples/image.h | $(BUILD)
+$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import_scene.c examples/import.h examples/image.h tests/fuzz_replay.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(FUZZ_IMPORT_DEFS) -I. -o $@ $(FUZZ_IMPORT_SRC) -lm
 
 fuzz-import: | $(BUILD)
@@ -77,7 +77,7 @@ fuzz-import: | $(BUILD)
 # Colour codec fuzzing: libFuzzer (clang) for `make fuzz-voxcolor`; `make test`
 # replays the committed corpus with the same entry point.
 .PHONY: fuzz-voxcolor
-$(BUILD)/fuzz_voxcolor: tests/fuzz_voxcolor.c voxcolor.h | $(BUILD)
+$(BUILD)/fuzz_voxcolor: tests/fuzz_voxcolor.c tests/fuzz_replay.h voxcolor.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) -I. -o $@ tests/fuzz_voxcolor.c -lm
 
 fuzz-voxcolor: | $(BUILD)
@@ -90,7 +90,7 @@ fuzz-voxcolor: | $(BUILD)
 # Loader fuzzing: libFuzzer (clang) for `make fuzz-load`; `make test` replays
 # the committed corpus (seeds from `make_golden --seeds`, crash inputs).
 .PHONY: fuzz-load
-FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/golden.h voxdag.h
+FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/fuzz_replay.h tests/golden.h voxdag.h
 $(BUILD)/fuzz_load: $(FUZZ_LOAD_DEPS) | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_load.c -lm
 

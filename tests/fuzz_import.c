@@ -6,12 +6,10 @@
 #define _POSIX_C_SOURCE 200809L
 #include "examples/import.h"
 
-#include <dirent.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -54,53 +52,5 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 }
 
 #ifndef VDAG_LIBFUZZER
-/* Runs one input file; 0 if it cannot be read. */
-static int replay_file(const char *path) {
-    FILE *f = fopen(path, "rb");
-    uint8_t *data = NULL;
-    size_t size = 0, cap = 0, got;
-    if (!f) return 0;
-    do {
-        if (size == cap) {
-            cap = cap ? 2 * cap : 4096;
-            data = (uint8_t *)realloc(data, cap);
-            REQUIRE(data != NULL);
-        }
-        got = fread(data + size, 1, cap - size, f);
-        size += got;
-    } while (got);
-    fclose(f);
-    LLVMFuzzerTestOneInput(data, size);
-    free(data);
-    return 1;
-}
-
-int main(int argc, char **argv) {
-    int i, passed = 0, failed = 0;
-    for (i = 1; i < argc; i++) {
-        struct stat st;
-        DIR *dir;
-        struct dirent *e;
-        if (stat(argv[i], &st) == 0 && !S_ISDIR(st.st_mode)) {
-            if (replay_file(argv[i])) passed++;
-            else failed++, fprintf(stderr, "fuzz_import: cannot read %s\n", argv[i]);
-            continue;
-        }
-        if (!(dir = opendir(argv[i]))) {
-            fprintf(stderr, "fuzz_import: cannot open %s\n", argv[i]);
-            failed++;
-            continue;
-        }
-        while ((e = readdir(dir)) != NULL) {
-            char path[4096];
-            if (e->d_name[0] == '.') continue;
-            snprintf(path, sizeof path, "%s/%s", argv[i], e->d_name);
-            if (replay_file(path)) passed++;
-            else failed++, fprintf(stderr, "fuzz_import: cannot read %s\n", path);
-        }
-        closedir(dir);
-    }
-    printf("%d passed, %d failed\n", passed, failed);
-    return failed != 0;
-}
+#include "fuzz_replay.h"
 #endif
