@@ -44,7 +44,7 @@ $(BUILD):
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h $(wildcard examples/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/count_alloc.h tests/import_test.h $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
 $(BUILD)/opt/image.o: $(IMAGE_DEPS)
@@ -90,7 +90,7 @@ fuzz-voxcolor: | $(BUILD)
 # Loader fuzzing: libFuzzer (clang) for `make fuzz-load`; `make test` replays
 # the committed corpus (seeds from `make_golden --seeds`, crash inputs).
 .PHONY: fuzz-load
-FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/fuzz_replay.h tests/golden.h voxdag.h
+FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/fuzz_replay.h tests/count_alloc.h tests/golden.h voxdag.h
 $(BUILD)/fuzz_load: $(FUZZ_LOAD_DEPS) | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_load.c -lm
 

@@ -20,6 +20,7 @@
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "golden.h"
+#include "count_alloc.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,35 +33,6 @@ static void require(int ok, const char *what) {
         fprintf(stderr, "fuzz_load: %s\n", what);
         abort();
     }
-}
-
-// -- A counting allocator that can fail at allocation N
-
-typedef struct fuzz_alloc {
-    long calls, fail_at; /* fail_at < 0: never */
-    uint64_t held, peak;
-} fuzz_alloc;
-
-static void *fa_alloc(void *user, size_t size) {
-    fuzz_alloc *a = (fuzz_alloc *)user;
-    unsigned char *p;
-    if (a->fail_at >= 0 && a->calls++ == a->fail_at) return NULL;
-    p = (unsigned char *)malloc(size + 16);
-    if (!p) return NULL;
-    memcpy(p, &size, sizeof size);
-    a->held += size;
-    if (a->held > a->peak) a->peak = a->held;
-    return p + 16;
-}
-
-static void fa_free(void *user, void *ptr, size_t size) {
-    fuzz_alloc *a = (fuzz_alloc *)user;
-    size_t stored;
-    memcpy(&stored, (unsigned char *)ptr - 16, sizeof stored);
-    require(stored == size, "free with a size other than the allocation's");
-    require(a->held >= size, "more bytes freed than allocated");
-    a->held -= size;
-    free((unsigned char *)ptr - 16);
 }
 
 // -- Queries on a loaded DAG
@@ -129,7 +101,7 @@ static void query(const voxdag *d, const uint8_t *file, size_t size) {
 }
 
 /* Rewrites the colour section of a loaded DAG; the result must load. */
-static void recolor(const voxdag *d, fuzz_alloc *fa) {
+static void recolor(const voxdag *d, count_alloc *fa) {
     voxdag_info info;
     voxdag *e = NULL, *f = NULL;
     uint8_t *rgb;
@@ -153,7 +125,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     voxdag_load_opts o;
-    fuzz_alloc fa;
+    count_alloc fa;
     voxdag *d = NULL;
     voxdag_error err;
     voxdag_status st;
@@ -171,8 +143,8 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     fa.fail_at = sel & 16 ? 3 * (long)p : -1;
     memset(&o, 0, sizeof o);
     o.copy = sel & 1;
-    o.allocator.alloc = fa_alloc;
-    o.allocator.free = fa_free;
+    o.allocator.alloc = ca_alloc;
+    o.allocator.free = ca_free;
     o.allocator.user = &fa;
     switch (sel >> 2 & 3) {
     case 1: o.max_nodes = 1 + p * p; break;
@@ -199,6 +171,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     voxdag_free(d);
     require(fa.held == 0, "bytes held after voxdag_free");
+    require(!fa.bad_free, "a free with a size other than the allocation's");
     free(file);
     return 0;
 }

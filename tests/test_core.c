@@ -2,6 +2,7 @@
    a brute-force answer computed here from a dense grid, independently of the
    library's own logic (raster-order subtree contents, sorting, rank). */
 #include "test.h"
+#include "count_alloc.h"
 #include "voxdag.h"
 
 // -- Scenes on a dense grid
@@ -512,31 +513,6 @@ static void test_bad_arguments(void) {
 
 // -- Allocation failure: a counting allocator that fails at call N
 
-typedef struct counting_alloc {
-    long calls, fail_at;
-    size_t held;
-} counting_alloc;
-
-static void *ca_alloc(void *user, size_t size) {
-    counting_alloc *a = (counting_alloc *)user;
-    void *p;
-    if (a->fail_at >= 0 && a->calls++ == a->fail_at) return NULL;
-    p = malloc(size + 16);
-    if (!p) return NULL;
-    memcpy(p, &size, sizeof size);
-    a->held += size;
-    return (char *)p + 16;
-}
-
-static void ca_free(void *user, void *ptr, size_t size) {
-    counting_alloc *a = (counting_alloc *)user;
-    size_t stored;
-    memcpy(&stored, (char *)ptr - 16, sizeof stored);
-    if (stored != size) a->held += 1u << 30; /* size mismatch shows as a leak */
-    a->held -= size;
-    free((char *)ptr - 16);
-}
-
 static void test_allocation_failures(void) {
     scene s = make_scene(SC_SPHERE, 6, 8);
     uint32_t *xyz;
@@ -545,11 +521,12 @@ static void test_allocation_failures(void) {
     long fail_at;
     int succeeded = 0;
     for (fail_at = 0; !succeeded && fail_at < 100000; fail_at++) {
-        counting_alloc ca = {0, 0, 0};
+        count_alloc ca;
         voxdag_build_opts o;
         voxdag_builder *b = NULL;
         voxdag *d = NULL;
         voxdag_status st;
+        memset(&ca, 0, sizeof ca);
         ca.fail_at = fail_at;
         memset(&o, 0, sizeof o);
         o.levels = 6;
@@ -568,7 +545,8 @@ static void test_allocation_failures(void) {
             check_queries(&s, d, "after allocation failures");
         }
         voxdag_free(d);
-        CHECK_MSG(ca.held == 0, "%zu bytes held after failing allocation %ld", ca.held, fail_at);
+        CHECK_MSG(ca.held == 0 && !ca.bad_free, "%llu bytes held (bad free: %d) after failing allocation %ld",
+                  (unsigned long long)ca.held, ca.bad_free, fail_at);
     }
     CHECK(succeeded);
     free(xyz);

@@ -25,6 +25,7 @@
 
 #include "golden.h"
 #include "test.h"
+#include "count_alloc.h"
 
 // -- Helpers
 
@@ -52,38 +53,6 @@ static uint8_t *read_golden(int kind, size_t *size) {
     fclose(f);
     *size = (size_t)n;
     return buf;
-}
-
-/* A counting allocator that fails at call FAIL_AT (never when negative). */
-typedef struct count_alloc {
-    long calls, fail_at;
-    uint64_t held, peak;
-    int bad_free;
-} count_alloc;
-
-static void *ca_alloc(void *user, size_t size) {
-    count_alloc *a = (count_alloc *)user;
-    unsigned char *p;
-    if (a->fail_at >= 0 && a->calls == a->fail_at) {
-        a->calls++;
-        return NULL;
-    }
-    a->calls++;
-    p = (unsigned char *)malloc(size + 16);
-    if (!p) return NULL;
-    memcpy(p, &size, sizeof size);
-    a->held += size;
-    if (a->held > a->peak) a->peak = a->held;
-    return p + 16;
-}
-
-static void ca_free(void *user, void *ptr, size_t size) {
-    count_alloc *a = (count_alloc *)user;
-    size_t stored;
-    memcpy(&stored, (unsigned char *)ptr - 16, sizeof stored);
-    if (stored != size || a->held < size) a->bad_free = 1;
-    a->held -= size;
-    free((unsigned char *)ptr - 16);
 }
 
 static void opts_with(voxdag_load_opts *o, count_alloc *ca, long fail_at) {
