@@ -12,44 +12,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "import_test.h"
+
 // -- Helpers
 
-typedef struct sbytes {
-    uint8_t *p;
-    size_t n, cap;
-} sbytes;
-
-static void sput(sbytes *b, const void *data, size_t n) {
-    if (!n) return;
-    if (b->n + n > b->cap) {
-        b->cap = (b->n + n) * 2 + 64;
-        b->p = (uint8_t *)realloc(b->p, b->cap);
-    }
-    memcpy(b->p + b->n, data, n);
-    b->n += n;
-}
-
-static void sputf(sbytes *b, const char *fmt, ...) {
-    char line[1024];
-    va_list ap;
-    int n;
-    va_start(ap, fmt);
-    n = vsnprintf(line, sizeof line, fmt, ap);
-    va_end(ap);
-    sput(b, line, (size_t)n);
-}
-
-static void sput_le(sbytes *b, uint64_t v, int n) {
-    uint8_t tmp[8];
-    int i;
-    for (i = 0; i < n; i++) tmp[i] = (uint8_t)(v >> (8 * i));
-    sput(b, tmp, (size_t)n);
-}
-
-static void sput_f32(sbytes *b, float f) {
+static void put_f32(bytes *b, float f) {
     uint32_t u;
     memcpy(&u, &f, 4);
-    sput_le(b, u, 4);
+    put_uint(b, u, 4, 0);
 }
 
 /* Half-precision bits of V, a multiple of 1/256 with |V| < 64 (exact). */
@@ -60,59 +30,6 @@ static uint16_t half_of(double v) {
     if (v == 0) return sign;
     m = frexp(fabs(v), &e); /* fabs(v) = m 2^e, m in [0.5, 1) */
     return (uint16_t)(sign | (uint16_t)((e + 14) << 10) | (uint16_t)((m * 2 - 1) * 1024));
-}
-
-static int scene_import(const char *ext, const sbytes *data, vdag_scene *s, char *err, size_t err_size) {
-    int ok = vdag_import_memory(ext, data->p, data->n, NULL, s, err, err_size);
-    if (!ok) {
-        CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
-        CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);
-    }
-    return ok;
-}
-
-static void scene_error(const char *ext, const sbytes *data, const char *want) {
-    vdag_scene s;
-    char err[256];
-    if (scene_import(ext, data, &s, err, sizeof err)) {
-        CHECK_MSG(0, "%s file accepted; expected an error with \"%s\"", ext, want);
-        vdag_scene_free(&s);
-        return;
-    }
-    CHECK_MSG(strstr(err, want) != NULL, "message \"%s\" lacks \"%s\"", err, want);
-}
-
-static void scene_error_text(const char *ext, const char *text, const char *want) {
-    sbytes b = {NULL, 0, 0};
-    sput(&b, text, strlen(text));
-    scene_error(ext, &b, want);
-    free(b.p);
-}
-
-/* Every proper prefix fails (STRICT) or returns cleanly; every byte patched
-   to 0, 0xff, +1 and -1 returns cleanly. */
-static void scene_sweep(const char *ext, const sbytes *data, int strict) {
-    static const int patches[] = {0, 0xff, 1, -1};
-    sbytes cut = {NULL, 0, 0};
-    vdag_scene s;
-    char err[256];
-    size_t n, i, k;
-    for (n = 0; n < data->n; n++) {
-        cut.n = 0;
-        sput(&cut, data->p, n); /* exact size, so ASan sees over-reads */
-        if (scene_import(ext, &cut, &s, err, sizeof err)) {
-            CHECK_MSG(!strict, "%s cut to %zu of %zu bytes accepted", ext, n, data->n);
-            vdag_scene_free(&s);
-        }
-    }
-    for (i = 0; i < data->n; i++)
-        for (k = 0; k < 4; k++) {
-            cut.n = 0;
-            sput(&cut, data->p, data->n);
-            cut.p[i] = (uint8_t)(k < 2 ? patches[k] : cut.p[i] + patches[k]);
-            if (scene_import(ext, &cut, &s, err, sizeof err)) vdag_scene_free(&s);
-        }
-    free(cut.p);
 }
 
 static double rand_eighths(uint64_t *seed, int range) {
@@ -136,55 +53,55 @@ typedef struct spm_case {
     int32_t tmat[3 * SPM_MAX_T];
 } spm_case;
 
-static void write_spm(sbytes *b, spm_case *t, uint64_t *seed) {
+static void write_spm(bytes *b, spm_case *t, uint64_t *seed) {
     unsigned i, k, buf;
-    sput(b, "SP", 2);
-    sput_le(b, 1 << 3 | 2, 1);
-    sput_le(b, t->flags, 1);
-    for (i = 0; i < 6; i++) sput_f32(b, (float)i);
-    sput_le(b, t->nmat, 2);
+    put(b, "SP", 2);
+    put_uint(b, 1 << 3 | 2, 1, 0);
+    put_uint(b, t->flags, 1, 0);
+    for (i = 0; i < 6; i++) put_f32(b, (float)i);
+    put_uint(b, t->nmat, 2, 0);
     for (i = 0; i < t->nmat; i++) {
-        sput_le(b, strlen(t->tex1[i]), 1);
-        sput(b, t->tex1[i], strlen(t->tex1[i]));
-        sput_le(b, strlen(t->tex2[i]), 1);
-        sput(b, t->tex2[i], strlen(t->tex2[i]));
+        put_uint(b, strlen(t->tex1[i]), 1, 0);
+        put(b, t->tex1[i], strlen(t->tex1[i]));
+        put_uint(b, strlen(t->tex2[i]), 1, 0);
+        put(b, t->tex2[i], strlen(t->tex2[i]));
     }
-    sput_le(b, 2, 2); /* two meshes: buffer 0, then the rest */
+    put_uint(b, 2, 2, 0); /* two meshes: buffer 0, then the rest */
     t->nv = t->nt = 0;
     for (buf = 0; buf < t->nbuf; buf++) {
         unsigned vc = t->vc[buf], tc = t->ic[buf] / 3, mid = t->mid[buf];
         int tex1 = t->tex1[mid][0] != 0, tex2 = tex1 && t->tex2[mid][0] != 0;
         size_t base = t->nv;
-        if (buf < 2) sput_le(b, buf == 0 ? 1 : t->nbuf - 1, 2);
-        sput_le(b, vc, 4);
-        sput_le(b, 3 * tc, 4);
-        sput_le(b, mid, 2);
+        if (buf < 2) put_uint(b, buf == 0 ? 1 : t->nbuf - 1, 2, 0);
+        put_uint(b, vc, 4, 0);
+        put_uint(b, 3 * tc, 4, 0);
+        put_uint(b, mid, 2, 0);
         for (i = 0; i < vc; i++) {
             double *p = t->pos[t->nv], x = rand_eighths(seed, 100), y = rand_eighths(seed, 100),
                    z = rand_eighths(seed, 100);
-            sput_f32(b, (float)x);
-            sput_f32(b, (float)y);
-            sput_f32(b, (float)z);
+            put_f32(b, (float)x);
+            put_f32(b, (float)y);
+            put_f32(b, (float)z);
             p[0] = x, p[1] = z, p[2] = y;
-            if (t->flags & 1) sput_le(b, test_rand(seed), 4);
+            if (t->flags & 1) put_uint(b, test_rand(seed), 4, 0);
             if (t->flags & 2) {
                 if (test_rand_below(seed, 3) == 0) {
-                    sput_le(b, 128, 1);
+                    put_uint(b, 128, 1, 0);
                     memset(t->rgb[t->nv], 255, 3);
                 } else {
-                    sput_le(b, test_rand_below(seed, 2) ? 0 : 200, 1);
+                    put_uint(b, test_rand_below(seed, 2) ? 0 : 200, 1, 0);
                     for (k = 0; k < 3; k++) t->rgb[t->nv][k] = (uint8_t)test_rand_below(seed, 256);
-                    sput(b, t->rgb[t->nv], 3);
+                    put(b, t->rgb[t->nv], 3);
                 }
             }
             t->uv[t->nv][0] = t->uv[t->nv][1] = 0;
             if (tex1) {
                 for (k = 0; k < 2; k++) {
                     t->uv[t->nv][k] = (float)(((double)test_rand_below(seed, 4096) - 2048) / 256.0);
-                    sput_le(b, half_of(t->uv[t->nv][k]), 2);
+                    put_uint(b, half_of(t->uv[t->nv][k]), 2, 0);
                 }
-                if (tex2) sput_le(b, test_rand(seed), 4);
-                if (t->flags & 4) sput_le(b, test_rand(seed), 4);
+                if (tex2) put_uint(b, test_rand(seed), 4, 0);
+                if (t->flags & 4) put_uint(b, test_rand(seed), 4, 0);
             }
             t->nv++;
         }
@@ -192,7 +109,7 @@ static void write_spm(sbytes *b, spm_case *t, uint64_t *seed) {
             for (k = 0; k < 3; k++) {
                 uint32_t idx = test_rand_below(seed, vc);
                 t->tri[t->nt][k] = (uint32_t)base + idx;
-                sput_le(b, idx, vc > 255 ? 2 : 1);
+                put_uint(b, idx, vc > 255 ? 2 : 1, 0);
             }
             t->tmat[t->nt++] = (int32_t)mid;
         }
@@ -243,12 +160,12 @@ static void test_spm_roundtrip(void) {
     uint64_t seed = 61;
     int round;
     for (round = 0; round < 40; round++) {
-        sbytes b = {NULL, 0, 0};
+        bytes b = {NULL, 0, 0};
         vdag_scene s;
         char err[256];
         random_spm(&t, &seed);
         write_spm(&b, &t, &seed);
-        if (!scene_import("spm", &b, &s, err, sizeof err)) {
+        if (!import("spm", &b, &s, err, sizeof err)) {
             CHECK_MSG(0, "round %d: %s", round, err);
         } else {
             check_spm(&s, &t);
@@ -262,7 +179,7 @@ static void test_spm_roundtrip(void) {
 static void test_spm_sweep(void) {
     static spm_case t;
     uint64_t seed = 7;
-    sbytes b = {NULL, 0, 0};
+    bytes b = {NULL, 0, 0};
     memset(&t, 0, sizeof t);
     t.flags = 7;
     t.nmat = 2;
@@ -271,102 +188,102 @@ static void test_spm_sweep(void) {
     t.vc[0] = 3, t.ic[0] = 3, t.mid[0] = 0;
     t.vc[1] = 4, t.ic[1] = 6, t.mid[1] = 1;
     write_spm(&b, &t, &seed);
-    scene_sweep("spm", &b, 1);
+    sweep("spm", &b, 1);
     free(b.p);
 }
 
-static void spm_header(sbytes *b, unsigned kind, unsigned flags, const char *tex) {
+static void spm_header(bytes *b, unsigned kind, unsigned flags, const char *tex) {
     int i;
-    sput(b, "SP", 2);
-    sput_le(b, 1 << 3 | kind, 1);
-    sput_le(b, flags, 1);
-    for (i = 0; i < 6; i++) sput_f32(b, 0);
-    sput_le(b, 1, 2);
-    sput_le(b, strlen(tex), 1);
-    sput(b, tex, strlen(tex));
-    sput_le(b, 0, 1);
+    put(b, "SP", 2);
+    put_uint(b, 1 << 3 | kind, 1, 0);
+    put_uint(b, flags, 1, 0);
+    for (i = 0; i < 6; i++) put_f32(b, 0);
+    put_uint(b, 1, 2, 0);
+    put_uint(b, strlen(tex), 1, 0);
+    put(b, tex, strlen(tex));
+    put_uint(b, 0, 1, 0);
 }
 
 /* One mesh, one buffer: VC vertices at (I, 0, 0), then the indices. */
-static void spm_buffer(sbytes *b, uint32_t vc, uint32_t ic, unsigned mid, const uint32_t *idx, size_t n) {
+static void spm_buffer(bytes *b, uint32_t vc, uint32_t ic, unsigned mid, const uint32_t *idx, size_t n) {
     uint32_t i;
-    sput_le(b, 1, 2);
-    sput_le(b, 1, 2);
-    sput_le(b, vc, 4);
-    sput_le(b, ic, 4);
-    sput_le(b, mid, 2);
+    put_uint(b, 1, 2, 0);
+    put_uint(b, 1, 2, 0);
+    put_uint(b, vc, 4, 0);
+    put_uint(b, ic, 4, 0);
+    put_uint(b, mid, 2, 0);
     for (i = 0; i < vc && i < 16; i++) {
-        sput_f32(b, (float)i);
-        sput_f32(b, 0);
-        sput_f32(b, 0);
+        put_f32(b, (float)i);
+        put_f32(b, 0);
+        put_f32(b, 0);
     }
-    for (i = 0; i < n; i++) sput_le(b, idx[i], 1);
+    for (i = 0; i < n; i++) put_uint(b, idx[i], 1, 0);
 }
 
 static void test_spm_errors(void) {
     static const uint32_t tri[3] = {0, 1, 2}, bad[3] = {0, 1, 3};
-    sbytes b = {NULL, 0, 0};
+    bytes b = {NULL, 0, 0};
     float nan_f = (float)NAN;
     uint32_t u;
-    scene_error_text("spm", "", "no \"SP\" header");
-    scene_error_text("spm", "PS\x0a\x03", "no \"SP\" header");
+    expect_error_text("spm", "", "no \"SP\" header");
+    expect_error_text("spm", "PS\x0a\x03", "no \"SP\" header");
     spm_header(&b, 1, 0, "");
-    scene_error("spm", &b, "skinned");
+    expect_error("spm", &b, "skinned");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 3, 1, tri, 3);
-    scene_error("spm", &b, "material 1 of 1");
+    expect_error("spm", &b, "material 1 of 1");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 3, 0, bad, 3);
-    scene_error("spm", &b, "index 3 of 3 vertices");
+    expect_error("spm", &b, "index 3 of 3 vertices");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 2, 0, tri, 2);
-    scene_error("spm", &b, "not whole triangles");
+    expect_error("spm", &b, "not whole triangles");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 0xffffffffu, 3, 0, tri, 3);
-    scene_error("spm", &b, "need more bytes than remain");
+    expect_error("spm", &b, "need more bytes than remain");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 0x7ffffffeu, 0, tri, 3);
-    scene_error("spm", &b, "need more bytes than remain");
+    expect_error("spm", &b, "need more bytes than remain");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 3, 0, tri, 3);
-    sput_le(&b, 0, 1);
-    scene_error("spm", &b, "1 bytes after the last mesh");
+    put_uint(&b, 0, 1, 0);
+    expect_error("spm", &b, "1 bytes after the last mesh");
     b.n = 0; /* NaN position: a coordinate of the second vertex */
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 3, 0, tri, 3);
     memcpy(&u, &nan_f, 4);
     memcpy(b.p + 28 + 4 + 14 + 12 + 4, &u, 4); /* header, material, buffer, vertex 0, x */
-    scene_error("spm", &b, "not a finite number");
+    expect_error("spm", &b, "not a finite number");
     b.n = 0; /* an infinite half texture coordinate */
     spm_header(&b, 2, 0, "t.png");
-    sput_le(&b, 1, 2);
-    sput_le(&b, 1, 2);
-    sput_le(&b, 3, 4);
-    sput_le(&b, 3, 4);
-    sput_le(&b, 0, 2);
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, 3, 4, 0);
+    put_uint(&b, 3, 4, 0);
+    put_uint(&b, 0, 2, 0);
     for (u = 0; u < 3; u++) {
-        sput_f32(&b, (float)u), sput_f32(&b, 0), sput_f32(&b, 0);
-        sput_le(&b, u == 2 ? 0x7c00 : 0, 2);
-        sput_le(&b, 0, 2);
+        put_f32(&b, (float)u), put_f32(&b, 0), put_f32(&b, 0);
+        put_uint(&b, u == 2 ? 0x7c00 : 0, 2, 0);
+        put_uint(&b, 0, 2, 0);
     }
-    sput(&b, "\0\1\2", 3);
-    scene_error("spm", &b, "vertex 2: not a finite number");
+    put(&b, "\0\1\2", 3);
+    expect_error("spm", &b, "vertex 2: not a finite number");
     b.n = 0; /* a colour byte other than 128 without its RGB */
     spm_header(&b, 2, 2, "");
-    sput_le(&b, 1, 2);
-    sput_le(&b, 1, 2);
-    sput_le(&b, 1, 4);
-    sput_le(&b, 0, 4);
-    sput_le(&b, 0, 2);
-    sput_f32(&b, 0), sput_f32(&b, 0), sput_f32(&b, 0);
-    sput_le(&b, 7, 1);
-    scene_error("spm", &b, "truncated");
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, 1, 4, 0);
+    put_uint(&b, 0, 4, 0);
+    put_uint(&b, 0, 2, 0);
+    put_f32(&b, 0), put_f32(&b, 0), put_f32(&b, 0);
+    put_uint(&b, 7, 1, 0);
+    expect_error("spm", &b, "truncated");
     free(b.p);
 }
 
@@ -420,33 +337,33 @@ static void random_ac(ac_case *t, uint64_t *seed) {
     }
 }
 
-static void write_ac_object(sbytes *b, const ac_case *t, int o) {
+static void write_ac_object(bytes *b, const ac_case *t, int o) {
     int i, k;
-    sputf(b, "OBJECT poly\nname \"part %d\"\ndata 12\nline1\n#line2\n\n", o);
+    putf(b, "OBJECT poly\nname \"part %d\"\ndata 12\nline1\n#line2\n\n", o);
     if (o > 0) {
-        sputf(b, "rot");
-        for (k = 0; k < 9; k++) sputf(b, " %d", t->rot[o][k]);
-        sputf(b, "\nloc %d %d %d\n", t->loc[o][0], t->loc[o][1], t->loc[o][2]);
+        putf(b, "rot");
+        for (k = 0; k < 9; k++) putf(b, " %d", t->rot[o][k]);
+        putf(b, "\nloc %d %d %d\n", t->loc[o][0], t->loc[o][1], t->loc[o][2]);
     }
-    sputf(b, "crease 45.0\nnumvert 8\n");
-    for (i = 0; i < 8; i++) sputf(b, "%g %g %g\n", t->v[o][i][0], t->v[o][i][1], t->v[o][i][2]);
-    sputf(b, "numsurf 3\nSURF 0x22\nmat 0\nrefs 2\n0 0 0\n1 0 0\n");
+    putf(b, "crease 45.0\nnumvert 8\n");
+    for (i = 0; i < 8; i++) putf(b, "%g %g %g\n", t->v[o][i][0], t->v[o][i][1], t->v[o][i][2]);
+    putf(b, "numsurf 3\nSURF 0x22\nmat 0\nrefs 2\n0 0 0\n1 0 0\n");
     for (i = 0; i < 2; i++) {
-        sputf(b, "SURF 0x%d0\nmat %d\nrefs %zu\n", i + 1, t->mat[o][i], t->poly_n[o][i]);
-        for (k = 0; k < (int)t->poly_n[o][i]; k++) sputf(b, "%u 0.5 0.25\n", t->poly[o][i][k]);
+        putf(b, "SURF 0x%d0\nmat %d\nrefs %zu\n", i + 1, t->mat[o][i], t->poly_n[o][i]);
+        for (k = 0; k < (int)t->poly_n[o][i]; k++) putf(b, "%u 0.5 0.25\n", t->poly[o][i][k]);
     }
 }
 
-static void write_ac(sbytes *b, const ac_case *t) {
-    sputf(b, "AC3Db\nMATERIAL \"red # one\" rgb 1 0 0  amb 0.2 0.2 0.2  emis 0 0 0  spec 0 0 0  shi 10  trans 0\n");
-    sputf(b, "MATERIAL \"\" rgb 0.2 0.4 1 amb 1 1 1 emis 0 0 0 spec 0 0 0 shi 0 trans 0\n");
-    sputf(b, "OBJECT world\nkids 2\n");
+static void write_ac(bytes *b, const ac_case *t) {
+    putf(b, "AC3Db\nMATERIAL \"red # one\" rgb 1 0 0  amb 0.2 0.2 0.2  emis 0 0 0  spec 0 0 0  shi 10  trans 0\n");
+    putf(b, "MATERIAL \"\" rgb 0.2 0.4 1 amb 1 1 1 emis 0 0 0 spec 0 0 0 shi 0 trans 0\n");
+    putf(b, "OBJECT world\nkids 2\n");
     write_ac_object(b, t, 0);
-    sputf(b, "kids 0\n");
+    putf(b, "kids 0\n");
     write_ac_object(b, t, 1);
-    sputf(b, "kids 1\n");
+    putf(b, "kids 1\n");
     write_ac_object(b, t, 2);
-    sputf(b, "kids 0\n");
+    putf(b, "kids 0\n");
 }
 
 static void test_ac_roundtrip(void) {
@@ -454,14 +371,14 @@ static void test_ac_roundtrip(void) {
     uint64_t seed = 5;
     int round;
     for (round = 0; round < 30; round++) {
-        sbytes b = {NULL, 0, 0};
+        bytes b = {NULL, 0, 0};
         vdag_scene s;
         char err[256];
         size_t nv = 0, nt = 0, o, i, k;
         int first_mat = -1;
         random_ac(&t, &seed);
         write_ac(&b, &t);
-        if (!scene_import("ac", &b, &s, err, sizeof err)) {
+        if (!import("ac", &b, &s, err, sizeof err)) {
             CHECK_MSG(0, "round %d: %s", round, err);
             free(b.p);
             continue;
@@ -502,10 +419,10 @@ static void test_ac_roundtrip(void) {
 static void test_ac_sweep(void) {
     ac_case t;
     uint64_t seed = 3;
-    sbytes b = {NULL, 0, 0};
+    bytes b = {NULL, 0, 0};
     random_ac(&t, &seed);
     write_ac(&b, &t);
-    scene_sweep("ac", &b, 0);
+    sweep("ac", &b, 0);
     free(b.p);
 }
 
@@ -513,41 +430,41 @@ static void test_ac_errors(void) {
     static const char obj[] = "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n";
     char text[512];
     int i;
-    sbytes b = {NULL, 0, 0};
-    scene_error_text("ac", "", "no \"AC3D\" header");
-    scene_error_text("ac", "ply\n", "no \"AC3D\" header");
-    scene_error_text("ac", "AC3Db\nMATERIAL \"m\"\n", "MATERIAL without rgb");
-    scene_error_text("ac", "AC3Db\nfoo\n", "expected MATERIAL or OBJECT");
-    scene_error_text("ac", "AC3Db\nOBJECT world\nname \"w\"\n", "without kids line");
-    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 2\nOBJECT poly\nkids 0\n", "missing kids");
-    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 1\nnumvert 1\n", "expected OBJECT");
-    scene_error_text("ac", "AC3Db\nOBJECT world\nkids 99999999\n", "bad kids count");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 4000000000\n0 0 0\n", "bad numvert count");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 nan 0\nkids 0\n", "a vertex needs 3 numbers");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 0\nkids 0\n", "a vertex needs 3 numbers");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nrot 1 0 0 0 1 0 0 0\n", "rot needs 9 numbers");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nloc 1 inf 0\n", "loc needs 3 numbers");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\nloc 1e30 0 0\nnumvert 1\n1e30 0 0\nkids 0\n", "out of range once placed");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\ndata 100\nabc\n", "bad data length");
-    scene_error_text("ac", "AC3Db\nOBJECT poly\ntexture \"a.png\nkids 0\n", "unterminated texture name");
+    bytes b = {NULL, 0, 0};
+    expect_error_text("ac", "", "no \"AC3D\" header");
+    expect_error_text("ac", "ply\n", "no \"AC3D\" header");
+    expect_error_text("ac", "AC3Db\nMATERIAL \"m\"\n", "MATERIAL without rgb");
+    expect_error_text("ac", "AC3Db\nfoo\n", "expected MATERIAL or OBJECT");
+    expect_error_text("ac", "AC3Db\nOBJECT world\nname \"w\"\n", "without kids line");
+    expect_error_text("ac", "AC3Db\nOBJECT world\nkids 2\nOBJECT poly\nkids 0\n", "missing kids");
+    expect_error_text("ac", "AC3Db\nOBJECT world\nkids 1\nnumvert 1\n", "expected OBJECT");
+    expect_error_text("ac", "AC3Db\nOBJECT world\nkids 99999999\n", "bad kids count");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 4000000000\n0 0 0\n", "bad numvert count");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 nan 0\nkids 0\n", "a vertex needs 3 numbers");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 0\nkids 0\n", "a vertex needs 3 numbers");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nrot 1 0 0 0 1 0 0 0\n", "rot needs 9 numbers");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nloc 1 inf 0\n", "loc needs 3 numbers");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nloc 1e30 0 0\nnumvert 1\n1e30 0 0\nkids 0\n", "out of range once placed");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\ndata 100\nabc\n", "bad data length");
+    expect_error_text("ac", "AC3Db\nOBJECT poly\ntexture \"a.png\nkids 0\n", "unterminated texture name");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nmat 1\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
-    scene_error_text("ac", text, "material out of range");
+    expect_error_text("ac", text, "material out of range");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n3 0 0\nkids 0\n", obj);
-    scene_error_text("ac", text, "vertex index out of range");
+    expect_error_text("ac", text, "vertex index out of range");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nrefs 3\n0 0 0\n1 nan 0\n2 0 0\nkids 0\n", obj);
-    scene_error_text("ac", text, "bad texture coordinates");
+    expect_error_text("ac", text, "bad texture coordinates");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0xzz\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
-    scene_error_text("ac", text, "bad SURF flags");
+    expect_error_text("ac", text, "bad SURF flags");
     snprintf(text, sizeof text, "%snumsurf 2\nSURF 0x0\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n", obj);
-    scene_error_text("ac", text, "expected SURF flags");
+    expect_error_text("ac", text, "expected SURF flags");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nrefs 3\n0 0 0\n", obj);
-    scene_error_text("ac", text, "truncated refs");
+    expect_error_text("ac", text, "truncated refs");
     snprintf(text, sizeof text, "%snumsurf 1\nSURF 0x0\nfoo\n", obj);
-    scene_error_text("ac", text, "expected mat or refs");
+    expect_error_text("ac", text, "expected mat or refs");
     /* Nesting deeper than any real file: an error, not a stack overflow. */
-    sputf(&b, "AC3Db\n");
-    for (i = 0; i < 300; i++) sputf(&b, "OBJECT group\nkids 1\n");
-    scene_error("ac", &b, "nested too deep");
+    putf(&b, "AC3Db\n");
+    for (i = 0; i < 300; i++) putf(&b, "OBJECT group\nkids 1\n");
+    expect_error("ac", &b, "nested too deep");
     free(b.p);
 }
 
@@ -564,9 +481,9 @@ static int sfile(const char *path, const void *data, size_t n) {
 }
 
 static void ppm(const char *path, int variant) {
-    sbytes b = {NULL, 0, 0};
-    sputf(&b, "P6\n%d 2\n255\n", 2);
-    sput(&b, scene_pixels, sizeof scene_pixels);
+    bytes b = {NULL, 0, 0};
+    putf(&b, "P6\n%d 2\n255\n", 2);
+    put(&b, scene_pixels, sizeof scene_pixels);
     b.p[b.n - 1] = (uint8_t)variant;
     CHECK(sfile(path, b.p, b.n));
     free(b.p);
@@ -580,7 +497,7 @@ static void test_scene_files(void) {
     static spm_case t;
     static const char *const made[] = {"tracks", "tracks/t", "textures", "library", "library/lib1"};
     uint64_t seed = 11;
-    sbytes b = {NULL, 0, 0};
+    bytes b = {NULL, 0, 0};
     vdag_scene s;
     vdag_image probe;
     int decodes, i, n = 0;
@@ -631,7 +548,7 @@ static void test_scene_files(void) {
     }
 
     b.n = 0;
-    sputf(&b, "AC3Db\nMATERIAL \"m\" rgb 0 1 0\nOBJECT world\nkids 2\nOBJECT poly\ntexture \"near.ppm\"\n"
+    putf(&b, "AC3Db\nMATERIAL \"m\" rgb 0 1 0\nOBJECT world\nkids 2\nOBJECT poly\ntexture \"near.ppm\"\n"
               "texture \"ignored.png\"\ntexrep 2 4\ntexoff 0.5 0.25\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n"
               "numsurf 1\nSURF 0x10\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0.5 1\nkids 0\n"
               "OBJECT poly\ntexture empty_texture_no_mapping\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n"
