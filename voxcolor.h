@@ -45,7 +45,9 @@
      VOXCOLOR_ASSERT(x)   caller-contract checks (default: assert)
      VOXCOLOR_STATIC      give every function internal linkage
    The codec never allocates: the caller owns every buffer. voxcolor_encode
-   uses about 9 KiB of stack; decoding a few hundred bytes.
+   uses about 25 KiB of stack; decoding a few hundred bytes. Arrays too large
+   to hold in memory stream through voxcolor_encoder (colours in, stream
+   out, chunk by chunk).
 
    THREADS: no global state. A view is immutable after voxcolor_view_init: any
    number of threads may query one view at the same time. Encoding reads its
@@ -148,6 +150,78 @@ VOXCOLOR_API size_t voxcolor_encode_bound(size_t count);
    options give the same bytes. Invalid options trip VOXCOLOR_ASSERT. */
 VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
                                     size_t count, const voxcolor_encode_opts *opts);
+
+// -- Streaming encoding
+
+/* Stores SIZE bytes of the stream at byte OFFSET of the stream; returns 1, or
+   0 to stop the encoder (a write error). */
+typedef int (*voxcolor_write_fn)(void *user, uint64_t offset, const void *bytes, size_t size);
+
+/* The error test and modes of an encoder (private to the implementation). */
+typedef struct voxcolori_enc {
+    uint32_t thr2;      /* RGB: largest squared distance allowed */
+    int lab;            /* 1: CIELAB metric */
+    double lab_thr2;    /* CIELAB: largest squared delta E allowed */
+    double line2;       /* RGB: squared bound plus interpolation rounding */
+    double linear[256]; /* CIELAB: sRGB channel value to linear light */
+    unsigned page_shift;
+    unsigned modes[5], mode_count;
+    unsigned precisions[2], precision_count;
+} voxcolori_enc;
+
+/* A streaming encoder: takes the colours in index order, in chunks of any
+   size, and hands the stream to a write callback as it goes, holding at most
+   one page of colours and a few KiB of output (about 16 KiB in all, no
+   allocation). Its fields are private. The stream is byte for byte the one
+   voxcolor_encode makes from the same colours and options.
+
+       voxcolor_encoder enc;             // e.g. static or on the heap
+       voxcolor_encoder_init(&enc, count, &opts, write, file);
+       while (more colours)
+           voxcolor_encoder_push(&enc, chunk, chunk_count);
+       uint64_t size = voxcolor_encoder_finish(&enc);   // 0: failed
+
+   The colour count is given up front: it fixes where the block data starts.
+   WRITE receives the block data in order (offsets growing from
+   voxcolor_encoder_data_offset), the page table in pieces as pages complete
+   (in order), and the 24-byte header at offset 0 last, in finish. The pieces
+   never overlap and tile [0, size) exactly, so WRITE may pwrite to a file,
+   fill a buffer it grows, or keep the small header and table apart and
+   append only the block data. */
+typedef struct voxcolor_encoder {
+    voxcolori_enc enc;
+    voxcolor_write_fn write;
+    void *user;
+    uint64_t count, pushed;    /* colours declared, colours received */
+    uint64_t data_offset;      /* stream offset of the block data */
+    uint64_t data_size;        /* block data bytes made (written or in out) */
+    uint64_t pages;            /* pages made */
+    uint32_t entry, held, out_used, table_used;
+    int failed;
+    uint8_t rgb[3u << VOXCOLOR_MAX_PAGE_SHIFT]; /* the colours of the open page */
+    uint8_t out[8192];                           /* block data not yet written */
+    uint8_t table[2048];                         /* page table entries not yet written */
+} voxcolor_encoder;
+
+/* Sets up ENC to encode COUNT colours with OPTS (may be NULL; as for
+   voxcolor_encode) and to hand the stream to WRITE with USER. Writes
+   nothing yet. Invalid options trip VOXCOLOR_ASSERT. */
+VOXCOLOR_API void voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
+                                        const voxcolor_encode_opts *opts, voxcolor_write_fn write,
+                                        void *user);
+
+/* Byte offset in the stream where the block data starts (24 plus the page
+   table): known from the colour count alone. */
+VOXCOLOR_API uint64_t voxcolor_encoder_data_offset(const voxcolor_encoder *enc);
+
+/* Encodes the next N colours (RGB8) in index order; at most the count given
+   to init in all. Returns 1, or 0 when a write failed (then every later call
+   fails too). RGB8 may be reused as soon as this returns. */
+VOXCOLOR_API int voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8, size_t n);
+
+/* Writes the rest of the stream. Returns its size in bytes, or 0 when a write
+   failed or fewer colours than declared were pushed. */
+VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc);
 
 // -- Decoding
 
@@ -623,16 +697,6 @@ VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t fi
 
 // -- Encoding: error metric
 
-typedef struct voxcolori_enc {
-    uint32_t thr2;          /* RGB: largest squared distance allowed */
-    int lab;                /* 1: CIELAB metric */
-    double lab_thr2;        /* CIELAB: largest squared delta E allowed */
-    double line2;           /* RGB: squared bound plus interpolation rounding */
-    double linear[256];     /* CIELAB: sRGB channel value to linear light */
-    unsigned page_shift;
-    unsigned modes[VOXCOLORI_MAX_WEIGHT_BITS + 1], mode_count;
-    unsigned precisions[2], precision_count;
-} voxcolori_enc;
 
 /* X^(1/N) for X in [0, 2] by Newton's method from above (no libm needed). */
 static double voxcolori_root(double x, unsigned n) {
@@ -1119,55 +1183,153 @@ VOXCOLOR_API size_t voxcolor_encode_bound(size_t count) {
     return VOXCOLOR_HEADER_SIZE + 8 + pages * 11 + 3 * count;
 }
 
-VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
-                                    size_t count, const voxcolor_encode_opts *opts) {
-    voxcolor_encode_opts defaults;
-    voxcolori_enc e;
-    voxcolori_writer w;
-    uint8_t *data;
-    size_t pages, entry, table, page, used, cap, blocks;
+/* Hands the buffered block data to the write callback. */
+static void voxcolori_flush_data(voxcolor_encoder *s) {
+    if (!s->failed && s->out_used &&
+        !s->write(s->user, s->data_offset + s->data_size - s->out_used, s->out, s->out_used))
+        s->failed = 1;
+    s->out_used = 0;
+}
+
+/* Hands the buffered page table entries to the write callback. */
+static void voxcolori_flush_table(voxcolor_encoder *s) {
+    uint64_t first = s->pages - s->table_used / s->entry;
+    if (!s->failed && s->table_used &&
+        !s->write(s->user, VOXCOLOR_HEADER_SIZE + first * s->entry, s->table, s->table_used))
+        s->failed = 1;
+    s->table_used = 0;
+}
+
+/* Encodes one page of N colours: its table entry, then its blocks. */
+static void voxcolori_encode_page(voxcolor_encoder *s, const uint8_t *rgb, size_t n) {
     uint64_t plan[1u << VOXCOLOR_MAX_PAGE_SHIFT]; /* 8 KiB */
+    voxcolori_writer w;
+    size_t blocks, most = (2 * s->enc.page_shift + 4 + 24 * n + 7) / 8;
+    if (s->table_used + s->entry > sizeof s->table) voxcolori_flush_table(s);
+    voxcolori_store_le(s->table + s->table_used, s->data_size, s->entry);
+    s->table_used += s->entry;
+    s->pages++;
+    /* A page never takes more than one raw block would. */
+    if (s->out_used + most > sizeof s->out) voxcolori_flush_data(s);
+    w.p = s->out + s->out_used;
+    w.acc = 0;
+    w.n = 0;
+    blocks = voxcolori_plan_page(&s->enc, rgb, n, plan);
+    voxcolori_write_page(&w, rgb, plan, blocks, s->enc.page_shift);
+    if (w.n) voxcolori_put(&w, 0, 8 - w.n);
+    VOXCOLOR_ASSERT((size_t)(w.p - (s->out + s->out_used)) <= most);
+    s->data_size += (uint64_t)(w.p - (s->out + s->out_used));
+    s->out_used = (uint32_t)(w.p - s->out);
+}
+
+VOXCOLOR_API void voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
+                                        const voxcolor_encode_opts *opts, voxcolor_write_fn write,
+                                        void *user) {
+    voxcolor_encode_opts defaults;
+    uint64_t pages;
     memset(&defaults, 0, sizeof defaults);
     if (!opts) opts = &defaults;
-    VOXCOLOR_ASSERT(dst || !dst_size);
-    VOXCOLOR_ASSERT(rgb8 || !count);
+    VOXCOLOR_ASSERT(enc && write);
     VOXCOLOR_ASSERT(opts->max_error >= 0); /* also rejects NaN */
     VOXCOLOR_ASSERT(opts->metric == VOXCOLOR_METRIC_RGB || opts->metric == VOXCOLOR_METRIC_CIELAB);
     VOXCOLOR_ASSERT(opts->weight_bits <= VOXCOLORI_MAX_WEIGHT_BITS);
     VOXCOLOR_ASSERT(!opts->page_shift || (opts->page_shift >= VOXCOLOR_MIN_PAGE_SHIFT &&
                                           opts->page_shift <= VOXCOLOR_MAX_PAGE_SHIFT));
-    voxcolori_enc_init(&e, opts);
-    pages = count ? ((count - 1) >> e.page_shift) + 1 : 0;
+    voxcolori_enc_init(&enc->enc, opts);
+    enc->write = write;
+    enc->user = user;
+    enc->count = count;
+    enc->pushed = 0;
+    pages = count ? ((count - 1) >> enc->enc.page_shift) + 1 : 0;
     /* 4-byte entries address 4 GiB of data: always enough below 2^30 colours. */
-    entry = (uint64_t)count > (1ull << 30) ? 8 : 4;
-    table = VOXCOLOR_HEADER_SIZE + pages * entry;
-    if (dst_size < table + 8) return 0;
-    data = dst + table;
-    cap = dst_size - table - 8;
-    w.p = data;
-    w.acc = 0;
-    w.n = 0;
-    for (page = 0; page < pages; page++) {
-        size_t first = page << e.page_shift;
-        size_t n = count - first < ((size_t)1 << e.page_shift) ? count - first
-                                                                : (size_t)1 << e.page_shift;
-        used = (size_t)(w.p - data);
-        /* A page never takes more than one raw block would. */
-        if (cap - used < (2 * e.page_shift + 4 + 24 * n + 7) / 8) return 0;
-        voxcolori_store_le(dst + VOXCOLOR_HEADER_SIZE + page * entry, used, (unsigned)entry);
-        blocks = voxcolori_plan_page(&e, rgb8 + 3 * first, n, plan);
-        voxcolori_write_page(&w, rgb8 + 3 * first, plan, blocks, e.page_shift);
-        if (w.n) voxcolori_put(&w, 0, 8 - w.n);
+    enc->entry = count > (1ull << 30) ? 8 : 4;
+    enc->data_offset = VOXCOLOR_HEADER_SIZE + pages * enc->entry;
+    enc->data_size = 0;
+    enc->pages = 0;
+    enc->held = 0;
+    enc->out_used = 0;
+    enc->table_used = 0;
+    enc->failed = 0;
+}
+
+VOXCOLOR_API uint64_t voxcolor_encoder_data_offset(const voxcolor_encoder *enc) {
+    VOXCOLOR_ASSERT(enc);
+    return enc->data_offset;
+}
+
+VOXCOLOR_API int voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8, size_t n) {
+    VOXCOLOR_ASSERT(enc && (rgb8 || !n) && n <= enc->count - enc->pushed);
+    while (n && !enc->failed) {
+        uint64_t left = enc->count - enc->pushed + enc->held;
+        size_t page = (size_t)1 << enc->enc.page_shift, take;
+        if (left < page) page = (size_t)left; /* the last page */
+        if (!enc->held && n >= page) {
+            /* A whole page in the caller's colours: no copy. */
+            voxcolori_encode_page(enc, rgb8, page);
+            take = page;
+        } else {
+            take = page - enc->held < n ? page - enc->held : n;
+            memcpy(enc->rgb + 3 * (size_t)enc->held, rgb8, 3 * take);
+            enc->held += (uint32_t)take;
+            if (enc->held == page) {
+                voxcolori_encode_page(enc, enc->rgb, page);
+                enc->held = 0;
+            }
+        }
+        enc->pushed += take;
+        rgb8 += 3 * take;
+        n -= take;
     }
-    used = (size_t)(w.p - data);
-    memset(data + used, 0, 8);
-    memcpy(dst + VOXCOLOR_OFF_MAGIC, "VXC1", 4);
-    voxcolori_store_le(dst + VOXCOLOR_OFF_VERSION, VOXCOLOR_FORMAT_VERSION, 2);
-    dst[VOXCOLOR_OFF_PAGE_SHIFT] = (uint8_t)e.page_shift;
-    dst[VOXCOLOR_OFF_FLAGS] = entry == 8 ? 1 : 0;
-    voxcolori_store_le(dst + VOXCOLOR_OFF_COUNT, count, 8);
-    voxcolori_store_le(dst + VOXCOLOR_OFF_DATA_SIZE, used + 8, 8);
-    return table + used + 8;
+    return !enc->failed;
+}
+
+VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc) {
+    uint8_t header[VOXCOLOR_HEADER_SIZE];
+    VOXCOLOR_ASSERT(enc);
+    if (enc->pushed != enc->count) enc->failed = 1;
+    /* The 8 closing zero bytes. */
+    if (enc->out_used + 8 > sizeof enc->out) voxcolori_flush_data(enc);
+    memset(enc->out + enc->out_used, 0, 8);
+    enc->out_used += 8;
+    enc->data_size += 8;
+    voxcolori_flush_data(enc);
+    voxcolori_flush_table(enc);
+    memcpy(header + VOXCOLOR_OFF_MAGIC, "VXC1", 4);
+    voxcolori_store_le(header + VOXCOLOR_OFF_VERSION, VOXCOLOR_FORMAT_VERSION, 2);
+    header[VOXCOLOR_OFF_PAGE_SHIFT] = (uint8_t)enc->enc.page_shift;
+    header[VOXCOLOR_OFF_FLAGS] = enc->entry == 8 ? 1 : 0;
+    voxcolori_store_le(header + VOXCOLOR_OFF_COUNT, enc->count, 8);
+    voxcolori_store_le(header + VOXCOLOR_OFF_DATA_SIZE, enc->data_size, 8);
+    if (!enc->failed && !enc->write(enc->user, 0, header, sizeof header)) enc->failed = 1;
+    return enc->failed ? 0 : enc->data_offset + enc->data_size;
+}
+
+/* voxcolor_encode's target: the caller's buffer. */
+typedef struct voxcolori_buffer {
+    uint8_t *p;
+    size_t size;
+} voxcolori_buffer;
+
+static int voxcolori_write_buffer(void *user, uint64_t offset, const void *bytes, size_t size) {
+    voxcolori_buffer *b = (voxcolori_buffer *)user;
+    if (offset > b->size || size > b->size - offset) return 0;
+    memcpy(b->p + (size_t)offset, bytes, size);
+    return 1;
+}
+
+VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
+                                    size_t count, const voxcolor_encode_opts *opts) {
+    voxcolor_encoder enc; /* 16 KiB */
+    voxcolori_buffer b;
+    VOXCOLOR_ASSERT(dst || !dst_size);
+    VOXCOLOR_ASSERT(rgb8 || !count);
+    b.p = dst;
+    b.size = dst_size;
+    voxcolor_encoder_init(&enc, count, opts, voxcolori_write_buffer, &b);
+    /* Fails early when not even the page table fits. */
+    if (enc.data_offset + 8 > dst_size) return 0;
+    voxcolor_encoder_push(&enc, rgb8, count);
+    return (size_t)voxcolor_encoder_finish(&enc);
 }
 
 // -- 2D mapping

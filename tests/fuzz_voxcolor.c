@@ -3,7 +3,9 @@
        colour (up to a cap) is decoded singly and by ranges, which must agree.
      bit 7 set: RGB8 colours to encode with options from bits 0..6 (error
        bound, metric, weight width, page size). The stream must validate and
-       every decoded colour must be within the bound.
+       every decoded colour must be within the bound; the streaming encoder,
+       fed in chunks of a size taken from the input, must make the same
+       bytes.
    Any violation aborts.
 
    Built with -DVOXCOLOR_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
@@ -88,6 +90,35 @@ static double distance(const uint8_t *a, const uint8_t *b, int lab) {
     return lab ? sqrt(s) : sqrt(s) / 255.0;
 }
 
+/* The streaming encoder's target: a buffer of the one-shot size. */
+typedef struct fuzz_sink {
+    uint8_t *p;
+    size_t size;
+} fuzz_sink;
+
+static int fuzz_write(void *user, uint64_t offset, const void *bytes, size_t size) {
+    fuzz_sink *k = (fuzz_sink *)user;
+    require(offset <= k->size && size <= k->size - offset, "streamed past the one-shot size");
+    memcpy(k->p + offset, bytes, size);
+    return 1;
+}
+
+static void fuzz_stream(const uint8_t *rgb, size_t n, const voxcolor_encode_opts *o,
+                        const uint8_t *expect, size_t size) {
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    size_t chunk = n ? rgb[0] % 300 + 1 : 1, at;
+    fuzz_sink k;
+    k.p = (uint8_t *)malloc(size);
+    k.size = size;
+    voxcolor_encoder_init(enc, n, o, fuzz_write, &k);
+    for (at = 0; at < n; at += chunk)
+        require(voxcolor_encoder_push(enc, rgb + 3 * at, n - at < chunk ? n - at : chunk), "push");
+    require(voxcolor_encoder_finish(enc) == size && memcmp(k.p, expect, size) == 0,
+            "streamed and one-shot streams differ");
+    free(k.p);
+    free(enc);
+}
+
 static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
     static const double bounds[8] = {0, 0.004, 0.01, 0.02, 0.04, 0.08, 0.2, 1.0};
     voxcolor_encode_opts o;
@@ -104,6 +135,7 @@ static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
     require(len > 0 && len <= cap, "encode failed");
     require(voxcolor_view_init(&v, s, len) == VOXCOLOR_OK, "own stream rejected");
     require(v.count == n, "count");
+    fuzz_stream(rgb, n, &o, s, len);
     voxcolor_view_get_range(&v, 0, n, d);
     for (i = 0; i < n; i++)
         require(distance(rgb + 3 * i, d + 3 * i, o.metric == VOXCOLOR_METRIC_CIELAB) <=

@@ -671,6 +671,136 @@ static void test_wide_table(void) {
     free(c);
 }
 
+// -- Streaming encoder
+
+/* A growing stream: bytes placed where the encoder says, each byte written
+   exactly once, block data in order, the header last. FAIL_AT > 0 makes that
+   call (1-based) fail. */
+typedef struct sink {
+    uint8_t *bytes, *written;
+    size_t cap, calls, fail_at, overlaps, data_end, disorder;
+    uint64_t data_offset;
+    int header_seen;
+} sink;
+
+static int sink_write(void *user, uint64_t offset, const void *bytes, size_t size) {
+    sink *k = (sink *)user;
+    size_t i;
+    if (++k->calls == k->fail_at) return 0;
+    if (offset + size > k->cap) {
+        size_t cap = 2 * (size_t)(offset + size);
+        k->bytes = (uint8_t *)realloc(k->bytes, cap);
+        k->written = (uint8_t *)realloc(k->written, cap);
+        memset(k->written + k->cap, 0, cap - k->cap);
+        k->cap = cap;
+    }
+    memcpy(k->bytes + offset, bytes, size);
+    for (i = 0; i < size; i++) k->overlaps += k->written[offset + i]++ != 0;
+    if (k->header_seen) k->disorder++;
+    if (offset == 0) k->header_seen = 1;
+    if (offset >= k->data_offset) {
+        if (offset != k->data_end) k->disorder++;
+        k->data_end = (size_t)(offset + size);
+    }
+    return 1;
+}
+
+/* Streams N colours in chunks of CHUNK (0: random sizes) into *K. */
+static uint64_t stream_encode(const uint8_t *rgb, size_t n, const voxcolor_encode_opts *o,
+                              size_t chunk, sink *k) {
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    uint64_t seed = n + chunk, size;
+    size_t at = 0;
+    memset(k, 0, sizeof *k);
+    voxcolor_encoder_init(enc, n, o, sink_write, k);
+    k->data_offset = k->data_end = (size_t)voxcolor_encoder_data_offset(enc);
+    while (at < n) {
+        size_t m = chunk ? chunk : test_rand_below(&seed, 700);
+        if (m > n - at) m = n - at;
+        if (!voxcolor_encoder_push(enc, rgb + 3 * at, m)) break;
+        at += m;
+    }
+    size = voxcolor_encoder_finish(enc);
+    free(enc);
+    return size;
+}
+
+/* Streamed in chunks of any size, the stream is the one-shot encoder's, byte
+   for byte; the writes tile it. */
+static void test_stream_equals_oneshot(void) {
+    static const size_t counts[] = {0, 1, 15, 16, 17, 255, 256, 257, 1000, 4096, 20000};
+    static const size_t chunks[] = {1, 2, 255, 256, 257, 1024, 100000, 0};
+    static const double bounds[] = {0, 0.025, 0.1};
+    size_t c, h, b, shift;
+    uint8_t *rgb = make_colors(KIND_TEXTURE, 20000, 11);
+    for (c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        for (b = 0; b < sizeof bounds / sizeof bounds[0]; b++)
+            for (shift = 4; shift <= 10; shift += 3) {
+                voxcolor_encode_opts o;
+                uint8_t *one;
+                size_t n = counts[c], size;
+                memset(&o, 0, sizeof o);
+                o.max_error = bounds[b];
+                o.page_shift = (uint32_t)shift;
+                size = encode_new(rgb, n, &o, &one);
+                for (h = 0; h < sizeof chunks / sizeof chunks[0]; h++) {
+                    sink k;
+                    uint64_t got = stream_encode(rgb, n, &o, chunks[h], &k);
+                    size_t i, holes = 0;
+                    for (i = 0; i < got; i++) holes += k.written[i] != 1;
+                    CHECK_MSG(got == size && memcmp(k.bytes, one, size) == 0,
+                              "n=%zu e_t=%g shift=%zu chunk=%zu: %llu vs %zu bytes", n, bounds[b],
+                              shift, chunks[h], (unsigned long long)got, size);
+                    CHECK_MSG(holes == 0 && k.overlaps == 0 && k.disorder == 0 && k.header_seen,
+                              "n=%zu chunk=%zu: holes %zu overlaps %zu disorder %zu", n,
+                              chunks[h], holes, k.overlaps, k.disorder);
+                    free(k.bytes);
+                    free(k.written);
+                }
+                free(one);
+            }
+    free(rgb);
+}
+
+/* A failing write stops the encoder: push and finish report it. Pushing
+   fewer colours than declared fails at finish. */
+static void test_stream_failures(void) {
+    uint8_t *rgb = make_colors(KIND_NOISY, 30000, 12);
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    size_t calls, fail;
+    sink k;
+    stream_encode(rgb, 30000, NULL, 0, &k);
+    calls = k.calls;
+    free(k.bytes);
+    free(k.written);
+    CHECK(calls > 3);
+    for (fail = 1; fail <= calls; fail++) {
+        int ok = 1;
+        memset(&k, 0, sizeof k);
+        k.fail_at = fail;
+        voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k);
+        ok &= voxcolor_encoder_push(enc, rgb, 12345);
+        ok &= voxcolor_encoder_push(enc, rgb + 3 * 12345, 30000 - 12345);
+        CHECK(ok == (k.calls < fail)); /* failed exactly when a write failed */
+        CHECK_MSG(voxcolor_encoder_finish(enc) == 0, "write %zu of %zu failed", fail, calls);
+        free(k.bytes);
+        free(k.written);
+    }
+    memset(&k, 0, sizeof k);
+    voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k);
+    CHECK(voxcolor_encoder_push(enc, rgb, 29999));
+    CHECK(voxcolor_encoder_finish(enc) == 0);
+    free(k.bytes);
+    free(k.written);
+    /* Above 2^30 colours the page table has 8-byte entries. */
+    voxcolor_encoder_init(enc, (1ull << 30) + 1, NULL, sink_write, &k);
+    CHECK(voxcolor_encoder_data_offset(enc) == 24 + 8 * ((1ull << 22) + 1));
+    voxcolor_encoder_init(enc, 1ull << 30, NULL, sink_write, &k);
+    CHECK(voxcolor_encoder_data_offset(enc) == 24 + 4 * (1ull << 22));
+    free(enc);
+    free(rgb);
+}
+
 static void test_empty(void) {
     uint8_t buf[64];
     voxcolor_view v;
@@ -734,6 +864,8 @@ const test_case test_voxcolor_cases[] = {
     {"voxcolor/mutations", test_mutations},
     {"voxcolor/rejects_garbage", test_rejects_garbage},
     {"voxcolor/wide_table", test_wide_table},
+    {"voxcolor/stream_equals_oneshot", test_stream_equals_oneshot},
+    {"voxcolor/stream_failures", test_stream_failures},
     {"voxcolor/empty", test_empty},
     {"voxcolor/morton2d", test_morton2d},
     {NULL, NULL},
