@@ -101,6 +101,21 @@ fuzz-load: | $(BUILD)
 	$(BUILD)/fuzz_load_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/load.dict \
 	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_load_corpus tests/data/fuzz/load
 
+# Round-trip fuzzing (build, save, load, queries against an oracle):
+# libFuzzer (clang) for `make fuzz-roundtrip`; `make test` replays the
+# committed seeds tests/data/fuzz/roundtrip.
+.PHONY: fuzz-roundtrip
+FUZZ_ROUNDTRIP_DEPS := tests/fuzz_roundtrip.c tests/fuzz_replay.h tests/count_alloc.h $(HEADERS)
+$(BUILD)/fuzz_roundtrip: $(FUZZ_ROUNDTRIP_DEPS) | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_roundtrip.c -lm
+
+fuzz-roundtrip: | $(BUILD)
+	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXDAG_LIBFUZZER $(THREADS) \
+	    -I. -o $(BUILD)/fuzz_roundtrip_libfuzzer tests/fuzz_roundtrip.c -lm
+	@mkdir -p $(BUILD)/fuzz_roundtrip_corpus
+	$(BUILD)/fuzz_roundtrip_libfuzzer -max_total_time=$(FUZZ_SECONDS) \
+	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_roundtrip_corpus tests/data/fuzz/roundtrip
+
 # The main job on the built-in scene: generate, build, compress the colours,
 # save, validate, render.
 demo: $(BUILD)/vdag
@@ -122,7 +137,7 @@ deps:
 check-all:
 	@sh tests/check_all.sh $(BUILD)
 
-test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load
+test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
 	@sh tests/run.sh $(BUILD)
 
 clean:

@@ -30,6 +30,7 @@ run cli sh tests/cli.sh "$build/vdag"
 run fuzz-import "$build/fuzz_import" tests/data/fuzz/import
 run fuzz-voxcolor "$build/fuzz_voxcolor" tests/data/fuzz/voxcolor
 run fuzz-load "$build/fuzz_load" tests/data/fuzz/load
+run fuzz-roundtrip "$build/fuzz_roundtrip" tests/data/fuzz/roundtrip
 run check-all sh tests/check_all.sh "$build"
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]
