@@ -143,9 +143,11 @@ test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcol
 clean:
 	rm -rf $(BUILD)
 
-# Benchmarks: `make bench` fetches the scenes (bench/fetch.sh) and regenerates
-# BENCHMARKS.md with the full set (long); `make bench-quick` runs a smaller set
-# (under 5 minutes). bench-build / bench-geometry print one table set each.
+# Benchmarks: `make bench` installs what it lacks (bench/deps.sh), fetches the
+# scenes (bench/fetch.sh) and regenerates BENCHMARKS.md, its CSV files, plots
+# and pictures (docs/bench/) with the full set (long); `make bench-quick` runs a
+# smaller set (under 5 minutes). bench-build / bench-geometry print one table
+# set each.
 BENCH_CFLAGS := $(CSTD) $(WARN) -O2 -g $(THREADS) -I.
 BENCH_SUBMAKE := $(MAKE)
 BENCH_DEPS   := bench/scenes.h $(HEADERS) examples/import.c examples/import.h examples/image_none.c
@@ -183,9 +185,9 @@ $(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench
 bench-rays: bench-data $(BUILD)/bench/bench_rays
 	$(BUILD)/bench/bench_rays bench/data $(BENCH_FLAGS)
 
-bench: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry
+bench: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/vdag
 	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh full $(BUILD)
-bench-quick: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry
+bench-quick: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/vdag
 	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh quick $(BUILD)
 
 # bench-color: the colour codec against the reimplemented baselines on real

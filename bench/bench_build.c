@@ -23,9 +23,10 @@ typedef struct run {
 } run;
 
 /* Builds S from XYZ (in the given order) with THREADS; the best of REPEAT.
-   CHUNK > 0: add and flush CHUNK voxels at a time (XYZ must be Morton-sorted). */
+   ENDS (NENDS > 0): add and flush the voxels before ENDS[0], then before
+   ENDS[1], ... (XYZ must be Morton-sorted); else all in one add and flush. */
 static run build_chunked(const bscene *s, const uint32_t *xyz, unsigned threads, int compare, int repeat,
-                         size_t chunk) {
+                         const size_t *ends, size_t nends) {
     run best;
     int r;
     memset(&best, 0, sizeof best);
@@ -51,10 +52,10 @@ static run build_chunked(const bscene *s, const uint32_t *xyz, unsigned threads,
         }
         t1 = t0;
         {
-            size_t at = 0, step = chunk ? chunk : s->n;
+            size_t at = 0, c = 0;
             double in_add = 0;
             do {
-                size_t m = s->n - at < step ? s->n - at : step;
+                size_t m = (c < nends ? ends[c++] : s->n) - at;
                 double a = bench_now();
                 if (voxdag_builder_add(b, xyz + 3 * at, NULL, m, &e) != VOXDAG_OK) {
                     fprintf(stderr, "bench_build: %s\n", e.message);
@@ -101,7 +102,24 @@ static double bench_cpu(void) {
 }
 
 static run build(const bscene *s, const uint32_t *xyz, unsigned threads, int compare, int repeat) {
-    return build_chunked(s, xyz, threads, compare, repeat, 0);
+    return build_chunked(s, xyz, threads, compare, repeat, NULL, 0);
+}
+
+/* Chunk ends for build_chunked: every CHUNK voxels (CHUNK > 0), or (CHUNK =
+   0) at the borders of the aligned 2^BENCH_CHUNK_LEVELS cells that
+   voxdag_builder_add_mesh voxelizes and flushes one at a time. */
+static size_t *chunk_ends(const bscene *s, size_t chunk, size_t *nends) {
+    size_t *ends = (size_t *)bench_xmalloc((s->n + 1) * sizeof *ends), i, n = 0;
+    uint64_t prev = 0;
+    for (i = 0; i < s->n; i++) {
+        uint64_t cell = voxdag_morton_encode(s->xyz[3 * i], s->xyz[3 * i + 1], s->xyz[3 * i + 2]) >>
+                        (3 * BENCH_CHUNK_LEVELS);
+        if (i && (chunk ? i % chunk == 0 : cell != prev)) ends[n++] = i;
+        prev = cell;
+    }
+    ends[n++] = s->n;
+    *nends = n;
+    return ends;
 }
 
 static void shuffle(uint32_t *xyz, size_t n) {
@@ -131,6 +149,71 @@ static uint64_t sum(const uint64_t *a, uint32_t n) {
     uint32_t i;
     for (i = 0; i < n; i++) t += a[i];
     return t;
+}
+
+/* Triangle scenes (SSVDAG Table 1 shape, voxelization included): the mesh
+   voxelized and reduced by voxdag_builder_add_mesh + finish, then its voxels
+   reduced alone, replayed through add + flush in the same aligned cells the
+   voxelizer flushes; voxelization = the difference. */
+static void mesh_table(const char *dir, int quick, const unsigned tcount[2]) {
+    static const char *meshes[] = {"bunny.off", "armadillo.off", "dragon.off"};
+    uint32_t L, Lmax = quick ? 11 : 12;
+    size_t k;
+    printf("### Triangle scenes: voxelization and DAG reduction\n\n");
+    printf("Each mesh fitted into the 2^L grid and voxelized by `voxdag_builder_add_mesh` (exact conservative "
+           "voxelization, aligned 2^%u-voxel cells, each reduced as soon as it is voxelized), then `finish`: "
+           "*voxelize + reduce*. *Reduce alone*: the resulting voxels, Morton-sorted, added and flushed cell by cell "
+           "as the voxelizer does, then `finish`. *Voxelize* = the difference (derived). Seconds wall-clock, CPU "
+           "seconds = user + system of the process (all threads); %s. Peak = the builder's accounted memory "
+           "(voxelizer bins, one cell's voxels, the unique nodes, the encoder).\n\n",
+           BENCH_CHUNK_LEVELS, quick ? "one run each" : "best of 3 runs below 4 M voxels, else one run");
+    printf("| scene | L | triangles | voxels | threads | voxelize + reduce s | CPU s | peak MiB | reduce alone s | CPU s "
+           "| peak MiB | voxelize s (derived) | CPU s | M vox/CPU-s, whole build | M vox/CPU-s, reduce alone |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (k = 0; k < sizeof meshes / sizeof meshes[0]; k++)
+        for (L = 10; L <= Lmax; L++) {
+            char path[512];
+            bmesh m;
+            bscene s;
+            size_t nends, *ends;
+            int t, rep = 1;
+            if (quick && k > 0) break;
+            snprintf(path, sizeof path, "%s/%s", dir, meshes[k]);
+            if (!bmesh_load(&m, path, L)) break;
+            memset(&s, 0, sizeof s);
+            for (t = 0; t < 2; t++) {
+                double wall = 1e300, cpu = 0;
+                uint64_t peak = 0;
+                run red;
+                int r;
+                if (t == 1 && tcount[1] == 1) break;
+                fprintf(stderr, "bench_build: %s voxelized (L=%u, %u thread%s)\n", meshes[k], L, tcount[t],
+                        tcount[t] > 1 ? "s" : "");
+                for (r = 0; r < rep; r++) {
+                    voxdag_build_stats st;
+                    double c0 = bench_cpu(), t0 = bench_now(), w;
+                    voxdag *d = bmesh_voxelize(&m, L, tcount[t], &st);
+                    w = bench_now() - t0;
+                    if (w < wall) wall = w, cpu = bench_cpu() - c0, peak = st.peak_memory;
+                    if (!s.xyz) {
+                        bscene_from_dag(&s, d, L);
+                        snprintf(s.name, sizeof s.name, "%s", meshes[k]);
+                        rep = quick || s.n >= 4000000 ? 1 : 3;
+                    }
+                    voxdag_free(d);
+                }
+                ends = chunk_ends(&s, 0, &nends);
+                red = build_chunked(&s, s.xyz, tcount[t], 0, rep, ends, nends);
+                free(ends);
+                printf("| %s | %u | %zu | %zu | %u | %.3f | %.3f | %.1f | %.3f | %.3f | %.1f | %.3f | %.3f | %.1f | %.1f |\n",
+                       meshes[k], L, m.tris, s.n, tcount[t], wall, cpu, mb(peak), red.total, red.cpu, mb(red.peak),
+                       wall - red.total, cpu - red.cpu, (double)s.n / cpu / 1e6, (double)s.n / red.cpu / 1e6);
+                fflush(stdout);
+            }
+            bscene_free(&s);
+            bmesh_free(&m);
+        }
+    printf("\n");
 }
 
 int main(int argc, char **argv) {
@@ -197,7 +280,11 @@ int main(int argc, char **argv) {
             r->unsorted[t] = build(s, shuf, tcount[t], 0, rep);
         }
         r->cmp = build(s, s->xyz, threads, 1, 1);
-        r->streamed = build_chunked(s, s->xyz, 1, 0, rep, STREAM_CHUNK);
+        {
+            size_t nends, *ends = chunk_ends(s, STREAM_CHUNK, &nends);
+            r->streamed = build_chunked(s, s->xyz, 1, 0, rep, ends, nends);
+            free(ends);
+        }
         free(shuf);
     }
 
@@ -227,6 +314,7 @@ int main(int argc, char **argv) {
             }
     }
     printf("\nTarget: 30 M voxels/s per core from Morton-sorted input.\n\n");
+    mesh_table(dir, quick, tcount);
 
     printf("Published (SSVDAG paper, Table 1; Intel i7-4790K, 8 threads, reduction from an SVO on disk, "
            "excluding voxelization); M vox/s derived here as MVoxels / SSVDAG time:\n\n");

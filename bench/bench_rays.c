@@ -157,34 +157,8 @@ static speed timed(const rays *r, const voxdag *dag, const bench_peer *peer, con
 typedef struct scene {
     bscene v;
     voxdag *dag;
-    double *pos; /* source triangles in grid units, or NULL */
-    uint32_t *idx;
-    size_t verts, tris;
+    bmesh mesh; /* source triangles in grid units; empty for voxel scenes */
 } scene;
-
-typedef struct codes {
-    uint64_t *c;
-    size_t n;
-} codes;
-
-static int collect(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
-    codes *k = (codes *)user;
-    k->c[index] = voxdag_morton_encode(x, y, z);
-    k->n++;
-    return 0;
-}
-
-static void scene_voxels_from_dag(scene *s, const char *name, uint32_t L) {
-    voxdag_info info;
-    codes k;
-    voxdag_get_info(s->dag, &info);
-    k.c = (uint64_t *)bench_xmalloc((info.voxels ? info.voxels : 1) * sizeof *k.c);
-    k.n = 0;
-    voxdag_for_each_voxel(s->dag, collect, &k);
-    s->v.levels = L;
-    snprintf(s->v.name, sizeof s->v.name, "%s", name);
-    bscene_from_codes(&s->v, k.c, k.n);
-}
 
 static int build_dag(scene *s, unsigned threads) {
     voxdag_build_opts o;
@@ -198,44 +172,11 @@ static int build_dag(scene *s, unsigned threads) {
 
 /* A mesh voxelized by the library into 2^L, fitted to its bounding box. */
 static int scene_mesh(scene *s, const char *path, const char *name, uint32_t L, unsigned threads) {
-    vdag_scene sc;
-    char err[256];
-    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, ext = 0, scale;
-    voxdag_build_opts o;
-    voxdag_builder *b;
-    voxdag_mesh m;
-    size_t i;
     memset(s, 0, sizeof *s);
-    memset(&sc, 0, sizeof sc);
-    if (!vdag_import_file(path, &sc, err, sizeof err)) {
-        fprintf(stderr, "bench_rays: %s: %s\n", path, err);
-        return 0;
-    }
-    for (i = 0; i < 3 * sc.vertex_count; i++) {
-        if (sc.positions[i] < lo[i % 3]) lo[i % 3] = sc.positions[i];
-        if (sc.positions[i] > hi[i % 3]) hi[i % 3] = sc.positions[i];
-    }
-    for (i = 0; i < 3; i++)
-        if (hi[i] - lo[i] > ext) ext = hi[i] - lo[i];
-    scale = ext > 0 ? (double)(1u << L) / ext : 1;
-    s->verts = sc.vertex_count, s->tris = sc.triangle_count;
-    s->pos = (double *)bench_xmalloc(3 * s->verts * sizeof *s->pos + 1);
-    s->idx = (uint32_t *)bench_xmalloc(3 * s->tris * sizeof *s->idx + 1);
-    for (i = 0; i < 3 * s->verts; i++) s->pos[i] = (sc.positions[i] - lo[i % 3]) * scale;
-    memcpy(s->idx, sc.indices, 3 * s->tris * sizeof *s->idx);
-    vdag_scene_free(&sc);
-    memset(&o, 0, sizeof o);
-    o.levels = L;
-    o.threads = threads;
-    memset(&m, 0, sizeof m);
-    m.positions = s->pos, m.vertex_count = s->verts, m.indices = s->idx, m.triangle_count = s->tris;
-    if (voxdag_builder_create(&o, &b, NULL) != VOXDAG_OK) return 0;
-    if (voxdag_builder_add_mesh(b, &m, NULL) != VOXDAG_OK) {
-        voxdag_builder_free(b);
-        return 0;
-    }
-    if (voxdag_builder_finish(b, &s->dag, NULL, NULL) != VOXDAG_OK) return 0;
-    scene_voxels_from_dag(s, name, L);
+    if (!bmesh_load(&s->mesh, path, L)) return 0;
+    s->dag = bmesh_voxelize(&s->mesh, L, threads, NULL);
+    bscene_from_dag(&s->v, s->dag, L);
+    snprintf(s->v.name, sizeof s->v.name, "%s", name);
     return 1;
 }
 
@@ -248,7 +189,7 @@ static bool embree_memory(void *user, ssize_t bytes, bool post) {
 
 /* The triangles of S in an Embree scene (default build quality); *BYTES: the
    memory Embree reported allocating for it. */
-static RTCScene embree_scene(RTCDevice dev, const scene *s) {
+static RTCScene embree_scene(RTCDevice dev, const bmesh *s) {
     RTCScene sc = rtcNewScene(dev);
     RTCGeometry g = rtcNewGeometry(dev, RTC_GEOMETRY_TYPE_TRIANGLE);
     float *v = (float *)rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3, 3 * sizeof(float),
@@ -360,13 +301,13 @@ int main(int argc, char **argv) {
         }
 #endif
 #ifdef BENCH_EMBREE
-        if (s.pos) {
+        if (s.mesh.tris) {
             size_t peer_hits;
             uint32_t *theirs = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
             RTCScene es;
             speed one, all;
             embree_bytes = 0;
-            es = embree_scene(dev, &s);
+            es = embree_scene(dev, &s.mesh);
             one = timed(&r, NULL, NULL, es, 1, theirs, &peer_hits);
             all = timed(&r, NULL, NULL, es, threads, theirs, &peer_hits);
             row(s.v.name, s.v.levels, s.v.n, "Embree (triangles)", embree_bytes / 1e6, peer_hits, r.n, one, all,
@@ -378,8 +319,7 @@ int main(int argc, char **argv) {
         fflush(stdout);
         free(mine);
         free(r.dir);
-        free(s.pos);
-        free(s.idx);
+        bmesh_free(&s.mesh);
         voxdag_free(s.dag);
         bscene_free(&s.v);
     }

@@ -10,11 +10,9 @@
            kept: a fine voxel is kept when it lies on a face of its coarse
            voxel whose 6-neighbour across that face is empty.
    - mesh: a triangle mesh through the vdag importer, scaled uniformly so its
-           longest side spans the grid, voxelized by dense point sampling of
-           every triangle (barycentric lattice with at most half a voxel
-           between neighbouring samples); a voxel is full when a sample lands
-           in it. This approximates a surface voxelization; it is not
-           conservative for triangles thinner than half a voxel.
+           longest side spans the grid, voxelized by the library
+           (voxdag_builder_add_mesh: a voxel is full when a triangle
+           touches its closed box).
    - terrain: a generated heightfield (value noise, 4 octaves), each column
            filled from its lowest 4-neighbour height up to its own height, so
            the surface is closed. */
@@ -38,7 +36,7 @@
 
 typedef struct bscene {
     char name[64];
-    char input[160]; /* how the voxels were made */
+    char input[192]; /* how the voxels were made */
     uint32_t levels;
     size_t n;
     uint32_t *xyz; /* 3 per voxel, distinct, Morton order */
@@ -64,7 +62,7 @@ BENCH_UNUSED static void bscene_free(bscene *s) {
     memset(s, 0, sizeof *s);
 }
 
-// -- Morton-code sets: sort + unique, and a hash set for the voxelizer
+// -- Morton-code sets: sort + unique
 
 BENCH_UNUSED static void bench_sort_codes(uint64_t *c, size_t n) { /* LSD radix, 8-bit digits */
     uint64_t *t = (uint64_t *)bench_xmalloc(n * sizeof *t), *a = c, *b = t, *x;
@@ -100,30 +98,6 @@ BENCH_UNUSED static void bscene_from_codes(bscene *s, uint64_t *c, size_t n) {
     s->xyz = (uint32_t *)bench_xmalloc(3 * n * sizeof *s->xyz);
     for (i = 0; i < n; i++) voxdag_morton_decode(c[i], &s->xyz[3 * i], &s->xyz[3 * i + 1], &s->xyz[3 * i + 2]);
     free(c);
-}
-
-typedef struct bench_set {
-    uint64_t *slot; /* code + 1; 0 = free */
-    size_t cap, n;
-} bench_set;
-
-BENCH_UNUSED static void bench_set_add(bench_set *h, uint64_t code) {
-    size_t i;
-    if ((h->n + 1) * 2 > h->cap) {
-        bench_set g;
-        g.cap = h->cap ? h->cap * 2 : (1u << 20);
-        g.n = 0;
-        g.slot = (uint64_t *)calloc(g.cap, sizeof *g.slot);
-        if (!g.slot) { fprintf(stderr, "bench: out of memory\n"); exit(1); }
-        for (i = 0; i < h->cap; i++)
-            if (h->slot[i]) bench_set_add(&g, h->slot[i] - 1);
-        free(h->slot);
-        *h = g;
-    }
-    for (i = (size_t)((code + 1) * 0x9E3779B97F4A7C15ull >> 20) & (h->cap - 1); h->slot[i]; i = (i + 1) & (h->cap - 1))
-        if (h->slot[i] == code + 1) return;
-    h->slot[i] = code + 1;
-    h->n++;
 }
 
 // -- MagicaVoxel through the importer
@@ -205,15 +179,13 @@ BENCH_UNUSED static int bench_read_inr(const char *path, bench_grid *g) {
 /* Voxels of G scaled by 2^K: all of them (K = 0), or the shell (K > 0). */
 BENCH_UNUSED static void bscene_grid(bscene *s, const bench_grid *g, unsigned k, const char *name, const char *path) {
     uint32_t maxd = g->dim[0], L = 2, S = 1u << k;
-    bench_set h = {0};
-    size_t i, cells = 0, cap = 0, n = 0;
+    size_t cells = 0, cap = 0, n = 0;
     uint64_t *c = NULL;
     long x, y, z;
     memset(s, 0, sizeof *s);
     if (g->dim[1] > maxd) maxd = g->dim[1];
     if (g->dim[2] > maxd) maxd = g->dim[2];
     while ((1u << L) < (maxd << k)) L++;
-    (void)h;
     for (z = 0; z < (long)g->dim[2]; z++)
         for (y = 0; y < (long)g->dim[1]; y++)
             for (x = 0; x < (long)g->dim[0]; x++) {
@@ -250,68 +222,111 @@ BENCH_UNUSED static void bscene_grid(bscene *s, const bench_grid *g, unsigned k,
                  g->dim[0], g->dim[1], g->dim[2], cells);
     else
         snprintf(s->input, sizeof s->input, "%s: label != 0 scaled by %u, shell only", path, S);
-    (void)i;
     bscene_from_codes(s, c, n);
 }
 
-// -- Triangle meshes through the importer, voxelized by dense sampling
+// -- Triangle meshes through the importer, voxelized by the library
 
-BENCH_UNUSED static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L) {
+/* Triangles fitted into the 2^L grid by their bounding box (one uniform
+   scale), as `vdag build` does. */
+typedef struct bmesh {
+    double *pos; /* 3 per vertex, grid units */
+    uint32_t *idx;
+    size_t verts, tris;
+} bmesh;
+
+BENCH_UNUSED static int bmesh_load(bmesh *m, const char *path, uint32_t L) {
     vdag_scene sc;
     char err[256];
     double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300}, ext = 0, scale;
-    double N = (double)(1u << L);
-    bench_set h = {0};
-    size_t t, i, n;
-    uint64_t *c;
-    memset(s, 0, sizeof *s);
+    size_t i;
+    memset(m, 0, sizeof *m);
     memset(&sc, 0, sizeof sc);
     if (!vdag_import_file(path, &sc, err, sizeof err)) {
         fprintf(stderr, "bench: %s: %s\n", path, err);
         return 0;
     }
-    for (i = 0; i < sc.vertex_count; i++)
-        for (t = 0; t < 3; t++) {
-            double v = sc.positions[3 * i + t];
-            if (v < lo[t]) lo[t] = v;
-            if (v > hi[t]) hi[t] = v;
-        }
-    for (t = 0; t < 3; t++)
-        if (hi[t] - lo[t] > ext) ext = hi[t] - lo[t];
-    scale = (N - 1.0) / (ext > 0 ? ext : 1);
-    for (t = 0; t < sc.triangle_count; t++) {
-        double p[3][3], e = 0;
-        unsigned a, b, k, m;
-        for (k = 0; k < 3; k++)
-            for (m = 0; m < 3; m++) p[k][m] = (sc.positions[3 * (size_t)sc.indices[3 * t + k] + m] - lo[m]) * scale + 0.5;
-        for (k = 0; k < 3; k++) {
-            double dx = p[(k + 1) % 3][0] - p[k][0], dy = p[(k + 1) % 3][1] - p[k][1], dz = p[(k + 1) % 3][2] - p[k][2];
-            double len = sqrt(dx * dx + dy * dy + dz * dz);
-            if (len > e) e = len;
-        }
-        n = (size_t)ceil(2.0 * e);
-        if (n < 1) n = 1;
-        for (a = 0; a <= n; a++)
-            for (b = 0; a + b <= n; b++) {
-                double u = (double)a / (double)n, v = (double)b / (double)n, q[3];
-                for (m = 0; m < 3; m++) {
-                    q[m] = p[0][m] + (p[1][m] - p[0][m]) * u + (p[2][m] - p[0][m]) * v;
-                    if (q[m] < 0) q[m] = 0;
-                    if (q[m] > N - 1) q[m] = N - 1;
-                }
-                bench_set_add(&h, voxdag_morton_encode((uint32_t)q[0], (uint32_t)q[1], (uint32_t)q[2]));
-            }
+    for (i = 0; i < 3 * sc.vertex_count; i++) {
+        if (sc.positions[i] < lo[i % 3]) lo[i % 3] = sc.positions[i];
+        if (sc.positions[i] > hi[i % 3]) hi[i % 3] = sc.positions[i];
     }
-    c = (uint64_t *)bench_xmalloc((h.n ? h.n : 1) * sizeof *c);
-    for (i = 0, n = 0; i < h.cap; i++)
-        if (h.slot[i]) c[n++] = h.slot[i] - 1;
-    free(h.slot);
-    s->levels = L;
-    snprintf(s->name, sizeof s->name, "%s", name);
-    snprintf(s->input, sizeof s->input, "%.100s: %zu triangles, surface sampled at %u^3", path,
-             sc.triangle_count, 1u << L);
+    for (i = 0; i < 3; i++)
+        if (hi[i] - lo[i] > ext) ext = hi[i] - lo[i];
+    scale = ext > 0 ? (double)(1u << L) / ext : 1;
+    m->verts = sc.vertex_count, m->tris = sc.triangle_count;
+    m->pos = (double *)bench_xmalloc(3 * m->verts * sizeof *m->pos);
+    m->idx = (uint32_t *)bench_xmalloc(3 * m->tris * sizeof *m->idx);
+    for (i = 0; i < 3 * m->verts; i++) m->pos[i] = (sc.positions[i] - lo[i % 3]) * scale;
+    memcpy(m->idx, sc.indices, 3 * m->tris * sizeof *m->idx);
     vdag_scene_free(&sc);
-    bscene_from_codes(s, c, n);
+    return 1;
+}
+
+BENCH_UNUSED static void bmesh_free(bmesh *m) {
+    free(m->pos);
+    free(m->idx);
+    memset(m, 0, sizeof *m);
+}
+
+/* Voxelizes M into a DAG of 2^L with voxdag_builder_add_mesh (exact
+   conservative voxelization, chunks of 2^BENCH_CHUNK_LEVELS voxels a side). */
+#define BENCH_CHUNK_LEVELS 8
+BENCH_UNUSED static voxdag *bmesh_voxelize(const bmesh *m, uint32_t L, unsigned threads, voxdag_build_stats *st) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag_mesh vm;
+    voxdag_error e;
+    voxdag *d = NULL;
+    memset(&o, 0, sizeof o);
+    o.levels = L;
+    o.threads = threads;
+    o.chunk_levels = BENCH_CHUNK_LEVELS;
+    memset(&vm, 0, sizeof vm);
+    vm.positions = m->pos, vm.vertex_count = m->verts, vm.indices = m->idx, vm.triangle_count = m->tris;
+    if (voxdag_builder_create(&o, &b, &e) != VOXDAG_OK || voxdag_builder_add_mesh(b, &vm, &e) != VOXDAG_OK ||
+        voxdag_builder_finish(b, &d, st, &e) != VOXDAG_OK) {
+        fprintf(stderr, "bench: voxelizing: %s\n", e.message);
+        exit(1);
+    }
+    return d;
+}
+
+typedef struct bench_codes {
+    uint64_t *c;
+    size_t n;
+} bench_codes;
+
+BENCH_UNUSED static int bench_collect(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    bench_codes *k = (bench_codes *)user;
+    k->c[index] = voxdag_morton_encode(x, y, z);
+    k->n++;
+    return 0;
+}
+
+/* Fills S with the voxels of D. */
+BENCH_UNUSED static void bscene_from_dag(bscene *s, const voxdag *d, uint32_t L) {
+    voxdag_info info;
+    bench_codes k;
+    voxdag_get_info(d, &info);
+    k.c = (uint64_t *)bench_xmalloc((info.voxels ? info.voxels : 1) * sizeof *k.c);
+    k.n = 0;
+    voxdag_for_each_voxel(d, bench_collect, &k);
+    s->levels = L;
+    bscene_from_codes(s, k.c, k.n);
+}
+
+BENCH_UNUSED static int bscene_mesh(bscene *s, const char *path, const char *name, uint32_t L) {
+    bmesh m;
+    voxdag *d;
+    memset(s, 0, sizeof *s);
+    if (!bmesh_load(&m, path, L)) return 0;
+    d = bmesh_voxelize(&m, L, 1, NULL);
+    bscene_from_dag(s, d, L);
+    voxdag_free(d);
+    snprintf(s->name, sizeof s->name, "%s", name);
+    snprintf(s->input, sizeof s->input, "%.80s: %zu triangles, voxelized by voxdag_builder_add_mesh at %u^3", path,
+             m.tris, 1u << L);
+    bmesh_free(&m);
     return 1;
 }
 
