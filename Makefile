@@ -161,6 +161,7 @@ $(BUILD)/bench/bench_geometry: bench/bench_geometry.c $(BENCH_DEPS)
 	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
 
 bench-data:
+	@sh bench/deps.sh
 	@sh bench/fetch.sh bench/data >/dev/null
 
 bench-build: bench-data $(BUILD)/bench/bench_build

@@ -229,7 +229,7 @@ int main(int argc, char **argv) {
         const char *file;
         uint32_t L;
         int full_only;
-    } plan[] = {{"tree.vox", 0, 0}, {"bunny.off", 11, 0}, {"bunny.off", 13, 1}, {"dragon.off", 11, 1},
+    } plan[] = {{"tree.vox", 0, 0}, {"bunny.off", 11, 0}, {"bunny.off", 12, 1}, {"dragon.off", 11, 1},
                 {"terrain", 11, 1}, {"terrain", 10, 0}};
 #ifdef BENCH_EMBREE
     RTCDevice dev = rtcNewDevice(NULL);

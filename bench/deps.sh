@@ -1,13 +1,15 @@
 #!/bin/sh
 # Installs the Debian packages `make bench` uses when they are missing (root):
-# the ray-casting peers (NanoVDB, Embree), OpenImageIO's tools (image
-# conversion and comparison), gnuplot (plots), npm (bench/fetch.sh). Without
-# them the benchmarks still run and leave out what needs them.
+# the ray-casting peers (NanoVDB, Embree), OpenImageIO (its tools convert and
+# compare images; with its headers `vdag` decodes textures), gnuplot (plots),
+# npm (bench/fetch.sh). Without them the benchmarks still run and leave out
+# what needs them.
 set -u
 need=""
 [ -f /usr/include/nanovdb/NanoVDB.h ] || need="$need libnanovdb-dev"
 [ -f /usr/include/embree3/rtcore.h ] || need="$need libembree-dev"
 command -v oiiotool >/dev/null 2>&1 || need="$need openimageio-tools"
+[ -f /usr/include/OpenImageIO/imageio.h ] || need="$need libopenimageio-dev"
 command -v gnuplot >/dev/null 2>&1 || need="$need gnuplot-nox"
 command -v npm >/dev/null 2>&1 || need="$need npm"
 command -v c++ >/dev/null 2>&1 || need="$need g++"

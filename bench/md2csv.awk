@@ -16,7 +16,7 @@ function slug(s) {
 function cell(s) {
     gsub(/\*\*|`/, "", s)
     gsub(/^ +| +$/, "", s)
-    sub(/ MiB$/, "", s)
+    if (s ~ /^-?[0-9.]+ MiB$/) sub(/ MiB$/, "", s)
     if (s ~ /^-?[0-9.]+%$/) sub(/%$/, "", s)
     if (s ~ /[,"]/) { gsub(/"/, "\"\"", s); s = "\"" s "\"" }
     return s

@@ -16,22 +16,12 @@ trap 'rm -rf "$work"' EXIT
 mkdir -p "$pics"
 term="set terminal pngcairo size"
 gnuplot -e 'set terminal pngcairo' >/dev/null 2>&1 || term="set terminal png size"
-# CSV fields, quotes respected, as tab-separated lines.
-fields() {
-    awk '{ out = ""; q = 0
-           for (i = 1; i <= length($0); i++) {
-               c = substr($0, i, 1)
-               if (c == "\"") q = !q
-               else if (c == "," && !q) out = out "\t"
-               else out = out c
-           }
-           print out }' "$@"
-}
+. bench/csv.sh
 
 # Bits per voxel vs L: one panel per mesh scene, one line per structure.
 g=$csv/geometry_bits-per-voxel.csv
 if want geometry && [ -s "$g" ]; then
-    fields "$g" >"$work/g.tsv"
+    csv_fields "$g" >"$work/g.tsv"
     scenes=$(awk -F'\t' 'NR > 1 && $1 ~ /\.off$/ && !seen[$1]++ { print $1 }' "$work/g.tsv")
     n=$(echo "$scenes" | grep -c . || true)
     if [ "$n" -gt 0 ]; then
@@ -57,7 +47,7 @@ fi
 # Rays per CPU-second, one thread: clustered bars per scene.
 r=$csv/rays_primary-rays.csv
 if want rays && [ -s "$r" ]; then
-    fields "$r" | awk -F'\t' 'NR > 1 {
+    csv_fields "$r" | awk -F'\t' 'NR > 1 {
         k = $1 " L=" $2; if (!(k in row)) { order[++n] = k; row[k] = 1 }
         e = $4 ~ /^voxdag/ ? 1 : $4 ~ /^NanoVDB/ ? 2 : 3; v[k, e] = $8 }
         END { for (i = 1; i <= n; i++) { k = order[i]; printf "\"%s\"", k
@@ -88,7 +78,7 @@ if [ "$n" -gt 0 ]; then
         for f in $sets; do
             name=$(basename "$f" .csv); name=${name#color_}
             # One block per codec: size, PSNR; voxcolor: only its plain e_t curve.
-            fields "$f" | awk -F'\t' -v out="$work/c_$name" 'NR > 1 && $5 ~ /^[0-9.]+$/ {
+            csv_fields "$f" | awk -F'\t' -v out="$work/c_$name" 'NR > 1 && $5 ~ /^[0-9.]+$/ {
                 if ($1 == "voxcolor" && $2 !~ /^e_t [0-9.]+$/) next
                 if (!($1 in id)) { id[$1] = ++n; name[n] = $1 }
                 print $3, $5 > (out "_" id[$1] ".dat") }

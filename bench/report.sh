@@ -64,6 +64,7 @@ tmp=$out/BENCHMARKS.md.tmp
     echo "- Data: \`bench/fetch.sh\` (Debian \`libcgal-demo\` 5.5: liver label volume and OFF meshes, CC0; npm \`vox-reader\` 4.0.1: \`tree.vox\`, MIT; for the image-quality and real scenes \`supertuxkart-data\`, CC-BY-SA-4.0, and \`flightgear-data-models\`, GPL-2+), \`bench/color_fetch.sh\` (colour arrays)."
     echo "- Peers and tools (Debian package versions): NanoVDB \`libnanovdb-dev\` $(version libnanovdb-dev), Embree \`libembree-dev\` $(version libembree-dev), OpenImageIO \`openimageio-tools\` $(version openimageio-tools), libjpeg-turbo \`libjpeg-turbo-progs\` $(version libjpeg-turbo-progs), \`pngquant\` $(version pngquant), \`astcenc\` $(version astcenc), gnuplot \`gnuplot-nox\` $(version gnuplot-nox)."
     echo
+    sh bench/headline.sh "$docs"
     echo "## Build"
     echo
     cat "$out/build.md"
