@@ -75,19 +75,21 @@ if [ "$n" -gt 0 ]; then
         echo "set output '$pics/plot_color.png'"
         echo "set multiplot layout 1,$n title 'Colour: PSNR vs size (% of 24-bit RGB); up and left is better'"
         echo "set xlabel 'size (% of 24-bit)'; set ylabel 'PSNR (dB)'; set grid; set key bottom right font ',8'; set logscale x"
+        # One line type per codec over all panels, in order of appearance.
+        csv_fields $sets | awk -F'\t' '$1 != "codec" && $5 ~ /^[0-9.]+$/ && !seen[$1]++ { print ++n "\t" $1 }' >"$work/codecs"
         for f in $sets; do
             name=$(basename "$f" .csv); name=${name#color_}
             # One block per codec: size, PSNR; voxcolor: only its plain e_t curve.
-            csv_fields "$f" | awk -F'\t' -v out="$work/c_$name" 'NR > 1 && $5 ~ /^[0-9.]+$/ {
+            csv_fields "$f" | awk -F'\t' -v out="$work/c_$name" 'FNR == NR { id[$2] = $1; next }
+                FNR > 1 && $5 ~ /^[0-9.]+$/ {
                 if ($1 == "voxcolor" && $2 !~ /^e_t [0-9.]+$/) next
-                if (!($1 in id)) { id[$1] = ++n; name[n] = $1 }
-                print $3, $5 > (out "_" id[$1] ".dat") }
-                END { for (i = 1; i <= n; i++) print i "\t" name[i] > (out ".list") }'
+                if (!($1 in used)) { used[$1] = 1; print id[$1] "\t" $1 > (out ".list") }
+                print $3, $5 > (out "_" id[$1] ".dat") }' "$work/codecs" -
             echo "set title '$name'"
             printf "plot "
             sep=""
             while IFS='	' read -r i codec; do
-                w="linespoints"; [ "$codec" = voxcolor ] && w="linespoints lw 3"
+                w="linespoints lt $i"; [ "$codec" = voxcolor ] && w="$w lw 3"
                 printf "%s'%s' using 1:2 with %s title '%s'" "$sep" "$work/c_${name}_$i.dat" "$w" "$codec"
                 sep=", "
             done <"$work/c_$name.list"
