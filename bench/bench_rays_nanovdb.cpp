@@ -36,4 +36,9 @@ extern "C" int bench_peer_trace(const bench_peer *p, const double origin[3], con
 
 extern "C" void bench_peer_free(bench_peer *p) { delete p; }
 
-extern "C" const char *bench_peer_name(void) { return "NanoVDB firstActive (float grid)"; }
+#define BENCH_STR2(x) #x
+#define BENCH_STR(x) BENCH_STR2(x)
+extern "C" const char *bench_peer_name(void) {
+    return "NanoVDB " BENCH_STR(NANOVDB_MAJOR_VERSION_NUMBER) "." BENCH_STR(NANOVDB_MINOR_VERSION_NUMBER) "." BENCH_STR(
+        NANOVDB_PATCH_VERSION_NUMBER) " firstActive (float grid)";
+}
