@@ -1,3 +1,4 @@
+# shellcheck shell=sh
 # Sourced by the bench scripts that read bench/md2csv.awk's CSV files.
 # csv_fields FILE...: the rows as tab-separated lines (quotes respected).
 csv_fields() {

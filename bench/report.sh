@@ -12,7 +12,8 @@ set -eu
 mode=${1:?usage: bench/report.sh quick|full [BUILD_DIR]}
 build=${2:-build}
 make=${MAKE:-make}
-flag= color_flags=
+flag=
+color_flags=
 [ "$mode" = quick ] && flag=--quick color_flags="--quick --max 131072"
 out=$build/bench
 docs=docs/bench
@@ -23,7 +24,10 @@ step() { echo "bench: [$(( $(date +%s) - start )) s] $*" >&2; }
 step "packages"
 sh bench/deps.sh
 step "data"
-sh bench/fetch.sh bench/data $( [ "$mode" = full ] && echo scenes ) >/dev/null
+scenes=
+[ "$mode" = full ] && scenes=scenes
+# shellcheck disable=SC2086
+sh bench/fetch.sh bench/data $scenes >/dev/null
 rm -f "$docs"/*.csv
 
 # section NAME COMMAND...: COMMAND's markdown into $out/NAME.md and CSV files.
