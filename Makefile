@@ -186,9 +186,14 @@ $(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench
 bench-rays: bench-data $(BUILD)/bench/bench_rays
 	$(BUILD)/bench/bench_rays bench/data $(BENCH_FLAGS)
 
-bench: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/vdag
+$(BUILD)/bench/ssim: bench/ssim.c
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 -o $@ $< -lm
+
+BENCH_PROGRAMS := $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/bench/ssim $(BUILD)/vdag
+bench: bench-data $(BENCH_PROGRAMS)
 	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh full $(BUILD)
-bench-quick: bench-data $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/vdag
+bench-quick: bench-data $(BENCH_PROGRAMS)
 	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh quick $(BUILD)
 
 # bench-color: the colour codec against the reimplemented baselines on real

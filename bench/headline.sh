@@ -48,6 +48,6 @@ for f in "$csv"/color_*.csv; do
                 printf "| Colour encode / random lookup at e_t 0.05 (%s), M colours per CPU-second | voxcolor %s / %s; Alg. 1 %s / %s | - |\n", set, venc[k], vlook[k], denc[k], dlook[k]
         }'
 done
-tsv image_image-quality | awk -F'\t' '$4 != "raw" { s = s (s ? ", " : "") sprintf("%s e_t %s: %s dB (voxels %s dB) at %s bits/colour", $1, $4, $9, $8, $6) }
-    END { if (s) print "| Rendered image PSNR (voxel colour PSNR), compressed vs raw colours | " s " | - |" }'
+tsv image_image-quality | awk -F'\t' '$4 != "raw" { s = s (s ? ", " : "") sprintf("%s e_t %s: %s dB, SSIM %s (voxels %s dB) at %s bits/colour", $1, $4, $9, $10, $8, $6) }
+    END { if (s) print "| Rendered image PSNR and SSIM (voxel colour PSNR), compressed vs raw colours | " s " | - |" }'
 echo

@@ -3,13 +3,14 @@
 # with raw 24-bit colours and with --color-error E for a few E, every file is
 # rendered from the same camera, and OpenImageIO's idiff compares each
 # compressed render with the raw one; the voxels' own colours are compared
-# too (vdag export-voxels). Prints a markdown section.
-#   bench/image_quality.sh quick|full VDAG DATA_DIR PICTURE_DIR
+# too (vdag export-voxels), and bench/ssim.c gives the renders' SSIM. Prints
+# a markdown section.
+#   bench/image_quality.sh quick|full VDAG SSIM DATA_DIR PICTURE_DIR
 # Writes one mosaic per scene, PICTURE_DIR/quality_NAME.png:
 # raw | largest E | |difference| x 16.
 set -eu
-usage="usage: bench/image_quality.sh quick|full VDAG DATA_DIR PICTURE_DIR"
-mode=${1:?$usage} vdag=${2:?$usage} data=${3:?$usage} pics=${4:?$usage}
+usage="usage: bench/image_quality.sh quick|full VDAG SSIM DATA_DIR PICTURE_DIR"
+mode=${1:?$usage} vdag=${2:?$usage} ssim=${3:?$usage} data=${4:?$usage} pics=${5:?$usage}
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$pics"
@@ -27,10 +28,10 @@ CG-57|$C|11|1024|1250 -700 550|512 61 110|40"
 
 echo "## Image quality"
 echo
-echo "Each scene built by \`vdag build IN OUT.vdag [--levels L]\` with raw 24-bit colours and with \`--color-error E\`, rendered by \`vdag render --size $size --shadows\` from the same camera; PSNR of each compressed render against the raw one by OpenImageIO \`idiff\` (over the whole picture, RGB, background included). Voxel PSNR: over the voxels' decoded colours (\`vdag export-voxels\`, RGB, as in the colour tables). Colour bytes: the colour section of the file (\`vdag info --json\`). SSIM is not measured (OpenImageIO 2.4 has no SSIM)."
+echo "Each scene built by \`vdag build IN OUT.vdag [--levels L]\` with raw 24-bit colours and with \`--color-error E\`, rendered by \`vdag render --size $size --shadows\` from the same camera; PSNR of each compressed render against the raw one by OpenImageIO \`idiff\` (over the whole picture, RGB, background included); SSIM: mean structural similarity of the two renders' luma (\`bench/ssim.c\`: 11x11 Gaussian window, sigma 1.5, the usual constants; whole picture). Voxel PSNR: over the voxels' decoded colours (\`vdag export-voxels\`, RGB, as in the colour tables). Colour bytes: the colour section of the file (\`vdag info --json\`)."
 echo
-echo "| scene | L | voxels | e_t | colour bytes | bits/colour | % of raw | voxel PSNR (dB) | image PSNR (dB) | max pixel error | pixels differing |"
-echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+echo "| scene | L | voxels | e_t | colour bytes | bits/colour | % of raw | voxel PSNR (dB) | image PSNR (dB) | image SSIM | max pixel error | pixels differing |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 json() { sed -n "s/.*\"$2\": \\([0-9.]*\\).*/\\1/p" "$1"; }
 echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     [ -s "$data/$in" ] || { echo "image_quality: $data/$in missing (bench/fetch.sh DATA scenes)" >&2; continue; }
@@ -45,7 +46,8 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     render() { "$vdag" render "$1" "$2" --size $size --eye "$3" "$4" "$5" --target "$6" "$7" "$8" --fov "$fov" --shadows 2>/dev/null; }
     render "$work/raw.vdag" "$work/raw.png" "$@"
     "$vdag" export-voxels "$work/raw.vdag" >"$work/raw.xyz"
-    echo "| $name | $levels | $voxels | raw | $raw | 24.00 | 100.0 | - | - | - | - |"
+    oiiotool "$work/raw.png" --ch R,G,B -d uint8 -o "$work/raw.ppm"
+    echo "| $name | $levels | $voxels | raw | $raw | 24.00 | 100.0 | - | - | - | - | - |"
     for e in $errors; do
         echo "image_quality: $name e_t $e" >&2
         # shellcheck disable=SC2086
@@ -56,16 +58,18 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
         vpsnr=$(paste "$work/raw.xyz" "$work/e.xyz" | awk '!/^#/ { for (i = 4; i <= 6; i++) { d = $i - $(i + 6); s += d * d } n += 3 }
             END { if (s) printf "%.1f", 10 * log(255 * 255 * n / s) / log(10); else printf "lossless" }')
         idiff -a "$work/raw.png" "$work/e$e.png" >"$work/diff.txt" 2>&1 || true
+        oiiotool "$work/e$e.png" --ch R,G,B -d uint8 -o "$work/e.ppm"
+        ss=$("$ssim" "$work/raw.ppm" "$work/e.ppm")
         bytes=$(json "$work/e.json" colors)
         psnr=$(sed -n 's/.*Peak SNR = \([0-9.inf]*\).*/\1/p' "$work/diff.txt")
         maxe=$(sed -n 's/.*Max error *= \([0-9.e-]*\).*/\1/p' "$work/diff.txt")
         differ=$(sed -n 's/.*pixels (\([0-9.]*\)%) over.*/\1/p' "$work/diff.txt" | head -n 1)
         set -- $cam
         awk -v n="$name" -v L="$levels" -v v="$voxels" -v e="$e" -v b="$bytes" -v r="$raw" -v p="${psnr:-inf}" \
-            -v m="${maxe:-0}" -v d="${differ:-0}" -v vp="$vpsnr" 'BEGIN {
+            -v m="${maxe:-0}" -v d="${differ:-0}" -v vp="$vpsnr" -v ss="$ss" 'BEGIN {
             bits = 8 * b / v; pct = 100 * b / r; me = m * 255
             if (p != "inf") p = sprintf("%.1f", p)
-            printf "| %s | %s | %s | %s | %s | %.2f | %.1f | %s | %s | %.0f/255 | %s%% |\n", n, L, v, e, b, bits, pct, vp, p, me, d }'
+            printf "| %s | %s | %s | %s | %s | %.2f | %.1f | %s | %s | %.4f | %.0f/255 | %s%% |\n", n, L, v, e, b, bits, pct, vp, p, ss, me, d }'
     done
     oiiotool "$work/raw.png" "$work/e$last.png" --absdiff --mulc 16 -o "$work/diff.png"
     oiiotool "$work/raw.png" --resize 360x225 "$work/e$last.png" --resize 360x225 "$work/diff.png" --resize 360x225 \

@@ -50,7 +50,7 @@ fi
 if optional color; then
     section color $make -s --no-print-directory bench-color BUILD="$build" BENCH_COLOR_FLAGS="$color_flags"
 fi
-section image sh bench/image_quality.sh "$mode" "$build/vdag" bench/data "$docs"
+section image sh bench/image_quality.sh "$mode" "$build/vdag" "$build/bench/ssim" bench/data "$docs"
 step "plots"
 
 version() { dpkg-query -W -f '${Version}' "$1" 2>/dev/null || echo "not installed"; }
