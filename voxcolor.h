@@ -9,13 +9,16 @@
    Each block is one of: a single colour, two endpoints with a 1..4-bit weight
    per colour interpolating between them, or raw colours. Endpoints are RGB565
    or RGB888, chosen per block. Blocks never cross a page (2^page_shift
-   colours); each page starts with checkpoints (every 8th block's first
-   colour and payload offset) and a directory of its blocks, and a page table
-   gives each page's start, so a lookup reads one table entry, binary-searches
-   the page's checkpoints and walks at most 8 directory entries.
-   voxcolor_view_get_many overlaps the memory accesses
-   of many lookups. The encoder is a fast greedy heuristic (Dolonius et al.'s
-   Algorithm 1 and HashDAG's layout are reimplemented in bench/ to compare).
+   colours); each page starts with a byte-aligned directory of its blocks
+   (the last colour of each group of 8 blocks, then of the others, the
+   modes, the payload offset of each group), and a page table gives each
+   page's start. A lookup reads one table entry and compares the directory's
+   bytes a word at a time, without data-dependent branches but one short
+   walk (at most 7 blocks), and prefetches the likely payload meanwhile.
+   voxcolor_view_get_many overlaps the memory accesses of many lookups. The
+   encoder is a fast greedy heuristic with integer decisions: the same
+   stream on every compiler and processor (RGB metric). Dolonius et al.'s
+   Algorithm 1 and HashDAG's layout are reimplemented in bench/ to compare.
 
    QUICK START
        #define VOXCOLOR_IMPLEMENTATION   // in exactly one C or C++ file
@@ -69,7 +72,7 @@
     (VOXCOLOR_VERSION_MAJOR * 10000 + VOXCOLOR_VERSION_MINOR * 100 + VOXCOLOR_VERSION_PATCH)
 
 /* Stream layout version, stored in every stream (FORMAT.md). */
-#define VOXCOLOR_FORMAT_VERSION 2
+#define VOXCOLOR_FORMAT_VERSION 3
 
 /* Byte offsets of the stream header fields (FORMAT.md). */
 #define VOXCOLOR_OFF_MAGIC 0      /* 4 bytes "VXC1" */
@@ -147,7 +150,9 @@ VOXCOLOR_API size_t voxcolor_encode_bound(size_t count);
    Returns the stream size in bytes, or 0 when DST_SIZE is too small (a buffer
    of voxcolor_encode_bound(count) bytes is always large enough). The caller
    owns both buffers; no memory is allocated. Deterministic: the same input and
-   options give the same bytes. Invalid options trip VOXCOLOR_ASSERT. */
+   options give the same bytes, whatever the compiler, processor or
+   floating-point model (with the CIELAB metric: the same floating-point
+   model). Invalid options trip VOXCOLOR_ASSERT. */
 VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
                                     size_t count, const voxcolor_encode_opts *opts);
 
@@ -162,7 +167,7 @@ typedef struct voxcolori_enc {
     uint32_t thr2;      /* RGB: largest squared distance allowed */
     int lab;            /* 1: CIELAB metric */
     double lab_thr2;    /* CIELAB: largest squared delta E allowed */
-    double line2;       /* RGB: squared bound plus interpolation rounding */
+    uint64_t line64;    /* RGB: 64 (sqrt(thr2) + sqrt(3) / 2)^2, rounded up */
     double linear[256]; /* CIELAB: sRGB channel value to linear light */
     unsigned page_shift;
     unsigned modes[5], mode_count;
@@ -242,9 +247,9 @@ typedef struct voxcolor_view {
 VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src,
                                                 size_t size);
 
-/* Writes the colour at INDEX (< view->count) to RGB_OUT[0..2]. Reads one page
-   table entry, binary-searches the page's checkpoints and walks at most 8
-   block entries. Thread-safe. */
+/* Writes the colour at INDEX (< view->count) to RGB_OUT[0..2]. Reads two page
+   table entries, counts the page's directory bytes below the colour's a
+   word at a time and walks at most 7 block entries. Thread-safe. */
 VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
                                     uint8_t rgb_out[3]);
 
@@ -301,7 +306,8 @@ VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t
 
 #include <string.h>
 
-/* The encoder's error checks decide the stream's bytes: fused multiply-adds
+/* With the RGB metric every decision of the encoder is integer arithmetic.
+   The CIELAB metric's error checks use floating point: fused multiply-adds
    would change them between compilers, so contraction is off where the
    compiler honours the standard pragma (GCC: compile with -ffp-contract=off). */
 #if defined(__clang__)
@@ -314,21 +320,22 @@ VOXCOLOR_API void voxcolor_from_image(uint8_t *rgb8, size_t count, const uint8_t
 #endif
 
 // -- Block modes
-/* A page is its block count - 1 (page_shift bits), a checkpoint per group
-   of 8 blocks but the first: the index in the page of the group's first
-   colour (page_shift bits) and the payload bit offset of the group's first
-   block (page_shift + 6 bits), then a directory entry per block: MODE (3
-   bits), PRECISION (1 bit: 0 RGB565, 1 RGB888 endpoints) and the index in the
-   page of the block's last colour (page_shift bits), then each block's payload:
-   its endpoints and a weight per colour. Modes 0..4: weight width in bits
-   (0 = one colour); mode 5: raw RGB888 colours. */
+/* A page is its block count - 1, then per block the index in the page of its
+   last colour (these indices are 1 byte each for pages of up to 256 colours,
+   else 2), then per block MODE (3 bits) and PRECISION (1 bit: 0 RGB565, 1
+   RGB888 endpoints) in a nibble, two per byte, then a checkpoint per group of
+   8 blocks but the first: the payload bit offset of the group's first block
+   (u16), then the payloads from the next byte on: each block's endpoints and
+   a field per colour. Modes 0..4: weight width in bits (0 = one colour); mode
+   5: raw RGB888 colours. The byte-aligned directory makes a lookup a binary
+   search over bytes and a walk of at most 7 entries. */
 #define VOXCOLORI_MODE_RAW 5u
-#define VOXCOLORI_GROUP_SHIFT 3u /* checkpoints every 8 blocks */
+#define VOXCOLORI_GROUP_SHIFT 3u /* groups of 8 blocks */
 #define VOXCOLORI_MAX_WEIGHT_BITS 4u
 
 /* Interpolation weights in 64ths for weight k of width w: round(64 k / (2^w - 1)).
    A channel decodes as (e0 * (64 - t) + e1 * t + 32) >> 6 (as in BC7). */
-static const uint8_t voxcolori_weights[5][16] = {
+static const uint8_t voxcolori_weights[8][16] = {
     {0},
     {0, 64},
     {0, 21, 43, 64},
@@ -376,6 +383,18 @@ static unsigned voxcolori_channel_shift(unsigned channel, unsigned precision) {
 #define VOXCOLORI_INLINE
 #endif
 
+#if defined(__GNUC__) || defined(__clang__)
+#define VOXCOLORI_ALWAYS_INLINE __attribute__((always_inline)) VOXCOLORI_INLINE
+#else
+#define VOXCOLORI_ALWAYS_INLINE VOXCOLORI_INLINE
+#endif
+
+#if defined(__GNUC__) || defined(__clang__)
+#define VOXCOLORI_PREFETCH(p) __builtin_prefetch(p)
+#else
+#define VOXCOLORI_PREFETCH(p) ((void)(p))
+#endif
+
 // -- Little-endian bytes
 
 static uint64_t voxcolori_load_le(const uint8_t *p, unsigned n) {
@@ -405,29 +424,13 @@ static VOXCOLORI_INLINE uint64_t voxcolori_bits(const uint8_t *data, uint64_t po
 
 // -- Decoding one block
 
-/* Reads an endpoint colour of PRECISION at bit POS into E (8-bit channels). */
-static VOXCOLORI_INLINE void voxcolori_read_endpoint(const uint8_t *data, uint64_t pos,
-                                                     unsigned precision, unsigned e[3]) {
-    unsigned v = (unsigned)voxcolori_bits(data, pos, precision ? 24u : 16u), r, g, b;
-    if (precision) {
-        e[0] = v & 255;
-        e[1] = (v >> 8) & 255;
-        e[2] = v >> 16;
-        return;
-    }
-    r = v & 31;
-    g = (v >> 5) & 63;
-    b = v >> 11;
-    e[0] = r << 3 | r >> 2;
-    e[1] = g << 2 | g >> 4;
-    e[2] = b << 3 | b >> 2;
-}
-
-/* Interpolated colour for weight index K of a width-W block. */
-static void voxcolori_mix(const unsigned e0[3], const unsigned e1[3], unsigned w, unsigned k,
-                          uint8_t out[3]) {
-    unsigned t = voxcolori_weights[w][k], c;
-    for (c = 0; c < 3; c++) out[c] = (uint8_t)((e0[c] * (64 - t) + e1[c] * t + 32) >> 6);
+/* Channels of an endpoint in the low bits of V (PRECISION 0: RGB565, 1:
+   RGB888), widened to 8 bits, in the 16-bit lanes 0, 1 and 2. */
+static VOXCOLORI_INLINE uint64_t voxcolori_lanes(uint64_t v, unsigned precision) {
+    uint64_t r = v & 31, g = (v >> 5) & 63, b = (v >> 11) & 31;
+    uint64_t wide = (v & 255) | (v & 0xff00) << 8 | (v & 0xff0000) << 16;
+    uint64_t narrow = (r << 3 | r >> 2) | (g << 2 | g >> 4) << 16 | (b << 3 | b >> 2) << 32;
+    return precision ? wide : narrow;
 }
 
 /* Bits of a block's payload: endpoints, then a weight or raw colour per colour. */
@@ -435,36 +438,27 @@ static uint64_t voxcolori_block_bits(unsigned mode, unsigned precision, uint64_t
     return voxcolori_endpoint_bits(mode, precision) + length * voxcolori_payload_bits(mode);
 }
 
-typedef struct voxcolori_block {
-    unsigned mode, precision;
-    uint64_t length;
-    uint64_t payload; /* bit position of the endpoints */
-} voxcolori_block;
+/* Colour number I, as 0xBBGGRR, of the block with nibble H (mode | precision
+   << 3) whose payload starts at bit POS. Without branches: every mode reads
+   the same fields and keeps the ones it needs. */
+static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_block_color(const uint8_t *data, uint64_t pos,
+                                                       unsigned h, uint64_t i) {
+    unsigned mode = h & 7, precision = (h >> 3) & 1, bits = voxcolori_colour_table[mode];
+    uint64_t v = voxcolori_bits(data, pos + voxcolori_endpoint_table[h & 15] + i * bits, bits);
+    uint64_t e = voxcolori_bits(data, pos, 48);
+    uint64_t e0 = voxcolori_lanes(e, precision), e1 = voxcolori_lanes(e >> (16 + 8 * precision), precision);
+    uint64_t t = voxcolori_weights[mode][v & 15], c;
+    /* (e0 (64 - t) + e1 t + 32) >> 6 in the three lanes at once; mode 0 has
+       t = 0. */
+    c = ((e0 * (64 - t) + e1 * t + 0x002000200020ull) >> 6) & 0x00ff00ff00ffull;
+    c = (c & 0xff) | (c >> 8 & 0xff00) | (c >> 16 & 0xff0000);
+    return (uint32_t)(mode == VOXCOLORI_MODE_RAW ? v : c);
+}
 
-/* Colour number I (< length) of block B. */
-static VOXCOLORI_INLINE void voxcolori_block_color(const uint8_t *data, const voxcolori_block *b,
-                                                   uint64_t i, uint8_t out[3]) {
-    unsigned e0[3], e1[3];
-    if (b->mode == VOXCOLORI_MODE_RAW) {
-        uint64_t v = voxcolori_bits(data, b->payload + 24 * i, 24);
-        out[0] = (uint8_t)v;
-        out[1] = (uint8_t)(v >> 8);
-        out[2] = (uint8_t)(v >> 16);
-        return;
-    }
-    voxcolori_read_endpoint(data, b->payload, b->precision, e0);
-    if (b->mode == 0) {
-        out[0] = (uint8_t)e0[0];
-        out[1] = (uint8_t)e0[1];
-        out[2] = (uint8_t)e0[2];
-        return;
-    }
-    {
-        unsigned one = b->precision ? 24u : 16u;
-        uint64_t k = voxcolori_bits(data, b->payload + 2 * one + b->mode * i, b->mode);
-        voxcolori_read_endpoint(data, b->payload + one, b->precision, e1);
-        voxcolori_mix(e0, e1, b->mode, (unsigned)k, out);
-    }
+static void voxcolori_store_rgb(uint8_t *out, uint32_t c) {
+    out[0] = (uint8_t)c;
+    out[1] = (uint8_t)(c >> 8);
+    out[2] = (uint8_t)(c >> 16);
 }
 
 // -- Views
@@ -483,94 +477,106 @@ VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status) {
 
 VOXCOLOR_API uint32_t voxcolor_version(void) { return VOXCOLOR_VERSION; }
 
-static uint64_t voxcolori_page_offset(const voxcolor_view *v, uint64_t page) {
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_page_offset(const voxcolor_view *v, uint64_t page) {
     const uint8_t *p;
     if (v->wide) return voxcolori_load64(v->table + (size_t)(page * 8));
     p = v->table + (size_t)(page * 4);
     return (uint64_t)p[0] | (uint64_t)p[1] << 8 | (uint64_t)p[2] << 16 | (uint64_t)p[3] << 24;
 }
 
-/* Walks the block directory of one page. */
+/* The directory of one page. Colour indices (block count - 1, ends) are 1
+   byte each, 2 when WIDE (pages over 256 colours). */
 typedef struct voxcolori_page {
-    uint64_t entry;       /* bit position of the next directory entry */
-    uint64_t checkpoints; /* bit position of the checkpoints */
-    uint64_t payload;     /* bit position of that block's payload */
-    uint64_t start;       /* index in the page of that block's first colour */
-    unsigned entry_bits;
+    const uint8_t *group_ends;  /* per group of 8 blocks, the index of its last colour */
+    const uint8_t *block_ends;  /* per group, the last colours of its blocks but the last */
+    const uint8_t *modes;       /* per block, mode | precision << 3, low nibble first */
+    const uint8_t *checkpoints; /* u16 payload offsets of groups 1, 2, ... */
+    uint64_t payload;           /* bit position of block 0's payload */
+    uint64_t last;              /* block count - 1 */
+    unsigned wide;
 } voxcolori_page;
 
-/* Checkpoints of a page of BLOCKS blocks. */
-static uint64_t voxcolori_checkpoint_count(uint64_t blocks) {
-    return (blocks - 1) >> VOXCOLORI_GROUP_SHIFT;
+/* Bytes of the block count and directory of a page of BLOCKS blocks. */
+static uint64_t voxcolori_directory_bytes(uint64_t blocks, unsigned wide) {
+    uint64_t groups = ((blocks - 1) >> VOXCOLORI_GROUP_SHIFT) + 1;
+    return (blocks + 1) * (1 + wide) + (blocks + 1) / 2 + 2 * (groups - 1);
 }
 
-/* Starts walking the page that begins at bit POS. Returns its block count. */
-static uint64_t voxcolori_page_open(const voxcolor_view *v, uint64_t pos, voxcolori_page *p) {
-    uint64_t blocks = voxcolori_bits(v->data, pos, v->page_shift) + 1;
-    p->entry_bits = 4 + v->page_shift;
-    p->checkpoints = pos + v->page_shift;
-    p->entry = p->checkpoints + voxcolori_checkpoint_count(blocks) * (2 * v->page_shift + 6);
-    p->payload = p->entry + blocks * p->entry_bits;
-    p->start = 0;
-    return blocks;
+/* Bytes of a colour index in a page of 2^PAGE_SHIFT colours. */
+static unsigned voxcolori_index_bytes(unsigned page_shift) { return page_shift > 8 ? 2u : 1u; }
+
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_index(const uint8_t *p, unsigned wide) {
+    return wide ? (uint64_t)p[0] | (uint64_t)p[1] << 8 : p[0];
 }
 
-/* Reads the next directory entry into B. Entry positions do not depend on
-   the data, so the processor overlaps these reads. */
-static void voxcolori_page_next(const uint8_t *data, voxcolori_page *p, voxcolori_block *b) {
-    uint64_t h = voxcolori_bits(data, p->entry, p->entry_bits);
-    b->mode = (unsigned)(h & 7);
-    b->precision = (unsigned)(h >> 3) & 1;
-    b->length = (h >> 4) + 1 - p->start; /* wraps when the ends do not grow */
-    b->payload = p->payload;
-    p->start = (h >> 4) + 1;
-    p->entry += p->entry_bits;
-    p->payload += voxcolori_block_bits(b->mode, b->precision, b->length);
+/* Opens the page at byte AT of DATA (its block count must be readable). */
+static VOXCOLORI_ALWAYS_INLINE void voxcolori_page_open(const uint8_t *data, uint64_t at,
+                                                        unsigned wide, voxcolori_page *p) {
+    uint64_t groups;
+    p->wide = wide;
+    p->last = voxcolori_index(data + at, wide);
+    groups = (p->last >> VOXCOLORI_GROUP_SHIFT) + 1;
+    p->group_ends = data + at + 1 + wide;
+    p->block_ends = p->group_ends + (groups << wide);
+    p->modes = p->block_ends + ((p->last + 1 - groups) << wide);
+    p->checkpoints = p->modes + (p->last + 2) / 2;
+    p->payload = 8 * (at + voxcolori_directory_bytes(p->last + 1, wide));
+}
+
+/* Index in the page of block K's last colour. */
+static uint64_t voxcolori_end(const voxcolori_page *p, uint64_t k) {
+    uint64_t g = k >> VOXCOLORI_GROUP_SHIFT, i = k & ((1u << VOXCOLORI_GROUP_SHIFT) - 1);
+    if (i == (1u << VOXCOLORI_GROUP_SHIFT) - 1 || k == p->last)
+        return voxcolori_index(p->group_ends + (g << p->wide), p->wide);
+    return voxcolori_index(p->block_ends + ((7 * g + i) << p->wide), p->wide);
+}
+
+/* Block K's mode | precision << 3. */
+static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_nibble(const voxcolori_page *p, uint64_t k) {
+    return (p->modes[k >> 1] >> (4 * (k & 1))) & 15;
 }
 
 /* Checks every page: its directory and blocks must tile it exactly, pages
    must follow each other without gaps where the page table says, and the
    data must end with the 8 zero bytes. DATA_SIZE >= 8. */
 static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t data_size) {
-    uint64_t limit = (data_size - 8) * 8, pos = 0, page, pages;
-    uint64_t page_size = 1ull << v->page_shift, k, first_payload;
+    uint64_t limit = data_size - 8, at = 0, page, pages;
+    uint64_t page_size = 1ull << v->page_shift, k;
+    unsigned wide = v->page_shift > 8;
     size_t i;
     pages = v->count ? ((v->count - 1) >> v->page_shift) + 1 : 0;
     for (page = 0; page < pages; page++) {
-        uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size, blocks;
+        uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size;
+        uint64_t start = 0, pos;
         voxcolori_page p;
-        if (voxcolori_page_offset(v, page) != pos / 8 || limit - pos < v->page_shift)
-            return VOXCOLOR_ERR_CORRUPT;
-        blocks = voxcolori_page_open(v, pos, &p);
-        if (blocks > left || p.payload > limit) return VOXCOLOR_ERR_CORRUPT;
-        first_payload = p.payload;
-        for (k = 0; k < blocks; k++) {
-            voxcolori_block b;
-            uint64_t start = p.start;
+        if (voxcolori_page_offset(v, page) != at || limit - at < 1u + wide) return VOXCOLOR_ERR_CORRUPT;
+        k = voxcolori_index(v->data + at, wide) + 1;
+        if (k > left || voxcolori_directory_bytes(k, wide) > limit - at) return VOXCOLOR_ERR_CORRUPT;
+        voxcolori_page_open(v->data, at, wide, &p);
+        /* The nibble after the last block's is zero. */
+        if (!(p.last & 1) && p.modes[p.last >> 1] >> 4) return VOXCOLOR_ERR_CORRUPT;
+        for (k = 0, pos = p.payload; k <= p.last; k++) {
+            unsigned h = voxcolori_nibble(&p, k);
+            uint64_t end = voxcolori_end(&p, k) + 1;
             if (k && !(k & ((1u << VOXCOLORI_GROUP_SHIFT) - 1)) &&
-                voxcolori_bits(v->data,
-                               p.checkpoints + ((k >> VOXCOLORI_GROUP_SHIFT) - 1) * (2 * v->page_shift + 6),
-                               2 * v->page_shift + 6) != (p.start | (p.payload - first_payload) << v->page_shift))
+                voxcolori_load_le(p.checkpoints + 2 * ((k >> VOXCOLORI_GROUP_SHIFT) - 1), 2) != pos - p.payload)
                 return VOXCOLOR_ERR_CORRUPT;
-            voxcolori_page_next(v->data, &p, &b);
-            /* Ends grow, and stay inside the page. */
-            if (b.mode > VOXCOLORI_MODE_RAW || (b.mode == VOXCOLORI_MODE_RAW && b.precision) ||
-                p.start <= start || p.start > left)
+            /* Known modes; ends grow and stay inside the page. */
+            if ((h & 7) > VOXCOLORI_MODE_RAW || h == (VOXCOLORI_MODE_RAW | 8) || end <= start || end > left)
                 return VOXCOLOR_ERR_CORRUPT;
             /* A block has at most 1024 * 24 + 48 bits: no overflow before this. */
-            if (p.payload > limit) return VOXCOLOR_ERR_CORRUPT;
+            pos += voxcolori_block_bits(h & 7, h >> 3, end - start);
+            if (pos > 8 * limit) return VOXCOLOR_ERR_CORRUPT;
+            start = end;
         }
-        if (p.start != left) return VOXCOLOR_ERR_CORRUPT;
+        if (start != left) return VOXCOLOR_ERR_CORRUPT;
         /* Pages start on a byte; the bits up to it must be zero. */
-        pos = p.payload;
-        if (pos & 7) {
-            if (voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7))) return VOXCOLOR_ERR_CORRUPT;
-            pos += 8 - (pos & 7);
-        }
+        if ((pos & 7) && voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7))) return VOXCOLOR_ERR_CORRUPT;
+        at = (pos + 7) / 8;
     }
-    if (pos / 8 + 8 != data_size) return VOXCOLOR_ERR_CORRUPT;
+    if (at != limit) return VOXCOLOR_ERR_CORRUPT;
     for (i = 0; i < 8; i++)
-        if (v->data[pos / 8 + i]) return VOXCOLOR_ERR_CORRUPT;
+        if (v->data[at + i]) return VOXCOLOR_ERR_CORRUPT;
     return VOXCOLOR_OK;
 }
 
@@ -610,62 +616,93 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
     return st;
 }
 
-VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
-                                    uint8_t rgb_out[3]) {
-    const uint8_t *data = view->data;
-    voxcolori_page p;
-    voxcolori_block b;
-    uint64_t j, blocks, g, n, h, start, cp, k;
-    unsigned s = view->page_shift, eb = 4 + s, cb = 2 * s + 6;
-    VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
-    j = index & ((1ull << s) - 1);
-    blocks = voxcolori_page_open(view, voxcolori_page_offset(view, index >> s) * 8, &p);
-    /* The group holding colour j: the last whose first colour is at or
-       before j (group 0 starts at 0), by a binary search over the compact
-       checkpoints, without data-dependent branches. */
-    for (g = 0, n = voxcolori_checkpoint_count(blocks) + 1; n > 1; n -= n >> 1) {
-        uint64_t first = voxcolori_bits(data, p.checkpoints + (g + (n >> 1) - 1) * cb, s);
-        g += first <= j ? n >> 1 : 0;
-    }
-    /* Its first colour and payload offset (group 0: 0 and 0; the read then
-       takes the first checkpoint or directory entry, unused). */
-    cp = voxcolori_bits(data, p.checkpoints + (g - (g != 0)) * cb, cb) & (g ? ~0ull : 0);
-    start = cp & ((1ull << s) - 1);
-    p.payload += cp >> s;
-    /* The block: the first in the group ending at or after j; the payloads
-       of the (at most 7) blocks before it are added up on the way. */
-    for (k = g << VOXCOLORI_GROUP_SHIFT;; k++) {
-        uint64_t end;
-        h = voxcolori_bits(data, p.entry + k * eb, eb);
-        end = (h >> 4) + 1;
-        if (end > j) break;
-        p.payload += voxcolori_endpoint_table[h & 15] + (end - start) * voxcolori_colour_table[h & 7];
-        start = end;
-    }
-    b.mode = (unsigned)(h & 7);
-    b.precision = (unsigned)(h >> 3) & 1;
-    b.length = (h >> 4) + 1 - start;
-    b.payload = p.payload;
-    voxcolori_block_color(data, &b, j - start, rgb_out);
+/* Prefetches the start of PAGE and the part where colour J's payload likely
+   is (at its share of the page), so that both arrive together. Returns the
+   page's offset. */
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_prefetch_page(const voxcolor_view *view,
+                                                                uint64_t page, uint64_t j) {
+    uint64_t at = voxcolori_page_offset(view, page);
+    VOXCOLORI_PREFETCH(view->data + at);
+    if ((page + 1) << view->page_shift < view->count)
+        VOXCOLORI_PREFETCH(view->data + at +
+                           (((voxcolori_page_offset(view, page + 1) - at) * j) >> view->page_shift));
+    return at;
 }
 
-#if defined(__GNUC__) || defined(__clang__)
-#define VOXCOLORI_PREFETCH(p) __builtin_prefetch(p)
-#else
-#define VOXCOLORI_PREFETCH(p) ((void)(p))
-#endif
+/* Number of the lowest N lanes of X (8 bits each, 16 when WIDE) whose
+   value is below J, without branches: a lane-wise borrow of X - J. */
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_count_below(uint64_t x, uint64_t j, unsigned n,
+                                                              unsigned wide) {
+    unsigned bits = 8u << wide;
+    uint64_t ones = wide ? 0x0001000100010001ull : 0x0101010101010101ull, high = ones << (bits - 1);
+    uint64_t jj = j * ones, d = (x | high) - (jj & ~high);
+    uint64_t below = ((~x & jj) | (~(x ^ jj) & ~d)) & high;
+    below &= n * bits >= 64 ? ~0ull : (1ull << (n * bits)) - 1;
+    return ((below >> (bits - 1)) * ones) >> (64 - bits);
+}
+
+/* voxcolor_view_get for pages with WIDE indices, a constant in each call so
+   that every index read compiles to one load. */
+static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_get(const voxcolor_view *view, uint64_t index,
+                                                      unsigned wide) {
+    const uint8_t *data = view->data, *ends;
+    unsigned s = view->page_shift, lanes = 8u >> wide, n;
+    uint64_t j = index & ((1ull << s) - 1), page = index >> s, at, groups, g, w, r, start, pos, modes;
+    voxcolori_page p;
+    at = voxcolori_prefetch_page(view, page, j);
+    voxcolori_page_open(data, at, wide, &p);
+    groups = (p.last >> VOXCOLORI_GROUP_SHIFT) + 1;
+    /* Group g holding colour j: the number of groups ending before j,
+       counted a word of ends at a time. */
+    for (g = 0, w = 0; w < groups; w += lanes) {
+        n = groups - w < lanes ? (unsigned)(groups - w) : lanes;
+        g += voxcolori_count_below(voxcolori_load64(p.group_ends + (w << wide)), j, n, wide);
+    }
+    /* Block k holding j: the group's first block plus the number of its
+       other blocks ending before j. */
+    ends = p.block_ends + ((7 * g) << wide);
+    n = p.last - (g << VOXCOLORI_GROUP_SHIFT) < 7 ? (unsigned)(p.last - (g << VOXCOLORI_GROUP_SHIFT)) : 7;
+    r = voxcolori_count_below(voxcolori_load64(ends), j, n, wide);
+    if (wide) r += voxcolori_count_below(voxcolori_load64(ends + 8), j, n > 4 ? n - 4 : 0, wide);
+    /* Its payload: the group's checkpoint plus the payloads of the r blocks
+       before it in the group. */
+    pos = p.payload;
+    start = 0;
+    if (g) {
+        pos += voxcolori_load_le(p.checkpoints + 2 * (g - 1), 2);
+        start = voxcolori_index(p.group_ends + ((g - 1) << wide), wide) + 1;
+    }
+    modes = voxcolori_load64(p.modes + 4 * g); /* the group's 8 nibbles */
+    for (w = 0; w < r; w++, modes >>= 4) {
+        unsigned h = (unsigned)modes & 15;
+        uint64_t end = voxcolori_index(ends + (w << wide), wide) + 1;
+        pos += voxcolori_endpoint_table[h] + (end - start) * voxcolori_colour_table[h & 7];
+        start = end;
+    }
+    return voxcolori_block_color(data, pos, (unsigned)modes & 15, j - start);
+}
+
+VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
+                                    uint8_t rgb_out[3]) {
+    VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
+    voxcolori_store_rgb(rgb_out, view->page_shift > 8 ? voxcolori_get(view, index, 1)
+                                                      : voxcolori_get(view, index, 0));
+}
 
 VOXCOLOR_API void voxcolor_view_get_many(const voxcolor_view *view, const uint64_t *indices,
                                          size_t n, uint8_t *rgb_out) {
-    /* Software pipeline: the page table entry 16 lookups ahead, the page 8
-       lookups ahead (its entry is in cache by then). */
+    /* Software pipeline: the page table entries 16 lookups ahead, the page
+       and the likely place of the colour's payload 8 lookups ahead (the
+       entries are in cache by then). */
     size_t i, entry = view->wide ? 8u : 4u;
+    unsigned s = view->page_shift;
     VOXCOLOR_ASSERT(view && (indices || !n) && (rgb_out || !n));
     for (i = 0; i < n; i++) {
-        if (i + 16 < n) VOXCOLORI_PREFETCH(view->table + (size_t)(indices[i + 16] >> view->page_shift) * entry);
+        if (i + 16 < n) VOXCOLORI_PREFETCH(view->table + (size_t)(indices[i + 16] >> s) * entry);
         if (i + 8 < n) {
-            VOXCOLOR_ASSERT(indices[i + 8] < view->count);
-            VOXCOLORI_PREFETCH(view->data + voxcolori_page_offset(view, indices[i + 8] >> view->page_shift));
+            uint64_t ahead = indices[i + 8];
+            VOXCOLOR_ASSERT(ahead < view->count);
+            voxcolori_prefetch_page(view, ahead >> s, ahead & ((1ull << s) - 1));
         }
         voxcolor_view_get(view, indices[i], rgb_out + 3 * i);
     }
@@ -680,18 +717,17 @@ VOXCOLOR_API void voxcolor_view_get_range(const voxcolor_view *view, uint64_t fi
     i = first & ((1ull << view->page_shift) - 1);
     while (n) {
         voxcolori_page p;
-        uint64_t blocks = voxcolori_page_open(view, voxcolori_page_offset(view, page++) * 8, &p);
-        while (blocks-- && n) {
-            voxcolori_block b;
-            voxcolori_page_next(view->data, &p, &b);
-            if (i >= b.length) {
-                i -= b.length;
-                continue;
-            }
-            for (; i < b.length && n; i++, n--, rgb_out += 3)
-                voxcolori_block_color(view->data, &b, i, rgb_out);
-            i = 0;
+        uint64_t k, start = 0, pos;
+        voxcolori_page_open(view->data, voxcolori_page_offset(view, page++), view->page_shift > 8, &p);
+        for (k = 0, pos = p.payload; k <= p.last && n; k++) {
+            unsigned h = voxcolori_nibble(&p, k);
+            uint64_t end = voxcolori_end(&p, k) + 1;
+            for (; i < end && n; i++, n--, rgb_out += 3)
+                voxcolori_store_rgb(rgb_out, voxcolori_block_color(view->data, pos, h, i - start));
+            pos += voxcolori_block_bits(h & 7, h >> 3, end - start);
+            start = end;
         }
+        i = 0;
     }
 }
 
@@ -759,24 +795,72 @@ static int voxcolori_close(const voxcolori_enc *e, const uint8_t c[3], const uin
     return s <= e->lab_thr2;
 }
 
+/* The high and low 64 bits of A * B. */
+static void voxcolori_mul128(uint64_t a, uint64_t b, uint64_t *hi, uint64_t *lo) {
+    uint64_t al = a & 0xffffffffu, ah = a >> 32, bl = b & 0xffffffffu, bh = b >> 32;
+    uint64_t ll = al * bl, lh = al * bh, hl = ah * bl, hh = ah * bh;
+    uint64_t mid = (ll >> 32) + (lh & 0xffffffffu) + (hl & 0xffffffffu);
+    *lo = (mid << 32) | (ll & 0xffffffffu);
+    *hi = hh + (lh >> 32) + (hl >> 32) + (mid >> 32);
+}
+
+/* 1 when D <= (255 E)^2 exactly (E >= 0, D < 2^18), from E's bits: no
+   floating-point rounding, so every compiler agrees. */
+static int voxcolori_within(uint32_t d, double e) {
+    uint64_t bits, m, hi, lo, dh, dl;
+    int shift;
+    memcpy(&bits, &e, sizeof bits);
+    if ((bits >> 52) >= 0x7ff) return 1; /* infinity */
+    m = bits & ((1ull << 52) - 1);
+    /* e = m 2^shift, then (255 e)^2 = 65025 m^2 2^(2 shift). */
+    if (bits >> 52) {
+        m |= 1ull << 52;
+        shift = (int)(bits >> 52) - 1075;
+    } else {
+        shift = -1074;
+    }
+    if (!m || !d) return !d;
+    voxcolori_mul128(m, m, &hi, &lo); /* below 2^106 */
+    voxcolori_mul128(lo, 65025, &dh, &dl);
+    hi = hi * 65025 + dh;
+    lo = dl; /* 65025 m^2, below 2^122 */
+    shift *= 2;
+    if (shift >= 0) return 1; /* 65025 m^2 2^shift >= 65025 > d's bound */
+    shift = -shift;
+    /* d 2^shift <= hi:lo? d has at most 18 bits. */
+    if (shift >= 122 || (shift > 104 && d >> (122 - shift))) return 0; /* d 2^shift >= 2^122 */
+    dh = shift >= 64 ? (uint64_t)d << (shift - 64) : shift ? (uint64_t)d >> (64 - shift) : 0;
+    dl = shift >= 64 ? 0 : (uint64_t)d << shift;
+    return dh < hi || (dh == hi && dl <= lo);
+}
+
+/* Smallest integer r with r^2 >= X. */
+static uint64_t voxcolori_isqrt_up(uint64_t x) {
+    uint64_t r = 0, bit;
+    for (bit = 1ull << 31; bit; bit >>= 1)
+        if ((r + bit) * (r + bit) <= x) r += bit;
+    return r * r < x ? r + 1 : r;
+}
+
 /* Sets up the metric and the modes to try from the options. */
 static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) {
-    double x = o->max_error * 255.0;
+    uint32_t lo = 0, hi = 3 * 255 * 255;
     unsigned i;
     memset(e, 0, sizeof *e);
     e->page_shift = o->page_shift ? o->page_shift : VOXCOLOR_DEFAULT_PAGE_SHIFT;
     e->lab = o->metric == VOXCOLOR_METRIC_CIELAB && o->max_error > 0;
     e->lab_thr2 = o->max_error * o->max_error;
-    /* Largest integer d2 with sqrt(d2) <= x; 3 * 255^2 covers every colour. */
-    if (x >= 442.0) {
-        e->thr2 = 3 * 255 * 255;
-    } else {
-        e->thr2 = (uint32_t)(x * x);
-        while ((double)(e->thr2 + 1) <= x * x) e->thr2++;
-        while (e->thr2 && (double)e->thr2 > x * x) e->thr2--;
+    /* Largest integer d2 with sqrt(d2) <= 255 max_error, found with exact
+       comparisons; 3 * 255^2 covers every colour. */
+    while (lo < hi) {
+        uint32_t mid = lo + (hi - lo + 1) / 2;
+        if (voxcolori_within(mid, o->max_error)) lo = mid;
+        else hi = mid - 1;
     }
-    /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line. */
-    e->line2 = (x + 0.87) * (x + 0.87);
+    e->thr2 = lo;
+    /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line:
+       64 (r + 0.87)^2 <= 64 r^2 + sqrt(12402 r^2) + 49 for r^2 = thr2. */
+    e->line64 = 64 * (uint64_t)e->thr2 + voxcolori_isqrt_up(12402 * (uint64_t)e->thr2) + 49;
     if (e->lab)
         for (i = 0; i < 256; i++) {
             double c = i / 255.0, s = (c + 0.055) / 1.055;
@@ -797,37 +881,60 @@ typedef struct voxcolori_fit {
     unsigned mode, precision;
     unsigned q0[3], q1[3]; /* quantized endpoints as stored */
     unsigned e0[3], e1[3]; /* the same, expanded to 8 bits */
+    int d[3], dd;          /* e1 - e0 and its squared length */
+    uint64_t inverse;      /* 2^40 / (2 dd), for projections without division */
 } voxcolori_fit;
 
-/* Rounds V (any real) to the nearest endpoint of PRECISION. */
-static void voxcolori_quantize(const double v[3], unsigned precision, unsigned q[3],
+/* Sets the segment fields of F from its endpoints. */
+static void voxcolori_fit_segment(voxcolori_fit *f) {
+    unsigned i;
+    for (i = 0, f->dd = 0; i < 3; i++) {
+        f->d[i] = (int)f->e1[i] - (int)f->e0[i];
+        f->dd += f->d[i] * f->d[i];
+    }
+    f->inverse = f->dd ? (1ull << 40) / (2 * (uint64_t)f->dd) : 0;
+}
+
+/* Rounds V (channels in 256ths, 0 .. 255 * 256) to the nearest endpoint of
+   PRECISION. */
+static void voxcolori_quantize(const int64_t v[3], unsigned precision, unsigned q[3],
                                unsigned e[3]) {
     unsigned c;
     for (c = 0; c < 3; c++) {
         unsigned b = voxcolori_channel_bits(c, precision), top = (1u << b) - 1;
-        double x = v[c] < 0 ? 0 : v[c] > 255 ? 255 : v[c];
-        unsigned k = (unsigned)(x * top / 255.0 + 0.5);
+        int64_t x = v[c];
+        unsigned k = (unsigned)((x * top + 255 * 128) / (255 * 256));
         /* Bit replication is not uniform: the next code may be nearer. */
-        if (k < top && voxcolori_expand(k + 1, b) - x < x - voxcolori_expand(k, b)) k++;
-        else if (k && x - voxcolori_expand(k - 1, b) < voxcolori_expand(k, b) - x) k--;
+        if (k < top && 256 * (int64_t)voxcolori_expand(k + 1, b) - x < x - 256 * (int64_t)voxcolori_expand(k, b)) k++;
+        else if (k && x - 256 * (int64_t)voxcolori_expand(k - 1, b) < 256 * (int64_t)voxcolori_expand(k, b) - x) k--;
         q[c] = k;
         e[c] = voxcolori_expand(k, b);
     }
 }
 
+/* Interpolated colour for weight index K of a width-W block. */
+static void voxcolori_mix(const unsigned e0[3], const unsigned e1[3], unsigned w, unsigned k,
+                          uint8_t out[3]) {
+    unsigned t = voxcolori_weights[w][k], c;
+    for (c = 0; c < 3; c++) out[c] = (uint8_t)((e0[c] * (64 - t) + e1[c] * t + 32) >> 6);
+}
+
 /* The weight index whose interpolation point is nearest to C's projection
    onto the endpoint segment. */
 static unsigned voxcolori_project(const voxcolori_fit *f, const uint8_t c[3]) {
-    unsigned top = (1u << f->mode) - 1, i;
-    int d, dd = 0, dot = 0;
-    for (i = 0; i < 3; i++) {
-        d = (int)f->e1[i] - (int)f->e0[i];
-        dd += d * d;
-        dot += ((int)c[i] - (int)f->e0[i]) * d;
-    }
-    if (dd == 0 || dot <= 0) return 0;
-    if (dot >= dd) return top;
-    return (unsigned)((2 * dot * (int)top + dd) / (2 * dd));
+    unsigned top = (1u << f->mode) - 1, k;
+    int dot = ((int)c[0] - (int)f->e0[0]) * f->d[0] + ((int)c[1] - (int)f->e0[1]) * f->d[1] +
+              ((int)c[2] - (int)f->e0[2]) * f->d[2];
+    uint64_t num, den = 2 * (uint64_t)f->dd;
+    if (f->dd == 0 || dot <= 0) return 0;
+    if (dot >= f->dd) return top;
+    /* k = floor(num / den) for num = 2 dot top + dd, from the inverse, then
+       corrected to the exact quotient. */
+    num = 2 * (uint64_t)dot * top + (uint64_t)f->dd;
+    k = (unsigned)((num * f->inverse) >> 40);
+    if ((k + 1) * den <= num) k++;
+    if (k * den > num) k--;
+    return k;
 }
 
 /* The weight index decoding closest (in RGB) to C, and that decoded colour:
@@ -865,25 +972,23 @@ static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const 
     return voxcolori_close(e, c, d);
 }
 
-/* 1 when no block of MODE can hold N colours with sums S and products SS
-   (RGB metric): their root-mean-square distance from the mean (mode 0), or
+/* 1 when no block of MODE can hold N colours whose covariance times N^2 is
+   C (RGB metric): their root-mean-square distance from the mean (mode 0), or
    from any line (the sum of the covariance's two smaller eigenvalues, at
    least its trace minus its Frobenius norm), exceeds what the bound allows.
-   Rejects most failing windows before any endpoint is fitted. */
-static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, const uint64_t s[3],
-                              uint64_t ss[3][3], size_t n, unsigned mode) {
-    double c[3][3], tr, fro = 0, m[3], inv = 1.0 / (double)n;
-    unsigned a, b;
+   Rejects most failing windows before any endpoint is fitted. Integer
+   arithmetic: the same answer on every compiler and processor. */
+static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, int64_t c[3][3],
+                              size_t n, unsigned mode) {
+    int64_t n2 = (int64_t)n * (int64_t)n, tr = c[0][0] + c[1][1] + c[2][2], big, fro = 0;
+    unsigned a, b, shift = 0;
     size_t i;
-    for (a = 0; a < 3; a++) m[a] = (double)s[a] * inv;
-    for (a = 0; a < 3; a++)
-        for (b = a; b < 3; b++) c[a][b] = c[b][a] = (double)ss[a][b] * inv - m[a] * m[b];
-    tr = c[0][0] + c[1][1] + c[2][2];
-    if (mode == 0) return tr > (double)e->thr2 + 1e-6;
+    if (mode == 0) return tr > (int64_t)e->thr2 * n2;
     if (n <= 2) return 0;
     /* No line passes within R of three colours whose triangle has area A and
-       longest side L when A / L > R: |cross|^2 > 4 R^2 L^2. Short windows
-       only (longer ones are refits of blocks that mostly pass). */
+       longest side L when A / L > R: |cross|^2 > 4 R^2 L^2 (R^2 = line64 /
+       64). Short windows only (longer ones are refits of blocks that mostly
+       pass). */
     for (i = 0; i + 2 < n && n <= 8; i++) {
         const uint8_t *p = rgb + 3 * i;
         int64_t u[3], v[3], w[3], x[3], l2, m2;
@@ -900,80 +1005,124 @@ static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, const 
         if (m2 > l2) l2 = m2;
         m2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
         if (m2 > l2) l2 = m2;
-        if ((double)(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) > 4 * (e->line2 + 1e-6) * (double)l2)
-            return 1;
+        if (16 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) > (int64_t)e->line64 * l2) return 1;
     }
-    tr -= e->line2 + 1e-6;
+    /* trace - R^2 > Frobenius norm, in 64 N^2 units, squares taken after
+       dropping low bits so that nothing overflows. */
+    tr = 64 * tr - (int64_t)e->line64 * n2;
     if (tr <= 0) return 0;
+    for (big = tr, a = 0; a < 3; a++)
+        for (b = 0; b < 3; b++) {
+            int64_t x = 64 * (c[a][b] < 0 ? -c[a][b] : c[a][b]);
+            big = x > big ? x : big;
+        }
+    while (big >> shift >= (1ll << 29)) shift++;
     for (a = 0; a < 3; a++)
-        for (b = 0; b < 3; b++) fro += c[a][b] * c[a][b];
+        for (b = 0; b < 3; b++) {
+            int64_t x = 64 * c[a][b] / ((int64_t)1 << shift);
+            fro += x * x;
+        }
+    tr >>= shift;
     return tr * tr > fro;
 }
 
+/* Scales direction V (not all zero) so that its largest component has 15
+   bits: the power iteration's products then stay below 2^53. */
+static void voxcolori_normalize(int64_t v[3]) {
+    int64_t m = 0;
+    unsigned a, bits = 0, k;
+    for (a = 0; a < 3; a++) m = v[a] > m ? v[a] : -v[a] > m ? -v[a] : m;
+    if (!m) {
+        v[0] = v[1] = v[2] = 1 << 14;
+        return;
+    }
+    for (k = 32; k; k >>= 1)
+        if (m >> (bits + k)) bits += k;
+    /* m has bits + 1 bits. */
+    for (a = 0; a < 3; a++) {
+        int64_t x = v[a] < 0 ? -v[a] : v[a];
+        x = bits > 14 ? x >> (bits - 14) : x << (14 - bits);
+        v[a] = v[a] < 0 ? -x : x;
+    }
+}
+
+/* NUM / DEN rounded to the nearest integer, DEN > 0. */
+static int64_t voxcolori_div_round(int64_t num, int64_t den) {
+    return num >= 0 ? (num + den / 2) / den : -((den / 2 - num) / den);
+}
+
 /* Chooses endpoints for the N colours RGB; returns 0 when no block of F's
-   mode can hold them (voxcolori_hopeless), else 1. Mode 0: the centre of their bounding box. Else the extreme
-   projections on their principal axis (power iteration on the covariance;
-   two colours are their own extremes). */
+   mode can hold them (voxcolori_hopeless), else 1. Mode 0: the centre of
+   their bounding box. Else the extreme projections on their principal axis
+   (power iteration on the covariance; two colours are their own extremes).
+   All in integers, so that the stream does not depend on floating point. */
 static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                    voxcolori_fit *f) {
-    double mean[3], cov[3][3], v[3] = {1, 1, 1}, lo[3], hi[3], tmin = 0, tmax = 0, vv;
-    uint64_t s[3] = {0, 0, 0}, ss[3][3];
+    int64_t s[3] = {0, 0, 0}, ss[3][3], c[3][3], v[3], w[3], lo[3], hi[3], tmin = 0, tmax = 0, vv;
+    int64_t nn = (int64_t)n;
     unsigned a, b, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
     size_t i;
     memset(ss, 0, sizeof ss);
     for (i = 0; i < n; i++) {
-        const uint8_t *c = rgb + 3 * i;
+        const uint8_t *p = rgb + 3 * i;
         for (a = 0; a < 3; a++) {
-            s[a] += c[a];
-            if (c[a] < mn[a]) mn[a] = c[a];
-            if (c[a] > mx[a]) mx[a] = c[a];
-            for (b = a; b < 3; b++) ss[a][b] += (uint64_t)c[a] * c[b];
+            s[a] += p[a];
+            for (b = a; b < 3; b++) ss[a][b] += (int64_t)p[a] * p[b];
         }
     }
-    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, s, ss, n, f->mode)) return 0;
+    /* N^2 times the covariance: below 2^37. */
+    for (a = 0; a < 3; a++)
+        for (b = a; b < 3; b++) c[a][b] = c[b][a] = nn * ss[a][b] - s[a] * s[b];
+    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, c, n, f->mode)) return 0;
     if (f->mode == 0) {
-        for (a = 0; a < 3; a++) lo[a] = (mn[a] + mx[a]) * 0.5;
+        for (i = 0; i < n; i++)
+            for (a = 0; a < 3; a++) {
+                mn[a] = rgb[3 * i + a] < mn[a] ? rgb[3 * i + a] : mn[a];
+                mx[a] = rgb[3 * i + a] > mx[a] ? rgb[3 * i + a] : mx[a];
+            }
+        for (a = 0; a < 3; a++) lo[a] = 128 * (int64_t)(mn[a] + mx[a]);
         voxcolori_quantize(lo, f->precision, f->q0, f->e0);
-    } else if (n <= 2) {
+        return 1;
+    }
+    if (n <= 2) {
         /* The principal axis of two colours runs through both. */
         for (a = 0; a < 3; a++) {
-            lo[a] = rgb[a];
-            hi[a] = rgb[3 * (n - 1) + a];
+            lo[a] = 256 * (int64_t)rgb[a];
+            hi[a] = 256 * (int64_t)rgb[3 * (n - 1) + a];
         }
-        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
-        voxcolori_quantize(hi, f->precision, f->q1, f->e1);
     } else {
-        for (a = 0; a < 3; a++) mean[a] = (double)s[a] / (double)n;
-        for (a = 0; a < 3; a++)
-            for (b = a; b < 3; b++)
-                cov[a][b] = cov[b][a] = (double)ss[a][b] / (double)n - mean[a] * mean[b];
-        /* Start from the widest channel's column; scale by the largest
-           component (the direction is all that matters). */
-        it = cov[1][1] > cov[0][0] ? 1u : 0u;
-        if (cov[2][2] > cov[it][it]) it = 2;
-        for (a = 0; a < 3; a++) v[a] = cov[a][it] + (a == it ? 1e-9 : 0);
+        /* Start from the widest channel's column. */
+        it = c[1][1] > c[0][0] ? 1u : 0u;
+        if (c[2][2] > c[it][it]) it = 2;
+        for (a = 0; a < 3; a++) v[a] = c[a][it] + (a == it);
         for (it = 0; it < 4; it++) {
-            double w[3], m = 0;
-            for (a = 0; a < 3; a++) w[a] = cov[a][0] * v[0] + cov[a][1] * v[1] + cov[a][2] * v[2];
-            for (a = 0; a < 3; a++) m = w[a] > m ? w[a] : -w[a] > m ? -w[a] : m;
-            if (m < 1e-12) break;
-            for (a = 0; a < 3; a++) v[a] = w[a] / m;
+            voxcolori_normalize(v);
+            for (a = 0; a < 3; a++) w[a] = c[a][0] * v[0] + c[a][1] * v[1] + c[a][2] * v[2];
+            if (!w[0] && !w[1] && !w[2]) break;
+            memcpy(v, w, sizeof v);
         }
+        voxcolori_normalize(v);
         vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+        /* Projections, times N: (N c - S) . v. */
         for (i = 0; i < n; i++) {
-            const uint8_t *c = rgb + 3 * i;
-            double t = ((c[0] - mean[0]) * v[0] + (c[1] - mean[1]) * v[1] +
-                        (c[2] - mean[2]) * v[2]) / vv;
+            const uint8_t *p = rgb + 3 * i;
+            int64_t t = (nn * p[0] - s[0]) * v[0] + (nn * p[1] - s[1]) * v[1] + (nn * p[2] - s[2]) * v[2];
             if (t < tmin) tmin = t;
             if (t > tmax) tmax = t;
         }
+        /* Endpoints mean + t v / (N vv), in 256ths (below 2^59). */
         for (a = 0; a < 3; a++) {
-            lo[a] = mean[a] + tmin * v[a];
-            hi[a] = mean[a] + tmax * v[a];
+            lo[a] = voxcolori_div_round(256 * (s[a] * vv + tmin * v[a]), nn * vv);
+            hi[a] = voxcolori_div_round(256 * (s[a] * vv + tmax * v[a]), nn * vv);
         }
-        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
-        voxcolori_quantize(hi, f->precision, f->q1, f->e1);
     }
+    for (a = 0; a < 3; a++) {
+        lo[a] = lo[a] < 0 ? 0 : lo[a] > 255 * 256 ? 255 * 256 : lo[a];
+        hi[a] = hi[a] < 0 ? 0 : hi[a] > 255 * 256 ? 255 * 256 : hi[a];
+    }
+    voxcolori_quantize(lo, f->precision, f->q0, f->e0);
+    voxcolori_quantize(hi, f->precision, f->q1, f->e1);
+    voxcolori_fit_segment(f);
     return 1;
 }
 
@@ -986,9 +1135,35 @@ static int voxcolori_fits_all(const voxcolori_enc *e, const voxcolori_fit *f, co
     return 1;
 }
 
+/* Endpoints for windows of colours starting at one position, by length, as
+   fitted for modes 1..4 (they all get the same): each mode's search reuses
+   the fits of the others. Direct-mapped by length. */
+#define VOXCOLORI_CACHE_SIZE 32u
+typedef struct voxcolori_cache {
+    size_t length[VOXCOLORI_CACHE_SIZE]; /* 0: empty */
+    int fitted[VOXCOLORI_CACHE_SIZE];
+    voxcolori_fit fit[VOXCOLORI_CACHE_SIZE];
+} voxcolori_cache;
+
+/* voxcolori_fit_endpoints through CACHE (for F's precision) when F has
+   weights. */
+static int voxcolori_fit_cached(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                                voxcolori_fit *f, voxcolori_cache *cache) {
+    unsigned slot = (unsigned)(n % VOXCOLORI_CACHE_SIZE), mode = f->mode;
+    if (!mode) return voxcolori_fit_endpoints(e, rgb, n, f);
+    if (cache->length[slot] != n) {
+        cache->length[slot] = n;
+        cache->fit[slot] = *f;
+        cache->fitted[slot] = voxcolori_fit_endpoints(e, rgb, n, &cache->fit[slot]);
+    }
+    *f = cache->fit[slot];
+    f->mode = mode;
+    return cache->fitted[slot];
+}
+
 static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
-                               voxcolori_fit *f) {
-    return voxcolori_fit_endpoints(e, rgb, n, f) && voxcolori_fits_all(e, f, rgb, n);
+                               voxcolori_fit *f, voxcolori_cache *cache) {
+    return voxcolori_fit_cached(e, rgb, n, f, cache) && voxcolori_fits_all(e, f, rgb, n);
 }
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
@@ -998,21 +1173,21 @@ static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_
    one that does not triggers a refit including it, and repeated refits a
    refit over twice the length (so gradients cost O(n log n)). */
 static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n, size_t min,
-                               voxcolori_fit *f) {
+                               voxcolori_fit *f, voxcolori_cache *cache) {
     voxcolori_fit t = *f;
     size_t len = min < n ? min : n, streak = 0;
-    if (!voxcolori_fit_block(e, rgb, len, f)) return 0;
+    if (!voxcolori_fit_block(e, rgb, len, f, cache)) return 0;
     while (len < n) {
         size_t guess = 2 * len + 1 < n ? 2 * len + 1 : n;
         if (voxcolori_fits(e, f, rgb + 3 * len)) {
             len++;
             continue;
         }
-        if (!voxcolori_fit_block(e, rgb, len + 1, &t)) break;
+        if (!voxcolori_fit_block(e, rgb, len + 1, &t, cache)) break;
         *f = t;
         len++;
         /* Colours drifting out of every fit (a gradient): refit ahead. */
-        if (++streak >= 2 && guess > len && voxcolori_fit_block(e, rgb, guess, &t)) {
+        if (++streak >= 2 && guess > len && voxcolori_fit_block(e, rgb, guess, &t, cache)) {
             *f = t;
             len = guess;
             streak = 0;
@@ -1067,12 +1242,15 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
                                   uint64_t *plan) {
     /* A block's directory entry and its share of the checkpoints (one per 8
        blocks, rounded up). */
-    size_t pos = 0, raw_start = 0, blocks = 0, entry = 4 + e->page_shift + (2 * e->page_shift + 6 + 7) / 8;
+    size_t pos = 0, raw_start = 0, blocks = 0, entry = 8 * voxcolori_index_bytes(e->page_shift) + 4 + 2;
     while (pos < n) {
-        voxcolori_fit best, f, shared[2];
-        size_t best_len = 0, best_bits = 0, len, shared_len[2] = {0, 0};
+        voxcolori_fit best, f;
+        voxcolori_cache cache[2];
+        size_t best_len = 0, best_bits = 0, len;
         unsigned m, p;
         memset(&best, 0, sizeof best);
+        for (p = 0; p < e->precision_count; p++)
+            memset(cache[p].length, 0, sizeof cache[p].length);
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
             /* A wider mode costs more than f.mode bits per colour. */
@@ -1084,21 +1262,7 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
                 fixed = 2 * entry + voxcolori_endpoint_bits(f.mode, f.precision);
                 len = (fixed + 23 - f.mode) / (24 - f.mode);
                 if (len > n - pos) len = n - pos;
-                /* Modes 1..4 fit the same endpoints to the same colours: fit
-                   once per precision, then only check each mode. */
-                if (f.mode) {
-                    if (shared_len[p] != len) {
-                        shared[p] = f;
-                        shared[p].mode = 1;
-                        shared_len[p] = len;
-                        if (!voxcolori_fit_endpoints(e, rgb + 3 * pos, len, &shared[p]))
-                            shared[p].mode = 0;
-                    }
-                    if (!shared[p].mode) continue;
-                    shared[p].mode = f.mode;
-                    if (!voxcolori_fits_all(e, &shared[p], rgb + 3 * pos, len)) continue;
-                }
-                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f);
+                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f, &cache[p]);
                 if (!len) continue;
                 bits = entry + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
                 if (!best_len || bits * best_len < best_bits * len ||
@@ -1126,24 +1290,24 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
 /* Writes a planned page: block count, directory, payloads. */
 static void voxcolori_write_page(voxcolori_writer *w, const uint8_t *rgb, const uint64_t *plan,
                                  size_t blocks, unsigned page_shift) {
-    size_t b, i, end = 0;
+    size_t b, i, end;
+    unsigned index_bits = 8 * voxcolori_index_bytes(page_shift), pass;
     uint64_t payload = 0;
-    voxcolori_put(w, blocks - 1, page_shift);
-    /* Checkpoints: first colour and payload offset of every 8th block after
-       the first. */
+    voxcolori_put(w, blocks - 1, index_bits);
+    /* Directory: the last colour of each group of 8 blocks, then of the
+       other blocks of each group, then the nibbles. */
+    for (pass = 0; pass < 2; pass++)
+        for (b = 0, end = 0; b < blocks; b++) {
+            end += (size_t)((plan[b] >> 4) & 0xfff) + 1;
+            if ((b % 8 == 7 || b + 1 == blocks) == !pass) voxcolori_put(w, end - 1, index_bits);
+        }
+    for (b = 0; b < blocks; b++) voxcolori_put(w, plan[b] & 15, 4);
+    if (blocks & 1) voxcolori_put(w, 0, 4);
+    /* Checkpoints: the payload offset of every 8th block after the first. */
     for (b = 0; b < blocks; b++) {
         unsigned mode = (unsigned)(plan[b] & 7), precision = (unsigned)(plan[b] >> 3) & 1;
-        if (b && !(b & ((1u << VOXCOLORI_GROUP_SHIFT) - 1))) {
-            voxcolori_put(w, end, page_shift);
-            voxcolori_put(w, payload, page_shift + 6);
-        }
-        end += (size_t)((plan[b] >> 4) & 0xfff) + 1;
+        if (b && !(b & ((1u << VOXCOLORI_GROUP_SHIFT) - 1))) voxcolori_put(w, payload, 16);
         payload += voxcolori_block_bits(mode, precision, ((plan[b] >> 4) & 0xfff) + 1);
-    }
-    /* Directory: mode, precision, index of the block's last colour. */
-    for (b = 0, end = 0; b < blocks; b++) {
-        end += (size_t)((plan[b] >> 4) & 0xfff) + 1;
-        voxcolori_put(w, (plan[b] & 15) | (uint64_t)(end - 1) << 4, 4 + page_shift);
     }
     for (b = 0; b < blocks; b++) {
         unsigned mode = (unsigned)(plan[b] & 7), k;
@@ -1165,6 +1329,7 @@ static void voxcolori_write_page(voxcolori_writer *w, const uint8_t *rgb, const 
             f.e0[k] = voxcolori_expand(f.q0[k], bits);
             f.e1[k] = voxcolori_expand(f.q1[k], bits);
         }
+        voxcolori_fit_segment(&f);
         voxcolori_put_endpoint(w, f.q0, f.precision);
         if (mode) voxcolori_put_endpoint(w, f.q1, f.precision);
         for (i = 0; i < n && mode; i++) {
@@ -1204,7 +1369,7 @@ static void voxcolori_flush_table(voxcolor_encoder *s) {
 static void voxcolori_encode_page(voxcolor_encoder *s, const uint8_t *rgb, size_t n) {
     uint64_t plan[1u << VOXCOLOR_MAX_PAGE_SHIFT]; /* 8 KiB */
     voxcolori_writer w;
-    size_t blocks, most = (2 * s->enc.page_shift + 4 + 24 * n + 7) / 8;
+    size_t blocks, most = 2 * voxcolori_index_bytes(s->enc.page_shift) + 1 + 3 * n;
     if (s->table_used + s->entry > sizeof s->table) voxcolori_flush_table(s);
     voxcolori_store_le(s->table + s->table_used, s->data_size, s->entry);
     s->table_used += s->entry;

@@ -106,28 +106,30 @@ static void ref_endpoint(const uint8_t *data, uint64_t *pos, int prec, int out[3
 /* Decodes a whole valid stream block by block into OUT; returns the number
    of blocks per mode in MODES[0..5] (may be NULL). */
 static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6]) {
-    int ps = s[6], wide = s[7] & 1;
+    int ps = s[6], wide = s[7] & 1, ib = ps > 8 ? 2 : 1;
     uint64_t count = ref_le(s + 8, 8), pages = count ? ((count - 1) >> ps) + 1 : 0;
     const uint8_t *data = s + 24 + pages * (wide ? 8 : 4);
     uint64_t page, i = 0;
     for (page = 0; page < pages; page++) {
-        uint64_t pos = 8 * ref_le(s + 24 + page * (wide ? 8 : 4), wide ? 8 : 4);
-        uint32_t blocks = ref_bits(data, &pos, ps) + 1, block, first = 0;
-        uint64_t cps = pos, dir = pos + (blocks - 1) / 8 * (2 * ps + 6), payload0;
-        pos = dir + blocks * (4 + ps); /* payloads follow the directory */
-        payload0 = pos;
+        const uint8_t *p = data + ref_le(s + 24 + page * (wide ? 8 : 4), wide ? 8 : 4);
+        uint32_t blocks = (uint32_t)ref_le(p, ib) + 1, groups = (blocks - 1) / 8 + 1, block, first = 0;
+        const uint8_t *group_ends = p + ib, *block_ends = group_ends + groups * ib;
+        const uint8_t *nibbles = block_ends + (blocks - groups) * ib;
+        const uint8_t *checkpoints = nibbles + (blocks + 1) / 2;
+        uint64_t payload0 = 8 * (uint64_t)(checkpoints + 2 * (groups - 1) - data), pos = payload0;
         for (block = 0; block < blocks; block++) {
-            int mode, prec;
-            uint32_t len, j;
+            int mode, prec, nibble = nibbles[block / 2] >> (4 * (block % 2)) & 15;
+            uint32_t len, j, g = block / 8, last;
             int e0[3], e1[3], k;
-            if (block && block % 8 == 0) {
-                /* A checkpoint: this block's first colour and payload offset. */
-                uint32_t at = ref_bits(data, &cps, ps), off = ref_bits(data, &cps, ps + 6);
-                CHECK(at == first && off == pos - payload0);
-            }
-            mode = (int)ref_bits(data, &dir, 3);
-            prec = (int)ref_bits(data, &dir, 1);
-            len = ref_bits(data, &dir, ps) + 1 - first; /* from the last colour */
+            if (block && block % 8 == 0) /* a checkpoint: this block's payload offset */
+                CHECK(ref_le(checkpoints + 2 * (g - 1), 2) == pos - payload0);
+            /* The last block of a group has its last colour in the group
+               ends, the others in the block ends. */
+            if (block % 8 == 7 || block == blocks - 1) last = (uint32_t)ref_le(group_ends + g * ib, ib);
+            else last = (uint32_t)ref_le(block_ends + (7 * g + block % 8) * ib, ib);
+            mode = nibble & 7;
+            prec = nibble >> 3;
+            len = last + 1 - first;
             first += len;
             if (modes) modes[mode]++;
             if (mode == 5) {
@@ -432,14 +434,14 @@ static void test_deterministic(void) {
 static void test_golden(void) {
     static const uint8_t rgb[9] = {0x12, 0x34, 0x56, 0x12, 0x34, 0x56, 0x12, 0x34, 0x56};
     static const uint8_t expect[] = {
-        'V', 'X', 'C', '1', 2, 0, 8, 0,   /* magic, version 2, page shift 8, flags */
+        'V', 'X', 'C', '1', 3, 0, 8, 0,   /* magic, version 3, page shift 8, flags */
         3, 0, 0, 0, 0, 0, 0, 0,           /* 3 colours */
         14, 0, 0, 0, 0, 0, 0, 0,          /* 14 bytes of block data */
         0, 0, 0, 0,                       /* page 0 starts at byte 0 */
-        /* blocks - 1 = 0 (8 bits); no checkpoints (one block); entry: mode 0
-           (3 bits), RGB888 (1 bit), last colour 2 (8 bits); payload R G B:
-           bits 0 | 0x028 << 8 | 0x12 << 20 | 0x34 << 28 | 0x56 << 36 */
-        0x00, 0x28, 0x20, 0x41, 0x63, 0x05,
+        /* blocks - 1 = 0; group 0 ends at colour 2; no other block ends;
+           nibble: mode 0, RGB888 (8); no checkpoints (one group); payload
+           R G B. */
+        0x00, 0x02, 0x08, 0x12, 0x34, 0x56,
         0, 0, 0, 0, 0, 0, 0, 0, /* closing zero bytes */
     };
     uint8_t buf[128];
@@ -456,24 +458,25 @@ static void put_bits(uint8_t *buf, unsigned *pos, uint64_t v, unsigned n) {
 }
 
 /* A stream of 5 colours in one page of 16 assembled by hand from FORMAT.md:
-   an interpolated RGB565 block of 3 colours and a raw block of 2 (no
-   checkpoints: fewer than 9 blocks). The arguments break it in one place.
-   Returns the stream size. */
+   an interpolated RGB565 block of 3 colours and a raw block of 2 (one group,
+   so no checkpoints). The arguments break it in one place. Returns the
+   stream size. */
 static size_t handmade(uint8_t *s, unsigned mode1, unsigned raw_precision, unsigned length1,
                        unsigned extra_bytes, unsigned table_entry) {
     uint8_t *data = s + 28;
     unsigned pos = 0, k;
     memset(s, 0, 64);
     memcpy(s, "VXC1", 4);
-    s[4] = 2;                             /* format version */
+    s[4] = 3;                             /* format version */
     s[6] = 4;                             /* pages of 16 colours */
     s[8] = 5;                             /* 5 colours */
     s[24] = (uint8_t)table_entry;         /* page 0 starts at data byte 0 */
-    put_bits(data, &pos, 2 - 1, 4); /* 2 blocks */
-    /* Directory: mode 2, RGB565, colours 0..2; mode 5 (raw), colours 3..4
-       (each entry holds the block's last colour). */
-    put_bits(data, &pos, mode1 | 0 << 3 | (length1 - 1) << 4, 3 + 1 + 4);
-    put_bits(data, &pos, 5 | raw_precision << 3 | 4 << 4, 3 + 1 + 4);
+    put_bits(data, &pos, 2 - 1, 8); /* 2 blocks */
+    /* Last colours: of group 0 (its last block: 4), then of block 0. */
+    put_bits(data, &pos, 4, 8);
+    put_bits(data, &pos, length1 - 1, 8);
+    /* Nibbles: mode 2, RGB565; mode 5 (raw). */
+    put_bits(data, &pos, mode1 | 0 << 3 | (5 | raw_precision << 3) << 4, 8);
     /* e0 = (31,0,0), e1 = (0,63,31); weights 0 2 3 */
     put_bits(data, &pos, 31 | 0 << 5 | 0 << 11, 16);
     put_bits(data, &pos, 0 | 63 << 5 | 31 << 11, 16);
@@ -481,7 +484,7 @@ static size_t handmade(uint8_t *s, unsigned mode1, unsigned raw_precision, unsig
     /* Raw colours (3,2,1) and (0xfd,0xfe,0xff). */
     put_bits(data, &pos, 0x010203, 24);
     put_bits(data, &pos, 0xfffefd, 24);
-    if (mode1 == 2) CHECK(pos == 106); /* 14 bytes */
+    if (mode1 == 2) CHECK(pos == 118); /* 15 bytes */
     s[16] = (uint8_t)((pos + 7) / 8 + 8 + extra_bytes); /* then 8 zero bytes */
     return 28 + s[16];
 }
@@ -490,7 +493,7 @@ static void test_handmade_stream(void) {
     uint8_t s[64], out[3 * 5];
     voxcolor_view v;
     size_t size = handmade(s, 2, 0, 3, 0, 0);
-    CHECK(size == 24 + 4 + 14 + 8);
+    CHECK(size == 24 + 4 + 15 + 8);
     unsigned m;
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
     voxcolor_view_get_range(&v, 0, 5, out);
@@ -518,7 +521,7 @@ static void test_handmade_stream(void) {
     size = handmade(s, 2, 0, 3, 0, 1); /* page table points past the start */
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 0, 0);
-    s[28 + 13] |= 0x80; /* a padding bit */
+    s[28 + 14] |= 0x80; /* a padding bit */
     CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 0, 0);
     s[size - 1] = 1; /* a closing byte */
