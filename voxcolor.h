@@ -426,10 +426,12 @@ static VOXCOLORI_INLINE uint64_t voxcolori_bits(const uint8_t *data, uint64_t po
 
 /* Channels of an endpoint in the low bits of V (PRECISION 0: RGB565, 1:
    RGB888), widened to 8 bits, in the 16-bit lanes 0, 1 and 2. */
-static VOXCOLORI_INLINE uint64_t voxcolori_lanes(uint64_t v, unsigned precision) {
-    uint64_t r = v & 31, g = (v >> 5) & 63, b = (v >> 11) & 31;
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_lanes(uint64_t v, unsigned precision) {
     uint64_t wide = (v & 255) | (v & 0xff00) << 8 | (v & 0xff0000) << 16;
-    uint64_t narrow = (r << 3 | r >> 2) | (g << 2 | g >> 4) << 16 | (b << 3 | b >> 2) << 32;
+    /* 5 and 6 bits in the lanes, widened by (x * 132) >> 4 = x << 3 | x >> 2
+       and (x * 65) >> 4 = x << 2 | x >> 4, all lanes at once. */
+    uint64_t narrow = (v & 31) | (v & 0xf800) << 21, g = (v & 0x7e0) << 11;
+    narrow = ((narrow * 132 + g * 65) >> 4) & 0x00ff00ff00ffull;
     return precision ? wide : narrow;
 }
 
@@ -963,10 +965,16 @@ static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const 
         d[2] = (uint8_t)f->e0[2];
         return voxcolori_close(e, c, d);
     }
-    /* In RGB the pick errs at most as much as the projection: try that first. */
+    /* In RGB the pick (the nearest of the projection's weight and its two
+       neighbours) fits when any of the three does: the projection first. */
     if (!e->lab) {
-        voxcolori_mix(f->e0, f->e1, f->mode, voxcolori_project(f, c), d);
+        unsigned k = voxcolori_project(f, c), top = (1u << f->mode) - 1;
+        voxcolori_mix(f->e0, f->e1, f->mode, k, d);
         if (voxcolori_dist2(c, d) <= e->thr2) return 1;
+        if (k) voxcolori_mix(f->e0, f->e1, f->mode, k - 1, d);
+        if (k && voxcolori_dist2(c, d) <= e->thr2) return 1;
+        if (k < top) voxcolori_mix(f->e0, f->e1, f->mode, k + 1, d);
+        return k < top && voxcolori_dist2(c, d) <= e->thr2;
     }
     voxcolori_pick(f, c, d);
     return voxcolori_close(e, c, d);
@@ -1036,8 +1044,13 @@ static void voxcolori_normalize(int64_t v[3]) {
         v[0] = v[1] = v[2] = 1 << 14;
         return;
     }
+#if defined(__GNUC__) || defined(__clang__)
+    bits = 63u - (unsigned)__builtin_clzll((unsigned long long)m);
+    (void)k;
+#else
     for (k = 32; k; k >>= 1)
         if (m >> (bits + k)) bits += k;
+#endif
     /* m has bits + 1 bits. */
     for (a = 0; a < 3; a++) {
         int64_t x = v[a] < 0 ? -v[a] : v[a];
@@ -1135,12 +1148,13 @@ static int voxcolori_fits_all(const voxcolori_enc *e, const voxcolori_fit *f, co
     return 1;
 }
 
-/* Endpoints for windows of colours starting at one position, by length, as
+/* Endpoints for windows of colours of one page, by start and length, as
    fitted for modes 1..4 (they all get the same): each mode's search reuses
    the fits of the others. Direct-mapped by length. */
 #define VOXCOLORI_CACHE_SIZE 32u
 typedef struct voxcolori_cache {
-    size_t length[VOXCOLORI_CACHE_SIZE]; /* 0: empty */
+    size_t start;                     /* of the windows fitted now */
+    size_t key[VOXCOLORI_CACHE_SIZE]; /* start * 2048 + length; 0: empty */
     int fitted[VOXCOLORI_CACHE_SIZE];
     voxcolori_fit fit[VOXCOLORI_CACHE_SIZE];
 } voxcolori_cache;
@@ -1150,9 +1164,10 @@ typedef struct voxcolori_cache {
 static int voxcolori_fit_cached(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                 voxcolori_fit *f, voxcolori_cache *cache) {
     unsigned slot = (unsigned)(n % VOXCOLORI_CACHE_SIZE), mode = f->mode;
+    size_t key = cache->start * 2048 + n;
     if (!mode) return voxcolori_fit_endpoints(e, rgb, n, f);
-    if (cache->length[slot] != n) {
-        cache->length[slot] = n;
+    if (cache->key[slot] != key) {
+        cache->key[slot] = key;
         cache->fit[slot] = *f;
         cache->fitted[slot] = voxcolori_fit_endpoints(e, rgb, n, &cache->fit[slot]);
     }
@@ -1243,14 +1258,15 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
     /* A block's directory entry and its share of the checkpoints (one per 8
        blocks, rounded up). */
     size_t pos = 0, raw_start = 0, blocks = 0, entry = 8 * voxcolori_index_bytes(e->page_shift) + 4 + 2;
+    voxcolori_cache cache[2];
+    memset(cache[0].key, 0, sizeof cache[0].key);
+    memset(cache[1].key, 0, sizeof cache[1].key);
     while (pos < n) {
         voxcolori_fit best, f;
-        voxcolori_cache cache[2];
         size_t best_len = 0, best_bits = 0, len;
         unsigned m, p;
         memset(&best, 0, sizeof best);
-        for (p = 0; p < e->precision_count; p++)
-            memset(cache[p].length, 0, sizeof cache[p].length);
+        cache[0].start = cache[1].start = pos;
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
             /* A wider mode costs more than f.mode bits per colour. */
