@@ -56,7 +56,7 @@
 #define VOXDAG_VERSION_PATCH 0
 #define VOXDAG_VERSION \
     (VOXDAG_VERSION_MAJOR * 10000 + VOXDAG_VERSION_MINOR * 100 + VOXDAG_VERSION_PATCH)
-#define VOXDAG_FORMAT_VERSION 1
+#define VOXDAG_FORMAT_VERSION 2
 
 #ifndef VOXDAG_MAX_LEVELS
 #define VOXDAG_MAX_LEVELS 21
@@ -2062,6 +2062,36 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
     }
 }
 
+/* Count bytes C of each inner level: enough for its largest count, and 0
+   (counts derived from the children's) at level L-3, whose children are
+   bricks. A derived count costs the voxel index one sum over at most 8 stored
+   counts per sibling, so on large DAGs, where that sum misses the cache, the
+   counts stay; the writer derives at most one more level, the one among
+   0..L-5 where counts take the most bytes (the deepest on ties), and only
+   when they are at least 1/32 of an estimate of the geometry's bytes (2-byte
+   headers, counts, 1-byte pointers, bricks): small DAGs, which are mostly
+   counts and stay in the cache. */
+static void voxdagi_count_widths(voxdagi_encoder *e) {
+    uint32_t B = e->levels - 2, l, drop = B;
+    uint64_t most = 0, estimate = 8 * (uint64_t)e->r->store[B].n;
+    for (l = 0; l < B; l++) {
+        const voxdagi_store *s = &e->r->store[l];
+        uint64_t max_count = 0, bytes;
+        size_t i;
+        for (i = 0; i < s->n; i++)
+            if (s->count[i] > max_count) max_count = s->count[i];
+        for (i = 0; i < 8 * s->n; i++) estimate += s->child[i] != VOXDAGI_NONE;
+        e->count_bytes[l] = l + 1 < B ? voxdagi_bytes_for(max_count) : 0;
+        bytes = (uint64_t)s->n * e->count_bytes[l];
+        estimate += 2 * (uint64_t)s->n + bytes;
+        if (l + 2 < B && bytes >= most) {
+            most = bytes;
+            drop = l;
+        }
+    }
+    if (drop < B && most >= estimate / 32) e->count_bytes[drop] = 0;
+}
+
 /* Orders every level and computes record offsets, bottom-up (pointer sizes
    depend on where the next level put its nodes). Returns 0 when out of memory. */
 static int voxdagi_encoder_plan(voxdagi_encoder *e) {
@@ -2088,20 +2118,18 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
                     refs[l + 1][s->child[i] >> 3]++;
         }
     }
+    if (ok) voxdagi_count_widths(e);
     for (l = B + 1; ok && l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
         size_t n = s->n, i;
-        uint64_t at = 0, max_count = 0;
+        uint64_t at = 0;
         if (!voxdagi_storage_order(e->mem, s, refs[l], e->order[l])) {
             ok = 0;
             break;
         }
-        for (i = 0; s->count && i < n; i++)
-            if (s->count[i] > max_count) max_count = s->count[i];
         if (l < B) {
             uint64_t need[9] = {0};
             unsigned j;
-            e->count_bytes[l] = l + 1 < B ? voxdagi_bytes_for(max_count) : 0;
             for (i = 0; i < 8 * n; i++)
                 if (s->child[i] != VOXDAGI_NONE)
                     need[voxdagi_bytes_for(e->pos[l + 1][s->child[i] >> 3] << 3 | (s->child[i] & 7))]++;
@@ -2237,21 +2265,30 @@ static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
     return voxdagi_le(d->bricks + 8 * index, 8);
 }
 
+/* Voxels below the node at byte OFFSET of inner level L whose level stores
+   counts (or below brick OFFSET when L is the brick level). */
+static uint64_t voxdagi_stored_count(const voxdag *d, uint32_t l, uint64_t offset) {
+    if (l == d->levels - 2) return (uint64_t)voxdagi_popcount64(voxdagi_brick(d, offset));
+    return voxdagi_le_fast(d->level[l].data + offset + 2, d->level[l].count_bytes);
+}
+
 /* Voxels below the node at byte OFFSET of inner level L (or brick OFFSET when
-   L is the brick level). */
+   L is the brick level): stored, or, at a level without counts (C = 0), the
+   sum of its children's, whose level stores them (validated on load). */
 static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset) {
     const voxdagi_level *lv;
-    const uint8_t *rec;
-    unsigned header, s;
+    const uint8_t *p;
+    unsigned header;
     uint64_t sum = 0;
-    if (l == d->levels - 2) return (uint64_t)voxdagi_popcount64(voxdagi_brick(d, offset));
+    if (l == d->levels - 2 || d->level[l].count_bytes) return voxdagi_stored_count(d, l, offset);
     lv = &d->level[l];
-    rec = lv->data + offset;
-    if (lv->count_bytes) return voxdagi_le_fast(rec + 2, lv->count_bytes);
-    header = (unsigned)voxdagi_le(rec, 2);
-    for (s = 0; s < 8; s++)
-        if (header >> (2 * s) & 3)
-            sum += (uint64_t)voxdagi_popcount64(voxdagi_brick(d, voxdagi_child(lv, rec, header, s) >> 3));
+    p = lv->data + offset + 2; /* the pointers, one after the other */
+    for (header = (unsigned)voxdagi_le(p - 2, 2); header; header >>= 2) {
+        unsigned n = lv->ptr_bytes[header & 3];
+        if (!n) continue;
+        sum += voxdagi_stored_count(d, l + 1, voxdagi_le_fast(p, n) >> 3);
+        p += n;
+    }
     return sum;
 }
 
@@ -2515,8 +2552,10 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at ||
             lv->nodes > lv->size / 2 || !lv->ptr_bytes[1] || lv->ptr_bytes[1] >= lv->ptr_bytes[2] ||
             lv->ptr_bytes[2] >= lv->ptr_bytes[3] || lv->ptr_bytes[3] > 8 ||
-            (l + 1 < B ? lv->count_bytes < 1 || lv->count_bytes > 8 : lv->count_bytes != 0))
+            (l + 1 < B ? lv->count_bytes > 8 : lv->count_bytes != 0))
             return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad level entry", at, l);
+        if (l && !lv->count_bytes && !d->level[l - 1].count_bytes) /* derived counts sum stored ones */
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "two levels in a row without counts", at + 20, l);
         lv->data = nodes + level_at;
         level_at += lv->size;
         node_sum += lv->nodes;

@@ -19,8 +19,8 @@
      words. The index structure (a few words) is left out. On the SVDAG this
      is the paper's "ESVDAG"; on the symmetric DAG its "SSVDAG".
    - the same paper layout plus a per-level voxel count field padded to whole
-     16-bit words (none at level L-3, like ours): what the paper's layout
-     would pay to carry the counts we carry.
+     16-bit words (none at level L-3): what the paper's layout would pay to
+     carry counts at every level whose counts cannot be derived from bricks.
    - ours: voxdag_get_info node_bytes + brick_bytes (the .vdag node and
      brick sections), and the same minus the count bytes of every record. */
 #define VOXDAG_IMPLEMENTATION

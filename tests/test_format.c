@@ -139,7 +139,7 @@ static void test_offsets_documented(void) {
     CHECK(VOXDAG_FILE_OFF_HEADER_CRC == 52 && VOXDAG_FILE_HEADER_SIZE == 64);
     CHECK(VOXDAG_FILE_SECTION_ENTRY_SIZE == 32 && VOXDAG_FILE_LEVEL_ENTRY_SIZE == 24);
     CHECK(VOXDAG_FILE_NODE_PADDING == 8 && VOXDAG_FILE_MAX_SECTIONS == 16);
-    CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 1);
+    CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 2);
     /* the helpers of golden.h use the same numbers */
     CHECK(GOLDEN_OFF_SECTION_COUNT == VOXDAG_FILE_OFF_SECTION_COUNT && GOLDEN_OFF_TABLE_CRC == VOXDAG_FILE_OFF_TABLE_CRC);
     CHECK(GOLDEN_OFF_HEADER_CRC == VOXDAG_FILE_OFF_HEADER_CRC && GOLDEN_HEADER_SIZE == VOXDAG_FILE_HEADER_SIZE);
@@ -607,6 +607,12 @@ static void test_hostile_files(void) {
         q.size[parts_find(&q, 4)] += 3; /* one more colour (zero), so that only the counts disagree */
         memset(q.data[parts_find(&q, 4)] + q.size[parts_find(&q, 4)] - 3, 0, 3);
         expect(&q, VOXDAG_ERR_CORRUPT, "root count above its children's", NULL);
+        parts_free(&q);
+        /* level 1 without counts above level 2 (L-3), which has none either:
+           a derived count must sum stored ones */
+        parts_read(&q, f, size);
+        q.data[parts_find(&q, 1)][24 + 20] = 0;
+        expect(&q, VOXDAG_ERR_CORRUPT, "two levels in a row without counts", NULL);
         parts_free(&q);
         /* only the header's voxel count */
         parts_read(&q, f, size);
