@@ -1,6 +1,7 @@
 # voxdag: examples, tests, demo and benchmarks.
 #   make          build the vdag tool (build/vdag)
 #   make test     install missing test packages, run every test
+#   make test-full the same with exhaustive mutation sweeps (long)
 #   make check-all build matrix, link/symbol checks, determinism (in make test)
 #   make demo     build, colour-compress, save and render the default scene
 #   make bench    regenerate BENCHMARKS.md
@@ -30,7 +31,7 @@ IMAGE_DEPS := examples/image.h examples/image_oiio.cpp examples/image_none.c
 # Importer fuzzing: libFuzzer (clang) for `make fuzz-import`; `make test`
 # replays the committed corpus with the same entry point.
 FUZZ_IMPORT_SRC  := tests/fuzz_import.c examples/import.c examples/image_none.c
-FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=65536
+FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=65536 -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
 FUZZ_SECONDS     ?= 120
 
 .PHONY: all test deps demo bench clean fuzz-import
@@ -137,8 +138,16 @@ deps:
 check-all:
 	@sh tests/check_all.sh $(BUILD)
 
-test: deps $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
+test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
+
+# The same with exhaustive sweeps: every byte of every golden file, colour
+# stream, importer sample and fuzz seed patched to each of its 255 other
+# values (about an hour of CPU).
+.PHONY: test-full
+test-full: deps $(TEST_PROGRAMS)
+	@sh tests/run.sh $(BUILD) --full
 
 clean:
 	rm -rf $(BUILD)

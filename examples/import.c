@@ -11,6 +11,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Every allocation goes through VDAG_IMPORT_REALLOC: realloc, unless the
+   program names its own (the importer fuzz target fails each allocation in
+   turn through it); blocks are released with free. */
+#ifdef VDAG_IMPORT_REALLOC
+void *VDAG_IMPORT_REALLOC(void *ptr, size_t size);
+#else
+#define VDAG_IMPORT_REALLOC realloc
+#endif
+
 // -- Errors and limits
 
 /* Larger coordinate magnitudes are rejected so that bounding boxes and their
@@ -68,7 +77,7 @@ static void *vi_push(vi_ctx *c, vi_buf *b, size_t elem, size_t n) {
             cap *= 2;
         }
         if (cap > SIZE_MAX / elem) return vi_fail(c, "out of memory"), (void *)NULL;
-        p = realloc(b->data, cap * elem);
+        p = VDAG_IMPORT_REALLOC(b->data, cap * elem);
         if (!p) return vi_fail(c, "out of memory"), (void *)NULL;
         b->data = p;
         b->cap = cap;
@@ -88,7 +97,7 @@ static void vi_buf_free(vi_buf *b) {
 static void *vi_alloc(vi_ctx *c, size_t count, size_t elem) {
     void *p;
     if (elem && count > SIZE_MAX / elem) return vi_fail(c, "out of memory"), (void *)NULL;
-    p = malloc(count && elem ? count * elem : 1);
+    p = VDAG_IMPORT_REALLOC(NULL, count && elem ? count * elem : 1);
     if (!p) vi_fail(c, "out of memory");
     return p;
 }
@@ -1002,7 +1011,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
     e->path = path;
     e->image = -1;
     if (vdag_image_load(path, &img, why, sizeof why)) {
-        vdag_image *grown = (vdag_image *)realloc(s->images, (s->image_count + 1) * sizeof *grown);
+        vdag_image *grown = (vdag_image *)VDAG_IMPORT_REALLOC(s->images, (s->image_count + 1) * sizeof *grown);
         if (!grown) {
             vdag_image_free(&img);
             return vi_fail(c, "out of memory");

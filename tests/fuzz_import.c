@@ -13,6 +13,17 @@
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
+/* Allocation failure sweeps of the replay main (fuzz_replay.h): the
+   importers allocate through this (VDAG_IMPORT_REALLOC in the Makefile). */
+#define FUZZ_ALLOC_SWEEP
+static long fuzz_fail_at = -1, fuzz_alloc_calls;
+
+void *fuzz_import_realloc(void *ptr, size_t size);
+void *fuzz_import_realloc(void *ptr, size_t size) {
+    if (fuzz_alloc_calls++ == fuzz_fail_at) return NULL;
+    return realloc(ptr, size);
+}
+
 #define REQUIRE(cond)                                                                      \
     do {                                                                                   \
         if (!(cond)) {                                                                     \

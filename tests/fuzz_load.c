@@ -28,6 +28,10 @@
 
 #define FUZZ_MAX_VISIT 512 /* voxels walked by voxdag_for_each_voxel */
 
+/* Allocation failure sweeps of the replay main (fuzz_replay.h). */
+#define FUZZ_ALLOC_SWEEP
+static long fuzz_fail_at = -1, fuzz_alloc_calls;
+
 static void require(int ok, const char *what) {
     if (!ok) {
         fprintf(stderr, "fuzz_load: %s\n", what);
@@ -140,7 +144,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (size) memcpy(file, data + 1, size);
     if (sel & 2) golden_reseal(file, size);
     memset(&fa, 0, sizeof fa);
-    fa.fail_at = sel & 16 ? 3 * (long)p : -1;
+    fa.fail_at = fuzz_fail_at >= 0 ? fuzz_fail_at : sel & 16 ? 3 * (long)p : -1;
     memset(&o, 0, sizeof o);
     o.copy = sel & 1;
     o.allocator.alloc = ca_alloc;
@@ -170,6 +174,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         require(st != VOXDAG_ERR_OUT_OF_MEMORY || fa.fail_at >= 0 || o.max_memory, "out of memory");
     }
     voxdag_free(d);
+    fuzz_alloc_calls = fa.calls;
     require(fa.held == 0, "bytes held after voxdag_free");
     require(!fa.bad_free, "a free with a size other than the allocation's");
     free(file);

@@ -41,6 +41,10 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* Allocation failure sweeps of the replay main (fuzz_replay.h). */
+#define FUZZ_ALLOC_SWEEP
+static long fuzz_fail_at = -1, fuzz_alloc_calls;
+
 static void require(int ok, const char *what) {
     if (!ok) {
         fprintf(stderr, "fuzz_roundtrip: %s\n", what);
@@ -324,7 +328,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (size < 3) return 0;
     scene_read(&s, data, size);
     memset(&ca, 0, sizeof ca);
-    ca.fail_at = s.fail ? 4 * (long)s.p + (data[1] >> 6) : -1;
+    ca.fail_at = fuzz_fail_at >= 0 ? fuzz_fail_at : s.fail ? 4 * (long)s.p + (data[1] >> 6) : -1;
     a.alloc = ca_alloc;
     a.free = ca_free;
     a.user = &ca;
@@ -344,10 +348,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
             require(!memcmp(voxdag_image(loaded, &size2), img, img_size), "loaded image differs");
             check(&s, loaded, bounds[s.bound]);
             voxdag_get_info(loaded, &info);
-            if (!s.fail) check_limit(&s, img, img_size, &info);
+            if (ca.fail_at < 0) check_limit(&s, img, img_size, &info);
         }
     }
-    require(st == VOXDAG_OK || (s.fail && st == VOXDAG_ERR_OUT_OF_MEMORY), "round trip failed");
+    require(st == VOXDAG_OK || (ca.fail_at >= 0 && st == VOXDAG_ERR_OUT_OF_MEMORY), "round trip failed");
     /* Threads change nothing in the file. */
     if (st == VOXDAG_OK && s.threads > 1 && !(s.colors && s.bound)) {
         voxdag_allocator plain;
@@ -363,6 +367,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     voxdag_free(loaded);
     voxdag_free(built);
+    fuzz_alloc_calls = ca.calls;
     require(ca.held == 0 && !ca.bad_free, "bytes held at the end, or a free of the wrong size");
     scene_free(&s);
     return 0;

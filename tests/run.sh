@@ -1,8 +1,18 @@
 #!/bin/sh
 # Runs every test program and prints the combined "N passed, N failed" line.
-# Usage: tests/run.sh BUILD_DIR
+# Usage: tests/run.sh BUILD_DIR [--full]
+# The fuzz corpora are replayed with sweeps (tests/fuzz_replay.h): every
+# truncation, every byte patched to +1, -1, 0x00 and 0xff, and every
+# allocation failing in turn. --full (make test-full) patches every byte to
+# each of its 255 other values, here and in the unit tests' sweeps.
 set -u
 build=${1:-build}
+sweep=--sweep
+unit_args=
+if [ "${2:-}" = --full ]; then
+    sweep=--sweep-full
+    unit_args=--full
+fi
 export VDAG="$build/vdag" # the tool the tests run, from the same build
 total_pass=0
 total_fail=0
@@ -25,12 +35,12 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
     total_pass=$((total_pass + p))
     total_fail=$((total_fail + f))
 }
-run unit "$build/test"
+run unit "$build/test" $unit_args
 run cli sh tests/cli.sh "$build/vdag"
-run fuzz-import "$build/fuzz_import" tests/data/fuzz/import
-run fuzz-voxcolor "$build/fuzz_voxcolor" tests/data/fuzz/voxcolor
-run fuzz-load "$build/fuzz_load" tests/data/fuzz/load
-run fuzz-roundtrip "$build/fuzz_roundtrip" tests/data/fuzz/roundtrip
+run fuzz-import "$build/fuzz_import" $sweep tests/data/fuzz/import
+run fuzz-voxcolor "$build/fuzz_voxcolor" $sweep tests/data/fuzz/voxcolor
+run fuzz-load "$build/fuzz_load" $sweep tests/data/fuzz/load
+run fuzz-roundtrip "$build/fuzz_roundtrip" $sweep tests/data/fuzz/roundtrip
 run check-all sh tests/check_all.sh "$build"
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]

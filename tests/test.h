@@ -16,6 +16,17 @@ typedef struct test_case {
 /* Set by CHECK when the running test case fails. */
 extern int test_current_failed;
 
+/* 1 under `test --full` (make test-full): sweeps patch every byte to each of
+   its 255 other values instead of +1, -1, 0x00 and 0xff. */
+extern int test_full;
+
+/* The value patch K of a sweep gives byte V: K < test_patch_count(). */
+static inline int test_patch_count(void) { return test_full ? 256 : 4; }
+static inline uint8_t test_patch(uint8_t v, int k) {
+    static const int patch[4] = {1, -1, 0, 0xFF}; /* +1, -1, set 0, set 0xff */
+    return test_full ? (uint8_t)k : k < 2 ? (uint8_t)(v + patch[k]) : (uint8_t)patch[k];
+}
+
 #define CHECK(cond)                                                            \
     do {                                                                       \
         if (!(cond)) {                                                         \

@@ -519,8 +519,8 @@ static void test_allocation_failures(void) {
     uint8_t *rgb;
     size_t n = scene_voxels(&s, &xyz, &rgb);
     long fail_at;
-    int succeeded = 0;
-    for (fail_at = 0; !succeeded && fail_at < 100000; fail_at++) {
+    int done = 0;
+    for (fail_at = 0; !done && fail_at < 100000; fail_at++) {
         count_alloc ca;
         voxdag_build_opts o;
         voxdag_builder *b = NULL;
@@ -540,15 +540,15 @@ static void test_allocation_failures(void) {
         if (st == VOXDAG_OK) st = voxdag_builder_finish(b, &d, NULL, NULL);
         else voxdag_builder_free(b);
         CHECK(st == VOXDAG_OK || st == VOXDAG_ERR_OUT_OF_MEMORY);
-        if (st == VOXDAG_OK) {
-            succeeded = 1;
-            check_queries(&s, d, "after allocation failures");
-        }
+        /* a build may succeed past a failed optional allocation (a cache);
+           the sweep ends when the failure is no longer reached */
+        if (st == VOXDAG_OK) check_queries(&s, d, "after allocation failures");
+        done = ca.calls <= fail_at;
         voxdag_free(d);
         CHECK_MSG(ca.held == 0 && !ca.bad_free, "%llu bytes held (bad free: %d) after failing allocation %ld",
                   (unsigned long long)ca.held, ca.bad_free, fail_at);
     }
-    CHECK(succeeded);
+    CHECK(done);
     free(xyz);
     free(rgb);
     scene_free(&s);
@@ -565,11 +565,10 @@ static void test_mutations_rejected(void) {
     uint8_t *copy = (uint8_t *)malloc(size);
     int accepted = 0;
     for (i = 0; i < size; i++) {
-        static const int delta[4] = {1, -1, 0x100, 0x1FF}; /* +1, -1, set 0, set 0xff */
         int k;
-        for (k = 0; k < 4; k++) {
+        for (k = 0; k < test_patch_count(); k++) {
             voxdag *e = NULL;
-            uint8_t v = delta[k] == 0x100 ? 0 : delta[k] == 0x1FF ? 0xFF : (uint8_t)(img[i] + delta[k]);
+            uint8_t v = test_patch(img[i], k);
             if (v == img[i]) continue;
             memcpy(copy, img, size);
             copy[i] = v;

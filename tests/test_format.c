@@ -1,14 +1,16 @@
 /* The .vdag format pinned by golden files (tests/data/golden, written by
    tests/make_golden.c): byte-identical rebuilds, header fields at FORMAT.md's
    offsets, rejection of every truncation and single-byte change, allocation
-   failure at every step of a load, load limits, and hand-crafted hostile
-   files whose checksums are recomputed, so that the structural validation is
-   what refuses them.
+   failure at every step of a load and of a build, load limits, and
+   hand-crafted hostile files whose checksums are recomputed, so that the
+   structural validation is what refuses them.
 
    Sweep sizes (all goldens together, 2248 bytes): 2248 truncations, about
-   9k patched files, and every allocation of each load with and without a
-   copy; about half a second of CPU with sanitizers. FORMAT_VERBOSE=1 prints
-   the message each hostile file is refused with. */
+   9k patched files (under --full every byte takes each of its 255 other
+   values: about 570k), every allocation of each load with and without a
+   copy, and of each build; about half a second of CPU with sanitizers (a
+   few seconds under --full). FORMAT_VERBOSE=1 prints the message each
+   hostile file is refused with. */
 
 /* This unit carries its own static copy of the implementation, for the file
    layout macros (VOXDAG_FILE_*) that only the implementation part defines. */
@@ -256,7 +258,6 @@ static void test_header_fields(void) {
 // -- (c) Every truncation and every single-byte patch is rejected
 
 static void test_mutations(void) {
-    static const int patch[4] = {1, -1, 0x100, 0x1FF}; /* +1, -1, set 0, set 0xff */
     int kind;
     for (kind = 0; kind < GOLDEN_COUNT; kind++) {
         size_t size = 0, i;
@@ -273,8 +274,8 @@ static void test_mutations(void) {
         m = (uint8_t *)malloc(size);
         for (i = 0; i < size; i++) {
             int k;
-            for (k = 0; k < 4; k++) {
-                uint8_t v = patch[k] == 0x100 ? 0 : patch[k] == 0x1FF ? 0xFF : (uint8_t)(f[i] + patch[k]);
+            for (k = 0; k < test_patch_count(); k++) {
+                uint8_t v = test_patch(f[i], k);
                 if (v == f[i]) continue; /* unchanged bytes load, of course */
                 memcpy(m, f, size);
                 m[i] = v;
@@ -288,7 +289,7 @@ static void test_mutations(void) {
     }
 }
 
-// -- (d) Allocation N fails, for every N of a load
+// -- (d) Allocation N fails, for every N of a load or a build
 
 static void test_allocation_failures(void) {
     int kind, copy;
@@ -321,6 +322,43 @@ static void test_allocation_failures(void) {
             }
             CHECK(done);
         }
+        free(f);
+    }
+}
+
+/* ... and of every build of a golden scene: each failure ends in
+   VOXDAG_ERR_OUT_OF_MEMORY with nothing held, and a build that succeeds (also
+   past a failed optional allocation, such as a cache) gives the committed
+   bytes. */
+static void test_build_allocation_failures(void) {
+    int kind;
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) {
+        size_t size = 0;
+        uint8_t *f = read_golden(kind, &size);
+        long n;
+        int done = 0;
+        for (n = 0; f && !done && n < 100000; n++) {
+            voxdag_load_opts o; /* for its allocator */
+            count_alloc ca;
+            voxdag *d = NULL;
+            voxdag_status st;
+            opts_with(&o, &ca, n);
+            st = golden_build(kind, &o.allocator, &d);
+            CHECK_MSG(st == VOXDAG_OK || st == VOXDAG_ERR_OUT_OF_MEMORY, "%s: status %d at allocation %ld",
+                      golden_names[kind], (int)st, n);
+            if (st == VOXDAG_OK) {
+                size_t built_size;
+                const void *built = voxdag_image(d, &built_size);
+                CHECK(built_size == size && !memcmp(built, f, size));
+            } else {
+                CHECK(d == NULL && ca.calls > n);
+            }
+            done = ca.calls <= n; /* the failure was never reached */
+            voxdag_free(d);
+            CHECK_MSG(ca.held == 0 && !ca.bad_free, "%s: %llu bytes held after failing build allocation %ld",
+                      golden_names[kind], (unsigned long long)ca.held, n);
+        }
+        CHECK_MSG(done, "%s", golden_names[kind]);
         free(f);
     }
 }
@@ -765,6 +803,7 @@ const test_case test_format_cases[] = {
     {"format/header_fields", test_header_fields},
     {"format/mutations", test_mutations},
     {"format/allocation_failures", test_allocation_failures},
+    {"format/build_allocation_failures", test_build_allocation_failures},
     {"format/limits", test_limits},
     {"format/hostile_files", test_hostile_files},
     {NULL, NULL},

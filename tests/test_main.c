@@ -1,8 +1,10 @@
 /* The test runner: every suite registers its cases here. Usage:
-   test [FILTER]  runs the cases whose name contains FILTER. */
+   test [--full] [FILTER]  runs the cases whose name contains FILTER; --full
+   makes the sweeps exhaustive (test.h). */
 #include "test.h"
 
 int test_current_failed;
+int test_full;
 
 extern const test_case test_core_cases[];
 extern const test_case test_voxcolor_cases[];
@@ -28,9 +30,11 @@ const char *test_data_dir(void) {
 }
 
 int main(int argc, char **argv) {
-    const char *filter = argc > 1 ? argv[1] : NULL;
+    const char *filter;
     int passed = 0, failed = 0;
     size_t s;
+    test_full = argc > 1 && !strcmp(argv[1], "--full");
+    filter = argc > 1 + test_full ? argv[1 + test_full] : NULL;
     for (s = 0; s < sizeof suites / sizeof suites[0]; s++) {
         const test_case *t;
         for (t = suites[s]; t->name; t++) {

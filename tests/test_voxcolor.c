@@ -545,7 +545,7 @@ static void decode_all(const voxcolor_view *v) {
 }
 
 /* Every truncation is rejected; every byte patched (+1, -1, 0, 0xff, each
-   bit) is rejected or decodes in bounds. */
+   bit; under --full every value) is rejected or decodes in bounds. */
 static void test_mutations(void) {
     uint8_t *c = make_colors(KIND_TEXTURE, 700, 13), *s;
     static const double bounds[] = {0, 0.02, 0.08};
@@ -576,10 +576,11 @@ static void test_mutations(void) {
             static const int patch[] = {1, -1, 0x100, 0x1ff, -2};
             uint8_t *t = (uint8_t *)malloc(size);
             int p;
-            for (p = 0; p < 5 + 8; p++) {
+            for (p = 0; p < (test_full ? 256 : 5 + 8); p++) {
                 voxcolor_view v;
                 memcpy(t, s, size);
-                if (p >= 5) t[i] ^= (uint8_t)(1u << (p - 5));
+                if (test_full) t[i] = (uint8_t)p;
+                else if (p >= 5) t[i] ^= (uint8_t)(1u << (p - 5));
                 else if (patch[p] == 0x100) t[i] = 0;
                 else if (patch[p] == 0x1ff) t[i] = 0xff;
                 else t[i] = (uint8_t)(t[i] + patch[p]);
