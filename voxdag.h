@@ -1293,6 +1293,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
                             "builder, coordinates or colours missing");
     if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
+    if (!n) return voxdagi_ok(err); /* the buffer may not exist yet */
     if (n > ((size_t)-1) / 16 - b->pend_n)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "too many voxels");
     if (b->pend_n + n > b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + n))
