@@ -28,13 +28,7 @@ IMAGE_LIBS = $(if $(OIIO),$(shell pkg-config --libs OpenImageIO))
 LINK       = $(if $(OIIO),$(CXX),$(CC))
 IMAGE_DEPS := examples/image.h examples/image_oiio.cpp examples/image_none.c
 
-# Importer fuzzing: libFuzzer (clang) for `make fuzz-import`; `make test`
-# replays the committed corpus with the same entry point.
-FUZZ_IMPORT_SRC  := tests/fuzz_import.c examples/import.c examples/image_none.c
-FUZZ_IMPORT_DEFS := -DVDAG_IMPORT_MAX_POINTS=65536 -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
-FUZZ_SECONDS     ?= 120
-
-.PHONY: all test deps demo bench clean fuzz-import
+.PHONY: all test deps demo bench clean
 
 all: $(BUILD)/vdag
 
@@ -65,57 +59,36 @@ $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
 $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
 	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
-$(BUILD)/fuzz_import: $(FUZZ_IMPORT_SRC) examples/import_scene.c examples/import.h examples/image.h tests/fuzz_replay.h | $(BUILD)
-	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(FUZZ_IMPORT_DEFS) -I. -o $@ $(FUZZ_IMPORT_SRC) -lm
+# Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):
+#   import     the scene importers (the first byte picks the format)
+#   voxcolor   colour streams decoded, and colours encoded and decoded
+#   load       .vdag files loaded, and queries on what loaded
+#   roundtrip  scenes built, saved and loaded, every query against an oracle
+# `make fuzz-NAME` builds one with libFuzzer, ASan and UBSan (clang; any
+# finding stops the run and is saved in $(BUILD)) and fuzzes it for
+# FUZZ_SECONDS from the committed corpus tests/data/fuzz/NAME, with
+# tests/data/fuzz/NAME.dict when there is one. Built without libFuzzer,
+# $(BUILD)/fuzz_NAME replays files with the same entry point
+# (tests/fuzz_replay.h); `make test` replays and sweeps every corpus.
+FUZZ_NAMES   := import voxcolor load roundtrip
+FUZZ_SECONDS ?= 120
+FUZZ_DEPS    := tests/fuzz_replay.h tests/count_alloc.h tests/golden.h $(HEADERS) \
+                examples/import.c examples/import_scene.c examples/import.h examples/image.h
+FUZZ_EXTRA_import := examples/import.c examples/image_none.c \
+                     -DVDAG_IMPORT_MAX_POINTS=65536 -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
+FUZZ_FLAGS   = $(CSTD) $(WARN) -g $(THREADS) -I. tests/fuzz_$*.c $(FUZZ_EXTRA_$*) -lm
 
-fuzz-import: | $(BUILD)
-	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVDAG_LIBFUZZER \
-	    $(FUZZ_IMPORT_DEFS) -I. -o $(BUILD)/fuzz_import_libfuzzer $(FUZZ_IMPORT_SRC) -lm
-	@mkdir -p $(BUILD)/fuzz_import_corpus
-	$(BUILD)/fuzz_import_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/import.dict \
-	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_import_corpus tests/data/fuzz/import
+$(BUILD)/fuzz_%: tests/fuzz_%.c $(FUZZ_DEPS) | $(BUILD)
+	$(CC) -O2 $(SAN) -o $@ $(FUZZ_FLAGS)
 
-# Colour codec fuzzing: libFuzzer (clang) for `make fuzz-voxcolor`; `make test`
-# replays the committed corpus with the same entry point.
-.PHONY: fuzz-voxcolor
-$(BUILD)/fuzz_voxcolor: tests/fuzz_voxcolor.c tests/fuzz_replay.h voxcolor.h | $(BUILD)
-	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) -I. -o $@ tests/fuzz_voxcolor.c -lm
-
-fuzz-voxcolor: | $(BUILD)
-	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXCOLOR_LIBFUZZER \
-	    -I. -o $(BUILD)/fuzz_voxcolor_libfuzzer tests/fuzz_voxcolor.c -lm
-	@mkdir -p $(BUILD)/fuzz_voxcolor_corpus
-	$(BUILD)/fuzz_voxcolor_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/voxcolor.dict \
-	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_voxcolor_corpus tests/data/fuzz/voxcolor
-
-# Loader fuzzing: libFuzzer (clang) for `make fuzz-load`; `make test` replays
-# the committed corpus (seeds from `make_golden --seeds`, crash inputs).
-.PHONY: fuzz-load
-FUZZ_LOAD_DEPS := tests/fuzz_load.c tests/fuzz_replay.h tests/count_alloc.h tests/golden.h voxdag.h
-$(BUILD)/fuzz_load: $(FUZZ_LOAD_DEPS) | $(BUILD)
-	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_load.c -lm
-
-fuzz-load: | $(BUILD)
-	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXDAG_LIBFUZZER $(THREADS) \
-	    -I. -o $(BUILD)/fuzz_load_libfuzzer tests/fuzz_load.c -lm
-	@mkdir -p $(BUILD)/fuzz_load_corpus
-	$(BUILD)/fuzz_load_libfuzzer -max_total_time=$(FUZZ_SECONDS) -dict=tests/data/fuzz/load.dict \
-	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_load_corpus tests/data/fuzz/load
-
-# Round-trip fuzzing (build, save, load, queries against an oracle):
-# libFuzzer (clang) for `make fuzz-roundtrip`; `make test` replays the
-# committed seeds tests/data/fuzz/roundtrip.
-.PHONY: fuzz-roundtrip
-FUZZ_ROUNDTRIP_DEPS := tests/fuzz_roundtrip.c tests/fuzz_replay.h tests/count_alloc.h $(HEADERS)
-$(BUILD)/fuzz_roundtrip: $(FUZZ_ROUNDTRIP_DEPS) | $(BUILD)
-	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -o $@ tests/fuzz_roundtrip.c -lm
-
-fuzz-roundtrip: | $(BUILD)
-	clang $(CSTD) $(WARN) -O1 -g -fsanitize=fuzzer,address,undefined -DVOXDAG_LIBFUZZER $(THREADS) \
-	    -I. -o $(BUILD)/fuzz_roundtrip_libfuzzer tests/fuzz_roundtrip.c -lm
-	@mkdir -p $(BUILD)/fuzz_roundtrip_corpus
-	$(BUILD)/fuzz_roundtrip_libfuzzer -max_total_time=$(FUZZ_SECONDS) \
-	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_roundtrip_corpus tests/data/fuzz/roundtrip
+.PHONY: $(FUZZ_NAMES:%=fuzz-%)
+$(FUZZ_NAMES:%=fuzz-%): fuzz-%: | $(BUILD)
+	clang -O1 -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=all -DFUZZ_LIBFUZZER \
+	    -o $(BUILD)/fuzz_$*_libfuzzer $(FUZZ_FLAGS)
+	@mkdir -p $(BUILD)/fuzz_$*_corpus
+	$(BUILD)/fuzz_$*_libfuzzer -max_total_time=$(FUZZ_SECONDS) \
+	    $(if $(wildcard tests/data/fuzz/$*.dict),-dict=tests/data/fuzz/$*.dict) \
+	    -artifact_prefix=$(BUILD)/ $(BUILD)/fuzz_$*_corpus tests/data/fuzz/$*
 
 # The main job on the built-in scene: generate, build, compress the colours,
 # save, validate, render.

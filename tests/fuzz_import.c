@@ -1,6 +1,6 @@
 /* Fuzz target for the scene importers: the first input byte picks the format
    (modulo 8: xyz ply obj off vox mtl spm ac), the rest is the file. Built with
-   -DVDAG_LIBFUZZER it is a libFuzzer target (`make fuzz-import`); otherwise
+   -DFUZZ_LIBFUZZER it is a libFuzzer target (`make fuzz-import`); otherwise
    main replays the files and directories given as arguments and prints
    "N passed, N failed". Broken invariants abort, as sanitizer errors do. */
 #define _POSIX_C_SOURCE 200809L
@@ -62,6 +62,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
 }
 
-#ifndef VDAG_LIBFUZZER
+#ifndef FUZZ_LIBFUZZER
 #include "fuzz_replay.h"
 #endif

@@ -13,7 +13,7 @@
    index; lookups at coordinates taken from the input stay within the voxel
    count; colours exist for every index. Any violation aborts.
 
-   Built with -DVOXDAG_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
+   Built with -DFUZZ_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
    target (make fuzz-load). Otherwise main() replays the files and folders
    given on the command line (make test replays tests/data/fuzz/load) and
    prints "N passed, N failed". */
@@ -181,6 +181,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
 }
 
-#ifndef VOXDAG_LIBFUZZER
+#ifndef FUZZ_LIBFUZZER
 #include "fuzz_replay.h"
 #endif

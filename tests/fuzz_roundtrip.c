@@ -26,7 +26,7 @@
    goes through a counting allocator that holds zero bytes at the end. Any
    violation aborts.
 
-   Built with -DVOXDAG_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
+   Built with -DFUZZ_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
    target (make fuzz-roundtrip). Otherwise main() replays the files and
    folders given on the command line (make test replays
    tests/data/fuzz/roundtrip) and prints "N passed, N failed". */
@@ -373,6 +373,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
 }
 
-#ifndef VOXDAG_LIBFUZZER
+#ifndef FUZZ_LIBFUZZER
 #include "fuzz_replay.h"
 #endif

@@ -8,7 +8,7 @@
        bytes.
    Any violation aborts.
 
-   Built with -DVOXCOLOR_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
+   Built with -DFUZZ_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
    target (make fuzz-voxcolor). Otherwise main() replays the files and
    folders given on the command line (make test replays the committed
    corpus tests/data/fuzz/voxcolor) and prints "N passed, N failed". */
@@ -154,6 +154,6 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     return 0;
 }
 
-#ifndef VOXCOLOR_LIBFUZZER
+#ifndef FUZZ_LIBFUZZER
 #include "fuzz_replay.h"
 #endif
