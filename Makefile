@@ -74,8 +74,7 @@ FUZZ_NAMES   := import voxcolor load roundtrip
 FUZZ_SECONDS ?= 120
 FUZZ_DEPS    := tests/fuzz_replay.h tests/count_alloc.h tests/golden.h $(HEADERS) \
                 examples/import.c examples/import_scene.c examples/import.h examples/image.h
-FUZZ_EXTRA_import := examples/import.c examples/image_none.c \
-                     -DVDAG_IMPORT_MAX_POINTS=65536 -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
+FUZZ_EXTRA_import := examples/import.c examples/image_none.c -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
 FUZZ_FLAGS   = $(CSTD) $(WARN) -g $(THREADS) -I. tests/fuzz_$*.c $(FUZZ_EXTRA_$*) -lm
 
 $(BUILD)/fuzz_%: tests/fuzz_%.c $(FUZZ_DEPS) | $(BUILD)

@@ -133,7 +133,10 @@ typedef struct voxdag_build_opts {
     int colors;                  /* 1: every voxel carries an RGB8 colour */
     int compare_structures;      /* 1: also count SVDAG and SSVDAG nodes (2x work) */
     uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
-    uint64_t max_memory;         /* bytes the builder may hold; 0: no limit */
+    uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
+                                    nodes, the file image); 0: no limit */
+    uint64_t max_nodes;          /* unique nodes and bricks of the result, all
+                                    levels together; 0: no limit */
     uint32_t chunk_levels;       /* meshes are voxelized in chunks of 2^chunk_levels
                                     voxels per axis; 0 means 8 */
     const double *bounds;        /* optional world-space min xyz, max xyz (6) */
@@ -1530,6 +1533,19 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
 }
 #endif
 
+/* Unique nodes and bricks reduced so far, all levels together (what
+   opts.max_nodes caps). */
+static uint64_t voxdagi_builder_nodes(const voxdag_builder *b) {
+    uint64_t n = 0;
+    uint32_t l;
+    for (l = 0; l + 1 < b->levels; l++) n += b->red[0].store[l].n;
+    return n;
+}
+
+static const char *voxdagi_reduce_message(voxdag_status st) {
+    return st == VOXDAG_ERR_LIMIT ? "more nodes than max_nodes" : "out of memory while reducing voxels";
+}
+
 /* Sorts, deduplicates and reduces the buffered voxels. FINAL: no voxel follows. */
 static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     size_t n = b->pend_n, i, w;
@@ -1601,6 +1617,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     b->voxels += n;
     b->last_code = code[n - 1];
     b->any_reduced = 1;
+    if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) return VOXDAG_ERR_LIMIT;
     return VOXDAG_OK;
 }
 
@@ -1611,7 +1628,7 @@ VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *e
     st = voxdagi_builder_reduce(b, 0);
     if (st != VOXDAG_OK) {
         b->failed = st;
-        return VOXDAGI_FAIL(err, st, "out of memory while reducing voxels");
+        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
     }
     return voxdagi_ok(err);
 }
@@ -2708,7 +2725,7 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     st = b->failed ? b->failed : voxdagi_builder_reduce(b, 1);
     if (st != VOXDAG_OK) {
         voxdag_builder_free(b);
-        return VOXDAGI_FAIL(err, st, "out of memory while reducing voxels");
+        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
     }
     if (b->opts.progress) b->opts.progress(b->opts.progress_user, "reduce", 1.0);
     for (k = 0; k < b->red_count; k++) {
@@ -2717,6 +2734,10 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
             voxdag_builder_free(b);
             return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while reducing voxels");
         }
+    }
+    if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) {
+        voxdag_builder_free(b);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, voxdagi_reduce_message(VOXDAG_ERR_LIMIT));
     }
     if (stats) {
         memset(stats, 0, sizeof *stats);

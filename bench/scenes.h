@@ -110,7 +110,7 @@ BENCH_UNUSED static int bscene_vox(bscene *s, const char *path, const char *name
     size_t i;
     memset(s, 0, sizeof *s);
     memset(&sc, 0, sizeof sc);
-    if (!vdag_import_file(path, &sc, err, sizeof err)) {
+    if (!vdag_import_file(path, NULL, &sc, err, sizeof err)) {
         fprintf(stderr, "bench: %s: %s\n", path, err);
         return 0;
     }
@@ -242,7 +242,7 @@ BENCH_UNUSED static int bmesh_load(bmesh *m, const char *path, uint32_t L) {
     size_t i;
     memset(m, 0, sizeof *m);
     memset(&sc, 0, sizeof sc);
-    if (!vdag_import_file(path, &sc, err, sizeof err)) {
+    if (!vdag_import_file(path, NULL, &sc, err, sizeof err)) {
         fprintf(stderr, "bench: %s: %s\n", path, err);
         return 0;
     }

@@ -41,7 +41,23 @@ typedef struct vi_ctx {
     char *err;
     size_t err_size;
     const char *base_dir; /* resolves .mtl and texture paths; NULL: no file access */
+    vdag_import_limits limits; /* every field set */
 } vi_ctx;
+
+/* C for one import: the message target and LIMITS with defaults filled in. */
+static void vi_ctx_init(vi_ctx *c, const char *format, char *err, size_t err_size,
+                        const vdag_import_limits *limits) {
+    c->format = format;
+    c->err = err;
+    c->err_size = err_size;
+    c->base_dir = NULL;
+    memset(&c->limits, 0, sizeof c->limits);
+    if (limits) c->limits = *limits;
+    if (!c->limits.max_input_bytes) c->limits.max_input_bytes = VDAG_IMPORT_MAX_INPUT_BYTES;
+    if (!c->limits.max_points) c->limits.max_points = VDAG_IMPORT_MAX_POINTS;
+    if (!c->limits.max_vertices) c->limits.max_vertices = VDAG_IMPORT_MAX_VERTICES;
+    if (!c->limits.max_triangles) c->limits.max_triangles = VDAG_IMPORT_MAX_TRIANGLES;
+}
 
 /* Writes "FORMAT: message" to the caller's buffer; returns 0 so that parsers
    can `return vi_fail(...)`. */
@@ -852,13 +868,14 @@ static uint64_t vi_hash_u64(uint64_t x) { /* splitmix64 finaliser */
 static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
     enum { CHUNK = 1 << 16 };
     vi_buf b = {NULL, 0, 0};
-    int ok = 1;
+    int ok = 1, too_big = 0;
     FILE *f = fopen(path, "rb");
     long known;
     if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
     /* Reserve the size when it is known, so that big files are not copied. */
     if (!fseek(f, 0, SEEK_END) && (known = ftell(f)) > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
-        ok = vi_push(c, &b, 1, (size_t)known + CHUNK) != NULL;
+        too_big = (uint64_t)known > c->limits.max_input_bytes;
+        ok = !too_big && vi_push(c, &b, 1, (size_t)known + CHUNK) != NULL;
         b.count = 0;
     }
     rewind(f);
@@ -868,8 +885,10 @@ static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) 
         if (!(ok = chunk != NULL)) break;
         got = fread(chunk, 1, CHUNK, f);
         b.count -= CHUNK - got;
+        if ((too_big = b.count > c->limits.max_input_bytes) != 0) ok = 0;
         if (got < CHUNK) break;
     }
+    if (too_big) vi_fail(c, "file larger than max_input_bytes (%llu)", (vi_ull)c->limits.max_input_bytes);
     if (ok && ferror(f)) ok = vi_fail(c, "cannot read the file (%s)", strerror(errno));
     fclose(f);
     if (!ok) {
@@ -1561,8 +1580,8 @@ static int64_t vi_floor_half(int64_t x) { return x >= 0 ? x / 2 : -((1 - x) / 2)
 static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, int centred,
                         const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb) {
     uint32_t i;
-    if (m->count > VDAG_IMPORT_MAX_POINTS - pts->count / 3)
-        return vi_fail(c, "scene holds more than %llu voxels", (vi_ull)VDAG_IMPORT_MAX_POINTS);
+    if (m->count > c->limits.max_points || pts->count / 3 > c->limits.max_points - m->count)
+        return vi_fail(c, "scene holds more than max_points (%llu) voxels", (vi_ull)c->limits.max_points);
     for (i = 0; i < m->count; i++) {
         const uint8_t *b = m->voxels + 4 * (size_t)i;
         int64_t w[3], d[3];
@@ -1826,31 +1845,37 @@ static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_
     case VI_AC: ok = vi_parse_ac(c, &t, out); break;
     default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"); break;
     }
+    if (ok && out->point_count > c->limits.max_points)
+        ok = vi_fail(c, "more than max_points (%llu) points", (vi_ull)c->limits.max_points);
+    if (ok && out->vertex_count > c->limits.max_vertices)
+        ok = vi_fail(c, "more than max_vertices (%llu) vertices", (vi_ull)c->limits.max_vertices);
+    if (ok && out->triangle_count > c->limits.max_triangles)
+        ok = vi_fail(c, "more than max_triangles (%llu) triangles", (vi_ull)c->limits.max_triangles);
     if (!ok) vdag_scene_free(out);
     return ok;
 }
 
-int vdag_import_memory(const char *ext, const void *data, size_t size, const char *base_dir, vdag_scene *out,
-                       char *err, size_t err_size) {
+int vdag_import_memory(const char *ext, const void *data, size_t size, const char *base_dir,
+                       const vdag_import_limits *limits, vdag_scene *out, char *err, size_t err_size) {
     vi_ctx c;
     int format = vi_format(ext);
-    c.format = format < 0 ? ext : vi_formats[format];
-    c.err = err;
-    c.err_size = err_size;
+    vi_ctx_init(&c, format < 0 ? ext : vi_formats[format], err, err_size, limits);
     c.base_dir = base_dir;
+    if (size > c.limits.max_input_bytes) {
+        memset(out, 0, sizeof *out);
+        return vi_fail(&c, "input larger than max_input_bytes (%llu)", (vi_ull)c.limits.max_input_bytes);
+    }
     return vi_import(&c, format, size ? (const char *)data : vi_empty, size, out);
 }
 
-int vdag_import_file(const char *path, vdag_scene *out, char *err, size_t err_size) {
+int vdag_import_file(const char *path, const vdag_import_limits *limits, vdag_scene *out, char *err,
+                     size_t err_size) {
     const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
     char *data = NULL, *dir = NULL;
     size_t size = 0;
     vi_ctx c;
     int ok;
-    c.format = path; /* messages start with the file name */
-    c.err = err;
-    c.err_size = err_size;
-    c.base_dir = NULL;
+    vi_ctx_init(&c, path, err, err_size, limits); /* messages start with the file name */
     memset(out, 0, sizeof *out);
     ok = vi_read_file(&c, path, &data, &size) && (c.base_dir = dir = vi_dirname(&c, path)) != NULL &&
          vi_import(&c, dot ? vi_format(dot + 1) : -1, data ? data : vi_empty, size, out);

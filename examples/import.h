@@ -49,10 +49,31 @@
 extern "C" {
 #endif
 
-/* Most voxels a .vox scene may expand to (its scene graph can instance one
-   model many times); a larger scene is an error, not an allocation. */
+/* Limits on an import, applied to totals (the whole input, all points, all
+   vertices, all triangles; never per axis or per element): a larger input or
+   scene is an error with a message, not an allocation. A NULL pointer or a
+   zero field means the default below. While parsing, memory stays within a
+   small multiple of the input bytes (every count read from a file is checked
+   against the bytes that remain first), except for .vox scene graphs, which
+   can instance one model many times: their expansion stops at max_points. */
+typedef struct vdag_import_limits {
+    uint64_t max_input_bytes; /* 0: VDAG_IMPORT_MAX_INPUT_BYTES */
+    uint64_t max_points;      /* 0: VDAG_IMPORT_MAX_POINTS */
+    uint64_t max_vertices;    /* 0: VDAG_IMPORT_MAX_VERTICES */
+    uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
+} vdag_import_limits;
+
+#ifndef VDAG_IMPORT_MAX_INPUT_BYTES
+#define VDAG_IMPORT_MAX_INPUT_BYTES ((uint64_t)1 << 32) /* 4 GiB */
+#endif
 #ifndef VDAG_IMPORT_MAX_POINTS
 #define VDAG_IMPORT_MAX_POINTS ((uint64_t)1 << 28)
+#endif
+#ifndef VDAG_IMPORT_MAX_VERTICES
+#define VDAG_IMPORT_MAX_VERTICES ((uint64_t)1 << 28)
+#endif
+#ifndef VDAG_IMPORT_MAX_TRIANGLES
+#define VDAG_IMPORT_MAX_TRIANGLES ((uint64_t)1 << 28)
 #endif
 
 typedef struct vdag_material {
@@ -82,15 +103,16 @@ typedef struct vdag_scene {
 } vdag_scene;
 
 /* Reads PATH, choosing the parser by extension (.xyz .ply .obj .off .vox
-   .mtl .spm .ac).
+   .mtl .spm .ac). LIMITS may be NULL (the defaults).
    Returns 1 on success; 0 with a one-line reason in err otherwise. */
-int vdag_import_file(const char *path, vdag_scene *out, char *err, size_t err_size);
+int vdag_import_file(const char *path, const vdag_import_limits *limits, vdag_scene *out,
+                     char *err, size_t err_size);
 
 /* Parses bytes already in memory; EXT names the format ("xyz", "ply", ...).
    BASE_DIR (may be NULL) resolves .mtl and texture files for .obj. */
 int vdag_import_memory(const char *ext, const void *data, size_t size,
-                       const char *base_dir, vdag_scene *out, char *err,
-                       size_t err_size);
+                       const char *base_dir, const vdag_import_limits *limits,
+                       vdag_scene *out, char *err, size_t err_size);
 
 void vdag_scene_free(vdag_scene *scene);
 

@@ -386,7 +386,7 @@ static int cmd_build(int argc, char **argv) {
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--no-symmetry] ...");
     fprintf(stderr, "vdag: reading %s\n", a.in);
-    if (!vdag_import_file(a.in, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    if (!vdag_import_file(a.in, NULL, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);

@@ -44,7 +44,7 @@ static inline void put_le32(bytes *b, int64_t v) { put_uint(b, (uint64_t)v, 4, 0
 
 /* Imports DATA; a failure must leave a one-line message and an empty scene. */
 static inline int import(const char *ext, const bytes *data, vdag_scene *s, char *err, size_t err_size) {
-    int ok = vdag_import_memory(ext, data->p, data->n, NULL, s, err, err_size);
+    int ok = vdag_import_memory(ext, data->p, data->n, NULL, NULL, s, err, err_size);
     if (!ok) {
         CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
         CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);

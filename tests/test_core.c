@@ -554,6 +554,70 @@ static void test_allocation_failures(void) {
     scene_free(&s);
 }
 
+// -- Build limits: max_nodes and max_memory refuse exactly past the result's totals
+
+static voxdag_status build_limited(const uint32_t *xyz, const uint8_t *rgb, size_t n, const voxdag_build_opts *base,
+                                   uint64_t max_nodes, uint64_t max_memory, int flush, voxdag_build_stats *stats) {
+    count_alloc ca;
+    voxdag_build_opts o = *base;
+    voxdag_builder *b = NULL;
+    voxdag *d = NULL;
+    voxdag_error err;
+    voxdag_status st;
+    memset(&ca, 0, sizeof ca);
+    ca.fail_at = -1;
+    o.max_nodes = max_nodes;
+    o.max_memory = max_memory;
+    o.allocator.alloc = ca_alloc;
+    o.allocator.free = ca_free;
+    o.allocator.user = &ca;
+    st = voxdag_builder_create(&o, &b, &err);
+    if (st == VOXDAG_OK) st = voxdag_builder_add(b, xyz, rgb, n, &err);
+    if (st == VOXDAG_OK && flush) {
+        voxdag_status fs = voxdag_builder_flush(b, &err);
+        CHECK(fs == VOXDAG_OK || fs == VOXDAG_ERR_LIMIT || fs == VOXDAG_ERR_OUT_OF_MEMORY);
+    }
+    if (st == VOXDAG_OK) st = voxdag_builder_finish(b, &d, stats, &err);
+    else voxdag_builder_free(b);
+    CHECK(st == err.status && (st == VOXDAG_OK) == (d != NULL));
+    if (st == VOXDAG_ERR_LIMIT) CHECK(strstr(err.message, "max_nodes") != NULL);
+    voxdag_free(d);
+    CHECK(ca.held == 0 && !ca.bad_free);
+    return st;
+}
+
+static void test_build_limits(void) {
+    scene s = make_scene(SC_MIRRORED_BLOB, 6, 5);
+    uint32_t *xyz;
+    uint8_t *rgb;
+    size_t n = scene_voxels(&s, &xyz, &rgb);
+    voxdag_build_opts o;
+    voxdag_build_stats stats;
+    uint64_t nodes = 0;
+    uint32_t l;
+    int flush, threads;
+    memset(&o, 0, sizeof o);
+    o.levels = 6;
+    o.colors = 1;
+    CHECK(build_limited(xyz, rgb, n, &o, 0, 0, 0, &stats) == VOXDAG_OK);
+    for (l = 0; l + 1 < stats.levels; l++) nodes += stats.nodes[l];
+    CHECK(nodes > 1);
+    for (threads = 1; threads <= 2; threads++)
+        for (flush = 0; flush < 2; flush++) {
+            o.threads = (uint32_t)threads;
+            CHECK(build_limited(xyz, rgb, n, &o, nodes, 0, flush, NULL) == VOXDAG_OK);
+            CHECK_MSG(build_limited(xyz, rgb, n, &o, nodes - 1, 0, flush, NULL) == VOXDAG_ERR_LIMIT,
+                      "max_nodes, %d threads, flush %d", threads, flush);
+        }
+    /* max_memory: the measured peak passes, one byte less fails */
+    o.threads = 1;
+    CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory, 0, NULL) == VOXDAG_OK);
+    CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory - 1, 0, NULL) == VOXDAG_ERR_OUT_OF_MEMORY);
+    free(xyz);
+    free(rgb);
+    scene_free(&s);
+}
+
 /* Every single-byte change of a small image is rejected or, when it only
    touches ignored padding, still loads; never a crash (ASan checks). Every
    truncation is rejected. */
@@ -599,6 +663,7 @@ const test_case test_core_cases[] = {
     {"core/load_roundtrip", test_load_roundtrip},
     {"core/bad_arguments", test_bad_arguments},
     {"core/allocation_failures", test_allocation_failures},
+    {"core/build_limits", test_build_limits},
     {"core/mutations_rejected", test_mutations_rejected},
     {NULL, NULL},
 };

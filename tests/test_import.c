@@ -551,7 +551,7 @@ static void test_obj_file(void) {
     vdag_image_free(&probe);
 
     snprintf(path, sizeof path, "%s/scene.OBJ", dir);
-    if (!vdag_import_file(path, &s, err, sizeof err)) {
+    if (!vdag_import_file(path, NULL, &s, err, sizeof err)) {
         CHECK_MSG(0, "%s", err);
     } else {
         CHECK(s.triangle_count == 3 && s.material_count == 3 && s.uv != NULL);
@@ -583,15 +583,60 @@ static void test_obj_file(void) {
 static void test_file_errors(void) {
     vdag_scene s;
     char err[256];
-    CHECK(!vdag_import_file("/nonexistent/scene.ply", &s, err, sizeof err));
+    CHECK(!vdag_import_file("/nonexistent/scene.ply", NULL, &s, err, sizeof err));
     CHECK_MSG(strstr(err, "/nonexistent/scene.ply: cannot open") == err, "%s", err);
-    CHECK(!vdag_import_file("tests/test_import.c", &s, err, sizeof err));
+    CHECK(!vdag_import_file("tests/test_import.c", NULL, &s, err, sizeof err));
     CHECK_MSG(strstr(err, "unknown format") != NULL, "%s", err);
-    CHECK(!vdag_import_memory("stl", "", 0, NULL, &s, err, sizeof err));
+    CHECK(!vdag_import_memory("stl", "", 0, NULL, NULL, &s, err, sizeof err));
     CHECK_MSG(!strcmp(err, "stl: unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"), "%s", err);
-    CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, err, 8)); /* the message is cut, not overflowed */
+    CHECK(!vdag_import_memory("ply", "", 0, NULL, NULL, &s, err, 8)); /* the message is cut, not overflowed */
     CHECK(strlen(err) == 7);
-    CHECK(!vdag_import_memory("ply", "", 0, NULL, &s, NULL, 0));
+    CHECK(!vdag_import_memory("ply", "", 0, NULL, NULL, &s, NULL, 0));
+}
+
+/* Limits apply to totals: each passes at the scene's own count and fails
+   one below it, with a message naming it; the input cap also for files. */
+static void test_limits(void) {
+    static const char *const xyz = "1 2 3\n4 5 6\n7 8 9\n";
+    static const char *const obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 4\n";
+    char dir[] = "/tmp/vdag-limits-XXXXXX", path[256], err[512];
+    vdag_import_limits lim;
+    vdag_scene s;
+    int k;
+    for (k = 0; k < 2; k++) { /* max_points on a point cloud */
+        memset(&lim, 0, sizeof lim);
+        lim.max_points = 3 - (uint64_t)k;
+        CHECK(vdag_import_memory("xyz", xyz, strlen(xyz), NULL, &lim, &s, err, sizeof err) == !k);
+        if (!k) vdag_scene_free(&s);
+        else CHECK_MSG(strstr(err, "max_points") != NULL, "%s", err);
+    }
+    for (k = 0; k < 2; k++) { /* max_vertices and max_triangles on a mesh (a quad: 2 triangles) */
+        memset(&lim, 0, sizeof lim);
+        lim.max_vertices = 4 - (uint64_t)k;
+        CHECK(vdag_import_memory("obj", obj, strlen(obj), NULL, &lim, &s, err, sizeof err) == !k);
+        if (!k) vdag_scene_free(&s);
+        else CHECK_MSG(strstr(err, "max_vertices") != NULL, "%s", err);
+        memset(&lim, 0, sizeof lim);
+        lim.max_triangles = 2 - (uint64_t)k;
+        CHECK(vdag_import_memory("obj", obj, strlen(obj), NULL, &lim, &s, err, sizeof err) == !k);
+        if (!k) vdag_scene_free(&s);
+        else CHECK_MSG(strstr(err, "max_triangles") != NULL, "%s", err);
+    }
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/points.xyz", dir);
+    CHECK(write_file(path, xyz, strlen(xyz)));
+    for (k = 0; k < 2; k++) { /* max_input_bytes, in memory and from a file */
+        memset(&lim, 0, sizeof lim);
+        lim.max_input_bytes = strlen(xyz) - (uint64_t)k;
+        CHECK(vdag_import_memory("xyz", xyz, strlen(xyz), NULL, &lim, &s, err, sizeof err) == !k);
+        if (!k) vdag_scene_free(&s);
+        else CHECK_MSG(strstr(err, "max_input_bytes") != NULL, "%s", err);
+        CHECK(vdag_import_file(path, &lim, &s, err, sizeof err) == !k);
+        if (!k) vdag_scene_free(&s);
+        else CHECK_MSG(strstr(err, "max_input_bytes") != NULL && !s.point_count, "%s", err);
+    }
+    remove(path);
+    rmdir(dir);
 }
 
 // -- .vox
@@ -1044,6 +1089,7 @@ const test_case test_import_cases[] = {
     {"import/obj errors", test_obj_errors},
     {"import/obj file with mtl and texture", test_obj_file},
     {"import/file errors", test_file_errors},
+    {"import/limits", test_limits},
     {"import/vox models", test_vox_models},
     {"import/vox default palette", test_vox_default_palette},
     {"import/vox scene graph", test_vox_scene_graph},

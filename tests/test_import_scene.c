@@ -522,7 +522,7 @@ static void test_scene_files(void) {
     write_spm(&b, &t, &seed);
     snprintf(p[n], sizeof p[n], "%s/tracks/t/track.spm", dir);
     CHECK(sfile(p[n], b.p, b.n));
-    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+    if (!vdag_import_file(p[n++], NULL, &s, err, sizeof err)) {
         CHECK_MSG(0, "%s", err);
     } else {
         CHECK(s.material_count == 3 && s.triangle_count == 3 && s.uv != NULL);
@@ -540,7 +540,7 @@ static void test_scene_files(void) {
     write_spm(&b, &t, &seed);
     snprintf(p[n], sizeof p[n], "%s/tracks/t/track2.spm", dir);
     CHECK(sfile(p[n], b.p, b.n));
-    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+    if (!vdag_import_file(p[n++], NULL, &s, err, sizeof err)) {
         CHECK_MSG(0, "%s", err);
     } else {
         if (decodes) CHECK(s.image_count == 2 && s.materials[0].image == 0 && s.images[0].rgb[11] == 2);
@@ -555,7 +555,7 @@ static void test_scene_files(void) {
               "numsurf 1\nSURF 0x10\nmat 0\nrefs 3\n0 0 0\n1 1 0\n2 0.5 1\nkids 0\n");
     snprintf(p[n], sizeof p[n], "%s/tracks/t/model.ac", dir);
     CHECK(sfile(p[n], b.p, b.n));
-    if (!vdag_import_file(p[n++], &s, err, sizeof err)) {
+    if (!vdag_import_file(p[n++], NULL, &s, err, sizeof err)) {
         CHECK_MSG(0, "%s", err);
     } else {
         CHECK(s.triangle_count == 2 && s.material_count == (decodes ? 2u : 1u));
