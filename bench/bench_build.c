@@ -224,8 +224,7 @@ int main(int argc, char **argv) {
     char path[512];
     bscene scenes[16];
     result res[16];
-    size_t ns = 0, k;
-    bench_grid liver;
+    size_t ns, k;
     for (i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = (unsigned)atoi(argv[++i]);
@@ -236,18 +235,7 @@ int main(int argc, char **argv) {
     tcount[1] = threads;
 
     fprintf(stderr, "bench_build: loading scenes\n");
-    snprintf(path, sizeof path, "%s/tree.vox", dir);
-    if (bscene_vox(&scenes[ns], path, "tree.vox")) ns++;
-    snprintf(path, sizeof path, "%s/liver.inr", dir);
-    if (bench_read_inr(path, &liver)) {
-        unsigned kk, kmax = quick ? 1 : 3;
-        for (kk = 0; kk <= kmax; kk++) {
-            char nm[64];
-            snprintf(nm, sizeof nm, kk ? "liver shell x%u" : "liver", 1u << kk);
-            bscene_grid(&scenes[ns++], &liver, kk, nm, "liver.inr");
-        }
-        free(liver.full);
-    }
+    ns = bscene_voxel_scenes(scenes, dir, quick ? 1 : 3);
     if (!quick) {
         snprintf(path, sizeof path, "%s/armadillo.off", dir);
         if (bscene_mesh(&scenes[ns], path, "armadillo.off", 12)) ns++;

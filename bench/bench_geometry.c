@@ -255,23 +255,11 @@ int main(int argc, char **argv) {
     char path[512];
     bscene scenes[24];
     row rows[24];
-    size_t ns = 0, k;
-    bench_grid liver;
+    size_t ns, k;
     static const char *meshes[] = {"bunny.off", "armadillo.off", "dragon.off"};
 
     fprintf(stderr, "bench_geometry: loading scenes\n");
-    snprintf(path, sizeof path, "%s/tree.vox", dir);
-    if (bscene_vox(&scenes[ns], path, "tree.vox")) ns++;
-    snprintf(path, sizeof path, "%s/liver.inr", dir);
-    if (bench_read_inr(path, &liver)) {
-        unsigned kk, kmax = quick ? 2 : 3;
-        for (kk = 0; kk <= kmax; kk++) {
-            char nm[64];
-            snprintf(nm, sizeof nm, kk ? "liver shell x%u" : "liver", 1u << kk);
-            bscene_grid(&scenes[ns++], &liver, kk, nm, "liver.inr");
-        }
-        free(liver.full);
-    }
+    ns = bscene_voxel_scenes(scenes, dir, quick ? 2 : 3);
     for (k = 0; k < 3; k++) {
         uint32_t L, lmax = quick ? 10 : 12;
         if (quick && k) break;

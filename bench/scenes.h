@@ -225,6 +225,28 @@ BENCH_UNUSED static void bscene_grid(bscene *s, const bench_grid *g, unsigned k,
     bscene_from_codes(s, c, n);
 }
 
+/* The voxel scenes the build and geometry benches share: tree.vox, then the
+   liver CT grid and its shells scaled by 2^1..2^SHELLS, at SCENES (room for
+   2 + SHELLS). Returns how many loaded. */
+BENCH_UNUSED static size_t bscene_voxel_scenes(bscene *scenes, const char *dir, unsigned shells) {
+    char path[512];
+    bench_grid liver;
+    size_t ns = 0;
+    unsigned k;
+    snprintf(path, sizeof path, "%s/tree.vox", dir);
+    if (bscene_vox(&scenes[ns], path, "tree.vox")) ns++;
+    snprintf(path, sizeof path, "%s/liver.inr", dir);
+    if (bench_read_inr(path, &liver)) {
+        for (k = 0; k <= shells; k++) {
+            char name[64];
+            snprintf(name, sizeof name, k ? "liver shell x%u" : "liver", 1u << k);
+            bscene_grid(&scenes[ns++], &liver, k, name, "liver.inr");
+        }
+        free(liver.full);
+    }
+    return ns;
+}
+
 // -- Triangle meshes through the importer, voxelized by the library
 
 /* Triangles fitted into the 2^L grid by their bounding box (one uniform
