@@ -1,6 +1,6 @@
 /* A counting allocator for the tests and fuzz targets: fails at call FAIL_AT
    (never when negative), tracks bytes held and their peak, and flags a free
-   whose size differs from the allocation's. */
+   whose size differs from the allocation's. Include it after voxdag.h. */
 #ifndef VOXDAG_COUNT_ALLOC_H
 #define VOXDAG_COUNT_ALLOC_H
 
@@ -33,6 +33,18 @@ static void ca_free(void *user, void *ptr, size_t size) {
     if (stored != size || a->held < size) a->bad_free = 1;
     a->held -= size;
     free((unsigned char *)ptr - 16);
+}
+
+/* Resets A to fail at call FAIL_AT (-1: never) and returns it as a
+   voxdag_allocator. */
+static voxdag_allocator ca_start(count_alloc *a, long fail_at) {
+    voxdag_allocator r;
+    memset(a, 0, sizeof *a);
+    a->fail_at = fail_at;
+    r.alloc = ca_alloc;
+    r.free = ca_free;
+    r.user = a;
+    return r;
 }
 
 #endif

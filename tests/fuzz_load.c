@@ -143,13 +143,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     file = (uint8_t *)malloc(size ? size : 1);
     if (size) memcpy(file, data + 1, size);
     if (sel & 2) golden_reseal(file, size);
-    memset(&fa, 0, sizeof fa);
-    fa.fail_at = fuzz_fail_at >= 0 ? fuzz_fail_at : sel & 16 ? 3 * (long)p : -1;
     memset(&o, 0, sizeof o);
     o.copy = sel & 1;
-    o.allocator.alloc = ca_alloc;
-    o.allocator.free = ca_free;
-    o.allocator.user = &fa;
+    o.allocator = ca_start(&fa, fuzz_fail_at >= 0 ? fuzz_fail_at : sel & 16 ? 3 * (long)p : -1);
     switch (sel >> 2 & 3) {
     case 1: o.max_nodes = 1 + p * p; break;
     case 2: o.max_memory = (uint64_t)256 << p; break;

@@ -327,11 +327,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     voxdag_status st;
     if (size < 3) return 0;
     scene_read(&s, data, size);
-    memset(&ca, 0, sizeof ca);
-    ca.fail_at = fuzz_fail_at >= 0 ? fuzz_fail_at : s.fail ? 4 * (long)s.p + (data[1] >> 6) : -1;
-    a.alloc = ca_alloc;
-    a.free = ca_free;
-    a.user = &ca;
+    a = ca_start(&ca, fuzz_fail_at >= 0 ? fuzz_fail_at : s.fail ? 4 * (long)s.p + (data[1] >> 6) : -1);
     st = build(&s, (unsigned)s.threads, &a, &built);
     if (st == VOXDAG_OK && s.colors && s.bound) st = to_voxcolor(&built, bounds[s.bound], &a);
     if (st == VOXDAG_OK) {

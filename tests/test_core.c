@@ -2,8 +2,8 @@
    a brute-force answer computed here from a dense grid, independently of the
    library's own logic (raster-order subtree contents, sorting, rank). */
 #include "test.h"
-#include "count_alloc.h"
 #include "voxdag.h"
+#include "count_alloc.h"
 
 // -- Scenes on a dense grid
 
@@ -526,15 +526,11 @@ static void test_allocation_failures(void) {
         voxdag_builder *b = NULL;
         voxdag *d = NULL;
         voxdag_status st;
-        memset(&ca, 0, sizeof ca);
-        ca.fail_at = fail_at;
         memset(&o, 0, sizeof o);
         o.levels = 6;
         o.colors = 1;
         o.threads = (fail_at & 1) + 1;
-        o.allocator.alloc = ca_alloc;
-        o.allocator.free = ca_free;
-        o.allocator.user = &ca;
+        o.allocator = ca_start(&ca, fail_at);
         st = voxdag_builder_create(&o, &b, NULL);
         if (st == VOXDAG_OK) st = voxdag_builder_add(b, xyz, rgb, n, NULL);
         if (st == VOXDAG_OK) st = voxdag_builder_finish(b, &d, NULL, NULL);
@@ -564,13 +560,9 @@ static voxdag_status build_limited(const uint32_t *xyz, const uint8_t *rgb, size
     voxdag *d = NULL;
     voxdag_error err;
     voxdag_status st;
-    memset(&ca, 0, sizeof ca);
-    ca.fail_at = -1;
     o.max_nodes = max_nodes;
     o.max_memory = max_memory;
-    o.allocator.alloc = ca_alloc;
-    o.allocator.free = ca_free;
-    o.allocator.user = &ca;
+    o.allocator = ca_start(&ca, -1);
     st = voxdag_builder_create(&o, &b, &err);
     if (st == VOXDAG_OK) st = voxdag_builder_add(b, xyz, rgb, n, &err);
     if (st == VOXDAG_OK && flush) {

@@ -58,12 +58,8 @@ static uint8_t *read_golden(int kind, size_t *size) {
 }
 
 static void opts_with(voxdag_load_opts *o, count_alloc *ca, long fail_at) {
-    memset(ca, 0, sizeof *ca);
-    ca->fail_at = fail_at;
     memset(o, 0, sizeof *o);
-    o->allocator.alloc = ca_alloc;
-    o->allocator.free = ca_free;
-    o->allocator.user = ca;
+    o->allocator = ca_start(ca, fail_at);
 }
 
 /* Loads an exact-size heap copy of DATA; returns the status, frees the DAG,
