@@ -143,6 +143,13 @@ typedef struct voxdag_build_opts {
     voxdag_allocator allocator;
     voxdag_progress_fn progress; /* optional; called from the building thread */
     void *progress_user;
+    /* Optional, with colors: receives the colours (RGB8) in voxel-index order,
+       N at a time, as voxels are reduced (from the building thread); returns
+       0 to go on, non-zero to fail the build with VOXDAG_ERR_IO. The DAG then
+       has no colour section (voxdag_with_colors adds one), so the builder's
+       memory does not grow with the colours. */
+    int (*color_sink)(void *user, const uint8_t *rgb, size_t n);
+    void *color_sink_user;
     uint32_t zero_end;           /* must be 0 */
 } voxdag_build_opts;
 
@@ -187,13 +194,15 @@ typedef struct voxdag_mesh {
 /* Voxelizes MESH conservatively: a voxel is full when a triangle intersects
    its closed box (exact separating-axis test). Parts outside the grid are
    clipped. Works chunk by chunk (aligned subtrees of 2^chunk_levels voxels
-   per axis, in Morton order),
-   flushing each, so memory holds the unique nodes plus one chunk's voxels.
+   per axis, chunk_levels clamped to 2..8, in Morton order; with threads,
+   one chunk per thread at a time) and reduces each chunk at once, so memory
+   holds the unique nodes plus a chunk bitmap per thread.
    A voxel's colour comes from the triangle touching it with the highest
-   index, at the point of that triangle nearest to the voxel centre. Call it
-   on a builder that holds no voxels yet; more meshes need one combined call.
-   Returns VOXDAG_ERR_INVALID_ARGUMENT for an index >= vertex_count or a
-   non-finite vertex. */
+   index, at the point of that triangle nearest to the voxel centre; the
+   colour callback runs once per voxel, from several threads at once when
+   opts.threads > 1. Call it on a builder that holds no voxels yet; more
+   meshes need one combined call. Returns VOXDAG_ERR_INVALID_ARGUMENT for an
+   index >= vertex_count or a non-finite vertex. */
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
                                                  voxdag_error *err);
 
@@ -1068,15 +1077,21 @@ static void voxdagi_reducer_close_brick(voxdagi_reducer *r) {
     if (ref != VOXDAGI_NONE) voxdagi_reducer_push(r, r->levels - 2, r->brick_key, ref);
 }
 
-/* Adds one voxel; CODE must not precede the previous one. */
-static void voxdagi_reducer_voxel(voxdagi_reducer *r, uint64_t code) {
-    if (r->brick_open && r->brick_key != code >> 6) voxdagi_reducer_close_brick(r);
+/* Adds the voxels MASK of the brick with Morton code KEY (the voxel codes
+   without their low 6 bits); KEY must not precede the previous one. */
+static void voxdagi_reducer_brick(voxdagi_reducer *r, uint64_t key, uint64_t mask) {
+    if (r->brick_open && r->brick_key != key) voxdagi_reducer_close_brick(r);
     if (!r->brick_open) {
         r->brick_open = 1;
-        r->brick_key = code >> 6;
+        r->brick_key = key;
         r->brick_mask = 0;
     }
-    r->brick_mask |= 1ull << (code & 63);
+    r->brick_mask |= mask;
+}
+
+/* Adds one voxel; CODE must not precede the previous one. */
+static void voxdagi_reducer_voxel(voxdagi_reducer *r, uint64_t code) {
+    voxdagi_reducer_brick(r, code >> 6, 1ull << (code & 63));
 }
 
 /* Closes everything still open; the root reference is then in r->root. */
@@ -1140,8 +1155,9 @@ struct voxdag_builder {
     size_t pend_n, pend_cap;
     uint64_t last_code;          /* largest code reduced so far */
     int any_reduced;
-    uint8_t *colors;             /* RGB8 in voxel-index order */
+    uint8_t *colors;             /* RGB8 in voxel-index order, from voxel COLORS_BASE */
     size_t colors_cap;           /* in voxels */
+    uint64_t colors_base;        /* with a colour sink: the first colour not yet sent */
     uint64_t voxels;
     voxdag_status failed;        /* sticky error */
 };
@@ -1334,20 +1350,30 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
     return voxdagi_ok(err);
 }
 
-/* Appends the colours of N sorted, distinct voxels to the colour array. */
-static int voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, size_t n) {
-    size_t i;
+/* Sends the HELD buffered colours to the sink but for the last KEEP (0 or 1). */
+static voxdag_status voxdagi_builder_send_colors(voxdag_builder *b, size_t held, size_t keep) {
+    if (!b->opts.colors || !b->opts.color_sink || held <= keep) return VOXDAG_OK;
+    if (b->opts.color_sink(b->opts.color_sink_user, b->colors, held - keep)) return VOXDAG_ERR_IO;
+    memmove(b->colors, b->colors + 3 * (held - keep), 3 * keep);
+    b->colors_base += held - keep;
+    return VOXDAG_OK;
+}
+
+/* Appends the colours of N sorted, distinct voxels that follow the reduced
+   ones. With a sink, the colours go out at once, but for the last one: a
+   repeat of that voxel at the start of the next flush may still replace it. */
+static voxdag_status voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, size_t n) {
+    size_t i, held = (size_t)(b->voxels - b->colors_base);
     uint8_t *c;
-    if (!b->opts.colors) return 1;
-    if (!voxdagi_grow(&b->mem, (void **)&b->colors, &b->colors_cap, (size_t)b->voxels + n, 3))
-        return 0;
-    c = b->colors + 3 * (size_t)b->voxels;
+    if (!b->opts.colors) return VOXDAG_OK;
+    if (!voxdagi_grow(&b->mem, (void **)&b->colors, &b->colors_cap, held + n, 3)) return VOXDAG_ERR_OUT_OF_MEMORY;
+    c = b->colors + 3 * held;
     for (i = 0; i < n; i++) {
         c[3 * i] = (uint8_t)(rgb[i] >> 16);
         c[3 * i + 1] = (uint8_t)(rgb[i] >> 8);
         c[3 * i + 2] = (uint8_t)rgb[i];
     }
-    return 1;
+    return voxdagi_builder_send_colors(b, held + n, 1);
 }
 
 #ifndef VOXDAG_NO_THREADS
@@ -1543,7 +1569,9 @@ static uint64_t voxdagi_builder_nodes(const voxdag_builder *b) {
 }
 
 static const char *voxdagi_reduce_message(voxdag_status st) {
-    return st == VOXDAG_ERR_LIMIT ? "more nodes than max_nodes" : "out of memory while reducing voxels";
+    return st == VOXDAG_ERR_LIMIT ? "more nodes than max_nodes"
+           : st == VOXDAG_ERR_IO  ? "the colour sink failed"
+                                  : "out of memory while reducing voxels";
 }
 
 /* Sorts, deduplicates and reduces the buffered voxels. FINAL: no voxel follows. */
@@ -1553,6 +1581,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     uint32_t *rgb = b->pend_rgb;
     int sorted = 1, distinct = 1, done = 0;
     unsigned k;
+    voxdag_status st;
     if (!n) return VOXDAG_OK;
     for (i = 1; i < n && sorted; i++) {
         sorted = code[i - 1] <= code[i];
@@ -1588,7 +1617,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     if (b->any_reduced && code[0] < b->last_code) return VOXDAG_ERR_ORDER;
     if (b->any_reduced && code[0] == b->last_code) {
         if (rgb) {
-            uint8_t *c = b->colors + 3 * (size_t)(b->voxels - 1);
+            uint8_t *c = b->colors + 3 * (size_t)(b->voxels - 1 - b->colors_base);
             c[0] = (uint8_t)(rgb[0] >> 16);
             c[1] = (uint8_t)(rgb[0] >> 8);
             c[2] = (uint8_t)rgb[0];
@@ -1600,12 +1629,9 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     if (rgb) rgb += i;
     b->pend_n = 0;
     if (!n) return VOXDAG_OK;
-    if (!voxdagi_builder_colors(b, rgb, n)) return VOXDAG_ERR_OUT_OF_MEMORY;
+    if ((st = voxdagi_builder_colors(b, rgb, n)) != VOXDAG_OK) return st;
 #ifndef VOXDAG_NO_THREADS
-    {
-        voxdag_status st = voxdagi_reduce_parallel(b, code, n, final, &done);
-        if (st != VOXDAG_OK) return st;
-    }
+    if ((st = voxdagi_reduce_parallel(b, code, n, final, &done)) != VOXDAG_OK) return st;
 #else
     (void)final;
 #endif
@@ -1648,42 +1674,49 @@ typedef struct voxdagi_tri {
     double lo[3], hi[3]; /* bounding box */
 } voxdagi_tri;
 
-/* Does triangle T intersect the closed box [b, b + size]^3? The 13 axes of
-   the separating-axis theorem for a triangle and a box: the box normals, the
-   triangle normal, and the 9 cross products of edges and box normals. Touching
-   counts as intersecting. Degenerate triangles give zero axes, which never
-   separate, so segments and points are handled by the remaining axes. */
-static int voxdagi_tri_box(const voxdagi_tri *t, const double b[3], double size) {
-    double h = size / 2, v[3][3], e[3][3], d, r;
-    unsigned i, k, a;
+/* The 13 axes of the separating-axis theorem for a triangle and boxes of one
+   size: the box normals (0..2), the triangle normal (3), and the cross
+   products edge i x box normal k (4 + 3k + i, which have no k component).
+   The box [p, p + size]^3 and the triangle intersect, touching included, iff
+   lo <= a.p <= hi on every axis a ([lo, hi] is the triangle's interval on a,
+   less the box's extent). Degenerate triangles give zero axes (lo <= 0 <= hi),
+   which never separate, so segments and points are handled by the others. */
+typedef struct voxdagi_axes {
+    double a[13][3], lo[13], hi[13];
+} voxdagi_axes;
+
+static void voxdagi_axes_init(voxdagi_axes *x, const voxdagi_tri *t, double size) {
+    unsigned i, k, j, c;
+    memset(x->a, 0, sizeof x->a);
     for (k = 0; k < 3; k++) {
-        double c = b[k] + h;
-        if (t->lo[k] > c + h || t->hi[k] < c - h) return 0;
-        for (i = 0; i < 3; i++) v[i][k] = t->v[i][k] - c;
-    }
-    d = t->n[0] * v[0][0] + t->n[1] * v[0][1] + t->n[2] * v[0][2];
-    r = h * (voxdagi_abs(t->n[0]) + voxdagi_abs(t->n[1]) + voxdagi_abs(t->n[2]));
-    if (d > r || d < -r) return 0;
-    for (i = 0; i < 3; i++)
-        for (k = 0; k < 3; k++) e[i][k] = v[(i + 1) % 3][k] - v[i][k];
-    for (i = 0; i < 3; i++)
-        for (a = 0; a < 3; a++) { /* axis = e[i] x unit(a) */
-            unsigned a1 = (a + 1) % 3, a2 = (a + 2) % 3;
-            double axis[3], p0, p1, p2, mn, mx;
-            axis[a] = 0;
-            axis[a1] = e[i][a2];
-            axis[a2] = -e[i][a1];
-            p0 = axis[a1] * v[0][a1] + axis[a2] * v[0][a2];
-            p1 = axis[a1] * v[1][a1] + axis[a2] * v[1][a2];
-            p2 = axis[a1] * v[2][a1] + axis[a2] * v[2][a2];
-            mn = p0 < p1 ? p0 : p1;
-            mn = mn < p2 ? mn : p2;
-            mx = p0 > p1 ? p0 : p1;
-            mx = mx > p2 ? mx : p2;
-            r = h * (voxdagi_abs(axis[a1]) + voxdagi_abs(axis[a2]));
-            if (mn > r || mx < -r) return 0;
+        x->a[k][k] = 1;
+        x->a[3][k] = t->n[k];
+        for (i = 0; i < 3; i++) {
+            double *a = x->a[4 + 3 * k + i];
+            a[(k + 1) % 3] = t->v[(i + 1) % 3][(k + 2) % 3] - t->v[i][(k + 2) % 3];
+            a[(k + 2) % 3] = t->v[i][(k + 1) % 3] - t->v[(i + 1) % 3][(k + 1) % 3];
         }
-    return 1;
+    }
+    for (j = 0; j < 13; j++) {
+        const double *a = x->a[j];
+        double mn = 1e308, mx = -1e308, ext_lo = 0, ext_hi = 0;
+        for (c = 0; c < 3; c++) {
+            double p = a[0] * t->v[c][0] + a[1] * t->v[c][1] + a[2] * t->v[c][2];
+            if (p < mn) mn = p;
+            if (p > mx) mx = p;
+        }
+        for (k = 0; k < 3; k++) {
+            if (a[k] > 0) ext_hi += size * a[k];
+            else ext_lo += size * a[k];
+        }
+        x->lo[j] = mn - ext_hi;
+        x->hi[j] = mx - ext_lo;
+    }
+}
+
+static int voxdagi_axes_test(const voxdagi_axes *x, const double p[3], unsigned j) {
+    double s = x->a[j][0] * p[0] + x->a[j][1] * p[1] + x->a[j][2] * p[2];
+    return s >= x->lo[j] && s <= x->hi[j];
 }
 
 /* Range of voxels whose closed boxes [x, x+1] may touch [lo, hi], clamped to
@@ -1726,76 +1759,6 @@ static void voxdagi_tri_bary(const voxdagi_tri *t, const double p[3], double bar
     for (i = 0; i < 3; i++) bary[i] = sum > 0 ? bary[i] / sum : 1.0 / 3;
 }
 
-/* Appends one voxel (and its colour) to the builder's buffer. */
-static int voxdagi_emit(voxdag_builder *b, const voxdag_mesh *mesh, const voxdagi_tri *t, size_t tri,
-                        int64_t x, int64_t y, int64_t z) {
-    if (b->pend_n == b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + 1)) return 0;
-    b->pend_code[b->pend_n] = voxdag_morton_encode((uint32_t)x, (uint32_t)y, (uint32_t)z);
-    if (b->opts.colors) {
-        double c[3], bary[3];
-        uint8_t rgb[3];
-        c[0] = (double)x + 0.5;
-        c[1] = (double)y + 0.5;
-        c[2] = (double)z + 0.5;
-        voxdagi_tri_bary(t, c, bary);
-        mesh->color(mesh->user, tri, bary, rgb);
-        b->pend_rgb[b->pend_n] = (uint32_t)rgb[0] << 16 | (uint32_t)rgb[1] << 8 | rgb[2];
-    }
-    b->pend_n++;
-    return 1;
-}
-
-/* Every voxel of T inside the box [clo, chi): columns along the normal's
-   dominant axis w hold only the few voxels the plane crosses. */
-static int voxdagi_voxelize_tri(voxdag_builder *b, const voxdag_mesh *mesh, const voxdagi_tri *t, size_t tri,
-                                const int64_t clo[3], const int64_t chi[3]) {
-    unsigned w = 2, u, v, k;
-    int64_t first[3], last[3], i, j, q;
-    for (k = 0; k < 3; k++)
-        if (!voxdagi_voxel_range(t->lo[k] > (double)clo[k] ? t->lo[k] : (double)clo[k],
-                                 t->hi[k] < (double)chi[k] ? t->hi[k] : (double)chi[k], chi[k], &first[k], &last[k]) ||
-            last[k] < clo[k])
-            return 1;
-    for (k = 0; k < 3; k++) /* the chunk's own voxels only */
-        if (first[k] < clo[k]) first[k] = clo[k];
-    if (voxdagi_abs(t->n[0]) > voxdagi_abs(t->n[w])) w = 0;
-    if (voxdagi_abs(t->n[1]) > voxdagi_abs(t->n[w])) w = 1;
-    u = (w + 1) % 3;
-    v = (w + 2) % 3;
-    for (i = first[u]; i <= last[u]; i++)
-        for (j = first[v]; j <= last[v]; j++) {
-            int64_t wf = first[w], wl = last[w];
-            if (t->n[w] != 0) { /* the plane's w over the column's square, widened by rounding */
-                double d = t->n[0] * t->v[0][0] + t->n[1] * t->v[0][1] + t->n[2] * t->v[0][2];
-                double lo = 1e308, hi = -1e308;
-                unsigned c;
-                for (c = 0; c < 4; c++) {
-                    double pu = (double)i + (c & 1), pv = (double)j + (c >> 1);
-                    double pw = (d - t->n[u] * pu - t->n[v] * pv) / t->n[w];
-                    if (pw < lo) lo = pw;
-                    if (pw > hi) hi = pw;
-                }
-                lo -= 1e-6 * (1 + voxdagi_abs(lo));
-                hi += 1e-6 * (1 + voxdagi_abs(hi));
-                if (!voxdagi_voxel_range(lo, hi, chi[w], &wf, &wl)) continue;
-                if (wf < first[w]) wf = first[w];
-                if (wl > last[w]) wl = last[w];
-            }
-            for (q = wf; q <= wl; q++) {
-                double box[3];
-                int64_t p[3];
-                p[u] = i;
-                p[v] = j;
-                p[w] = q;
-                box[0] = (double)p[0];
-                box[1] = (double)p[1];
-                box[2] = (double)p[2];
-                if (voxdagi_tri_box(t, box, 1.0) && !voxdagi_emit(b, mesh, t, tri, p[0], p[1], p[2])) return 0;
-            }
-        }
-    return 1;
-}
-
 static int voxdagi_load_tri(const voxdag_mesh *mesh, size_t i, voxdagi_tri *t) {
     double e1[3], e2[3];
     unsigned c, k;
@@ -1821,13 +1784,206 @@ static int voxdagi_load_tri(const voxdag_mesh *mesh, size_t i, voxdagi_tri *t) {
     return 1;
 }
 
+/* One chunk being voxelized: a bitmap of its voxels in local Morton order
+   (so each 64-bit word is a 4^3 brick), then its bricks and colours in Morton
+   order, ready for the builder. Each thread owns one. */
+typedef struct voxdagi_chunk {
+    voxdag_builder *b;
+    const voxdag_mesh *mesh;
+    unsigned shift;            /* edge 2^shift voxels, 2..8 */
+    uint64_t *bits;            /* 2^(3 shift - 6) words */
+    uint64_t *used;            /* one bit per nonzero word of BITS */
+    uint32_t *owner;           /* per voxel: the last triangle touching it (colours only) */
+    uint64_t *brick;           /* the chunk's bricks: (brick Morton code, voxel mask) pairs */
+    uint32_t *rgb;             /* the chunk's colours, 0xRRGGBB, in Morton order */
+    size_t bricks, brick_cap, rgb_cap, voxels;
+    uint64_t code;             /* this round: chunk Morton code */
+    const uint32_t *tri;       /* this round: its triangles, ascending */
+    size_t tri_count;
+    int failed;                /* out of memory */
+} voxdagi_chunk;
+
+static size_t voxdagi_chunk_words(const voxdagi_chunk *c) { return (size_t)1 << (3 * c->shift - 6); }
+static size_t voxdagi_chunk_used_words(const voxdagi_chunk *c) { return (voxdagi_chunk_words(c) + 63) / 64; }
+
+static int voxdagi_chunk_init(voxdagi_chunk *c, voxdag_builder *b, const voxdag_mesh *mesh, unsigned shift) {
+    memset(c, 0, sizeof *c);
+    c->b = b;
+    c->mesh = mesh;
+    c->shift = shift;
+    c->bits = (uint64_t *)voxdagi_alloc(&b->mem, voxdagi_chunk_words(c) * 8);
+    c->used = (uint64_t *)voxdagi_alloc(&b->mem, voxdagi_chunk_used_words(c) * 8);
+    if (b->opts.colors) c->owner = (uint32_t *)voxdagi_alloc(&b->mem, voxdagi_chunk_words(c) * 64 * 4);
+    if (!c->bits || !c->used || (b->opts.colors && !c->owner)) return 0;
+    memset(c->bits, 0, voxdagi_chunk_words(c) * 8);
+    memset(c->used, 0, voxdagi_chunk_used_words(c) * 8);
+    return 1;
+}
+
+static void voxdagi_chunk_free(voxdagi_chunk *c) {
+    voxdagi_mem *m = &c->b->mem;
+    voxdagi_free(m, c->bits, c->bits ? voxdagi_chunk_words(c) * 8 : 0);
+    voxdagi_free(m, c->used, c->used ? voxdagi_chunk_used_words(c) * 8 : 0);
+    voxdagi_free(m, c->owner, c->owner ? voxdagi_chunk_words(c) * 64 * 4 : 0);
+    voxdagi_free(m, c->brick, c->brick_cap * 16);
+    voxdagi_free(m, c->rgb, c->rgb_cap * sizeof *c->rgb);
+}
+
+/* Marks every voxel of triangle TRI (T, with unit-box axes X) inside the
+   chunk whose lowest voxel is CLO. Columns run along the normal's dominant
+   axis w: the three axes without a w component are tested once per column,
+   the plane bounds the column to the few voxels it crosses, and the other
+   seven axes decide each of those (the box normals hold by the ranges). */
+static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxdagi_axes *x, uint32_t tri,
+                              const int64_t clo[3]) {
+    unsigned w = 2, u, v, k, j, per_voxel[7], col[3];
+    int64_t first[3], last[3], i, jj, q;
+    for (k = 0; k < 3; k++) {
+        int64_t lim = clo[k] + ((int64_t)1 << c->shift);
+        if (!voxdagi_voxel_range(t->lo[k], t->hi[k], lim, &first[k], &last[k]) || last[k] < clo[k]) return;
+        if (first[k] < clo[k]) first[k] = clo[k]; /* the chunk's own voxels only */
+    }
+    if (voxdagi_abs(t->n[0]) > voxdagi_abs(t->n[w])) w = 0;
+    if (voxdagi_abs(t->n[1]) > voxdagi_abs(t->n[w])) w = 1;
+    u = (w + 1) % 3;
+    v = (w + 2) % 3;
+    per_voxel[0] = 3;
+    for (j = 0; j < 3; j++) {
+        col[j] = 4 + 3 * w + j;
+        per_voxel[1 + j] = 4 + 3 * u + j;
+        per_voxel[4 + j] = 4 + 3 * v + j;
+    }
+    for (i = first[u]; i <= last[u]; i++)
+        for (jj = first[v]; jj <= last[v]; jj++) {
+            double p[3], qlo = (double)first[w], qhi = (double)last[w];
+            uint32_t local[3];
+            uint64_t uv;
+            p[u] = (double)i;
+            p[v] = (double)jj;
+            p[w] = 0;
+            for (j = 0; j < 3 && voxdagi_axes_test(x, p, col[j]); j++) continue;
+            if (j < 3) continue;
+            if (t->n[w] != 0) { /* the plane's slab on this column, widened by rounding */
+                double base = t->n[u] * p[u] + t->n[v] * p[v];
+                double qa = (x->lo[3] - base) / t->n[w], qb = (x->hi[3] - base) / t->n[w];
+                double lo = qa < qb ? qa : qb, hi = qa < qb ? qb : qa;
+                lo -= 1e-6 * (1 + voxdagi_abs(lo));
+                hi += 1e-6 * (1 + voxdagi_abs(hi));
+                if (lo > qlo) qlo = lo;
+                if (hi < qhi) qhi = hi;
+                if (qlo > qhi) continue;
+            }
+            local[u] = (uint32_t)(i - clo[u]);
+            local[v] = (uint32_t)(jj - clo[v]);
+            local[w] = 0;
+            uv = voxdag_morton_encode(local[0], local[1], local[2]);
+            for (q = (int64_t)-voxdagi_floor(-qlo); q <= (int64_t)voxdagi_floor(qhi); q++) {
+                uint64_t code;
+                p[w] = (double)q;
+                for (j = 0; j < 7 && voxdagi_axes_test(x, p, per_voxel[j]); j++) continue;
+                if (j < 7) continue;
+                code = uv | voxdag_morton_encode((uint32_t)(q - clo[w]), 0, 0) << w;
+                c->bits[code >> 6] |= 1ull << (code & 63);
+                c->used[code >> 12] |= 1ull << ((code >> 6) & 63);
+                if (c->owner) c->owner[code] = tri;
+            }
+        }
+}
+
+/* Colours of the voxels of brick WORD of the chunk at CLO, appended to RGB:
+   each from its owner triangle at the point nearest to the voxel centre. */
+static void voxdagi_chunk_colors(voxdagi_chunk *c, const int64_t clo[3], size_t word, uint64_t m) {
+    voxdagi_tri t;
+    uint32_t cached = 0;
+    int have = 0;
+    while (m) {
+        uint64_t bit = m & (0 - m), code = 64 * (uint64_t)word + (uint64_t)voxdagi_popcount64(bit - 1);
+        uint32_t tri = c->owner[code], xyz[3];
+        double centre[3], bary[3];
+        uint8_t rgb[3];
+        unsigned k;
+        m ^= bit;
+        if (!have || tri != cached) voxdagi_load_tri(c->mesh, tri, &t);
+        cached = tri;
+        have = 1;
+        voxdag_morton_decode(code, &xyz[0], &xyz[1], &xyz[2]);
+        for (k = 0; k < 3; k++) centre[k] = (double)(clo[k] + xyz[k]) + 0.5;
+        voxdagi_tri_bary(&t, centre, bary);
+        c->mesh->color(c->mesh->user, tri, bary, rgb);
+        c->rgb[c->voxels++] = (uint32_t)rgb[0] << 16 | (uint32_t)rgb[1] << 8 | rgb[2];
+    }
+}
+
+/* Voxelizes the chunk's triangles (ascending, so a voxel's last owner is its
+   highest triangle), then collects its bricks and colours in Morton order,
+   clearing the bitmap. */
+static void *voxdagi_chunk_run(void *arg) {
+    voxdagi_chunk *c = (voxdagi_chunk *)arg;
+    int64_t clo[3];
+    uint32_t xyz[3];
+    size_t i, wu;
+    unsigned k;
+    voxdag_morton_decode(c->code, &xyz[0], &xyz[1], &xyz[2]);
+    for (k = 0; k < 3; k++) clo[k] = (int64_t)xyz[k] << c->shift;
+    for (i = 0; i < c->tri_count; i++) {
+        voxdagi_tri t;
+        voxdagi_axes x;
+        voxdagi_load_tri(c->mesh, c->tri[i], &t);
+        voxdagi_axes_init(&x, &t, 1.0);
+        voxdagi_chunk_tri(c, &t, &x, c->tri[i], clo);
+    }
+    c->bricks = c->voxels = 0;
+    for (wu = 0; wu < voxdagi_chunk_used_words(c); wu++)
+        while (c->used[wu]) {
+            uint64_t low = c->used[wu] & (0 - c->used[wu]);
+            size_t word = 64 * wu + (size_t)voxdagi_popcount64(low - 1);
+            uint64_t m = c->bits[word];
+            c->used[wu] ^= low;
+            c->bits[word] = 0;
+            if (c->failed || !voxdagi_grow(&c->b->mem, (void **)&c->brick, &c->brick_cap, c->bricks + 1, 16) ||
+                (c->owner && !voxdagi_grow(&c->b->mem, (void **)&c->rgb, &c->rgb_cap,
+                                           c->voxels + (size_t)voxdagi_popcount64(m), sizeof *c->rgb))) {
+                c->failed = 1;
+                continue;
+            }
+            c->brick[2 * c->bricks] = c->code << (3 * c->shift - 6) | word;
+            c->brick[2 * c->bricks + 1] = m;
+            c->bricks++;
+            if (c->owner) voxdagi_chunk_colors(c, clo, word, m);
+            else c->voxels += (size_t)voxdagi_popcount64(m);
+        }
+    return NULL;
+}
+
+/* Reduces a voxelized chunk's bricks and takes its colours. */
+static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk *c) {
+    voxdag_status st;
+    uint64_t m;
+    size_t i;
+    unsigned k;
+    if (c->failed) return VOXDAG_ERR_OUT_OF_MEMORY;
+    if (!c->bricks) return VOXDAG_OK;
+    if ((st = voxdagi_builder_colors(b, c->rgb, c->voxels)) != VOXDAG_OK) return st;
+    for (k = 0; k < b->red_count; k++) {
+        for (i = 0; i < c->bricks; i++) voxdagi_reducer_brick(&b->red[k], c->brick[2 * i], c->brick[2 * i + 1]);
+        if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
+    }
+    b->voxels += c->voxels;
+    m = c->brick[2 * c->bricks - 1];
+    for (k = 1; k < 64; k *= 2) m |= m >> k; /* the last voxel: the mask's highest bit */
+    b->last_code = c->brick[2 * c->bricks - 2] << 6 | (uint64_t)(voxdagi_popcount64(m) - 1);
+    b->any_reduced = 1;
+    if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) return VOXDAG_ERR_LIMIT;
+    return VOXDAG_OK;
+}
+
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
-    const unsigned chunk_want = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8;
-    const unsigned chunk_shift = b && b->levels < chunk_want ? b->levels : chunk_want;
+    unsigned shift = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8, t, k, jobs = 0;
     int64_t n, chunks;
     uint64_t *pair_chunk = NULL, *tmp_chunk = NULL;
     uint32_t *pair_tri = NULL, *tmp_tri = NULL;
-    size_t pairs = 0, cap = 0, cap2 = 0, i, p;
+    size_t pairs = 0, cap = 0, cap2 = 0, i = 0, p;
+    voxdagi_chunk chunk[VOXDAGI_MAX_THREADS];
     voxdag_status st = VOXDAG_OK;
     if (!b || !mesh || (mesh->triangle_count && (!mesh->indices || !mesh->positions)) ||
         (b->opts.colors && !mesh->color))
@@ -1837,32 +1993,37 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "meshes go into a builder without voxels");
     if (mesh->triangle_count > UINT32_MAX)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more than 2^32-1 triangles");
+    if (shift > 8) shift = 8;
+    if (shift > b->levels) shift = b->levels;
+    if (shift < 2) shift = 2;
     n = (int64_t)1 << b->levels;
-    chunks = n >> chunk_shift;
+    chunks = n >> shift;
     /* Bin: (chunk Morton code, triangle) for every chunk a triangle touches. */
     for (i = 0; i < mesh->triangle_count && st == VOXDAG_OK; i++) {
-        voxdagi_tri t;
+        voxdagi_tri tr;
+        voxdagi_axes x;
         int64_t first[3], last[3], cx, cy, cz;
-        unsigned k;
         int inside = 1;
-        if (!voxdagi_load_tri(mesh, i, &t)) {
+        if (!voxdagi_load_tri(mesh, i, &tr)) {
             st = VOXDAG_ERR_INVALID_ARGUMENT;
             break;
         }
         for (k = 0; k < 3 && inside; k++) {
-            inside = voxdagi_voxel_range(t.lo[k], t.hi[k], n, &first[k], &last[k]);
-            first[k] >>= chunk_shift;
-            last[k] >>= chunk_shift;
+            inside = voxdagi_voxel_range(tr.lo[k], tr.hi[k], n, &first[k], &last[k]);
+            first[k] >>= shift;
+            last[k] >>= shift;
         }
         if (!inside) continue;
+        voxdagi_axes_init(&x, &tr, (double)((int64_t)1 << shift));
         for (cz = first[2]; cz <= last[2]; cz++)
             for (cy = first[1]; cy <= last[1]; cy++)
                 for (cx = first[0]; cx <= last[0]; cx++) {
-                    double box[3];
-                    box[0] = (double)(cx << chunk_shift);
-                    box[1] = (double)(cy << chunk_shift);
-                    box[2] = (double)(cz << chunk_shift);
-                    if (!voxdagi_tri_box(&t, box, (double)((int64_t)1 << chunk_shift))) continue;
+                    double corner[3];
+                    corner[0] = (double)(cx << shift);
+                    corner[1] = (double)(cy << shift);
+                    corner[2] = (double)(cz << shift);
+                    for (k = 3; k < 13 && voxdagi_axes_test(&x, corner, k); k++) continue;
+                    if (k < 13) continue;
                     if (pairs == cap) {
                         size_t c1 = cap;
                         if (!voxdagi_grow(&b->mem, (void **)&pair_chunk, &c1, pairs + 1, sizeof *pair_chunk) ||
@@ -1879,7 +2040,7 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
                     pairs++;
                 }
     }
-    if (st == VOXDAG_OK && pairs) {
+    if (st == VOXDAG_OK && pairs) { /* stable: each chunk keeps its triangles ascending */
         tmp_chunk = (uint64_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_chunk);
         tmp_tri = (uint32_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_tri);
         if (tmp_chunk && tmp_tri) {
@@ -1892,33 +2053,30 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         voxdagi_free(&b->mem, tmp_chunk, pairs * sizeof *tmp_chunk);
         voxdagi_free(&b->mem, tmp_tri, pairs * sizeof *tmp_tri);
     }
-    /* Voxelize chunk by chunk in Morton order, reducing each chunk at once. */
+    /* Voxelize in rounds of one chunk per thread, then reduce the round's
+       chunks in Morton order. */
+    for (; jobs < b->threads && st == VOXDAG_OK && pairs; jobs++)
+        if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift)) st = VOXDAG_ERR_OUT_OF_MEMORY;
     for (p = 0; p < pairs && st == VOXDAG_OK;) {
-        uint64_t code = pair_chunk[p];
-        uint32_t cx, cy, cz;
-        int64_t clo[3], chi[3];
-        unsigned k;
-        voxdag_morton_decode(code, &cx, &cy, &cz);
-        clo[0] = (int64_t)cx << chunk_shift;
-        clo[1] = (int64_t)cy << chunk_shift;
-        clo[2] = (int64_t)cz << chunk_shift;
-        for (k = 0; k < 3; k++) chi[k] = clo[k] + ((int64_t)1 << chunk_shift);
-        for (; p < pairs && pair_chunk[p] == code; p++) {
-            voxdagi_tri t;
-            voxdagi_load_tri(mesh, pair_tri[p], &t);
-            if (!voxdagi_voxelize_tri(b, mesh, &t, pair_tri[p], clo, chi)) st = VOXDAG_ERR_OUT_OF_MEMORY;
+        for (t = 0; t < jobs && p < pairs; t++) {
+            chunk[t].code = pair_chunk[p];
+            chunk[t].tri = pair_tri + p;
+            for (chunk[t].tri_count = 0; p < pairs && pair_chunk[p] == chunk[t].code; p++) chunk[t].tri_count++;
         }
-        if (st == VOXDAG_OK) st = voxdagi_builder_reduce(b, 0);
-        if (b->opts.progress && (p == pairs || (p & 0xFFF) == 0))
+        voxdagi_run_parallel(voxdagi_chunk_run, chunk, sizeof *chunk, t);
+        for (k = 0; k < t && st == VOXDAG_OK; k++)
+            st = voxdagi_builder_take(b, &chunk[k]);
+        if (b->opts.progress)
             b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
     }
+    for (t = 0; t < jobs; t++) voxdagi_chunk_free(&chunk[t]);
     voxdagi_free(&b->mem, pair_chunk, cap * sizeof *pair_chunk);
     voxdagi_free(&b->mem, pair_tri, cap2 * sizeof *pair_tri);
     if (st == VOXDAG_ERR_INVALID_ARGUMENT)
         return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, (uint64_t)i);
     if (st != VOXDAG_OK) {
         b->failed = st;
-        return VOXDAGI_FAIL(err, st, "out of memory while voxelizing");
+        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
     }
     return voxdagi_ok(err);
 }
@@ -2681,7 +2839,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     voxdagi_layout_add(&lay, VOXDAG_SECTION_LEVELS, 0, (uint64_t)B * VOXDAG_FILE_LEVEL_ENTRY_SIZE);
     voxdagi_layout_add(&lay, VOXDAG_SECTION_NODES, 0, node_bytes + VOXDAG_FILE_NODE_PADDING);
     voxdagi_layout_add(&lay, VOXDAG_SECTION_BRICKS, 0, 8 * (uint64_t)r->store[B].n);
-    if (b->opts.colors) voxdagi_layout_add(&lay, VOXDAG_SECTION_COLORS_RGB8, 0, 3 * b->voxels);
+    if (b->opts.colors && !b->opts.color_sink) voxdagi_layout_add(&lay, VOXDAG_SECTION_COLORS_RGB8, 0, 3 * b->voxels);
     if (b->has_bounds) voxdagi_layout_add(&lay, VOXDAG_SECTION_BOUNDS, 0, 48);
     st = voxdagi_new_dag(&b->mem, &d);
     img = !voxdagi_layout_place(&lay) || st != VOXDAG_OK ? NULL
@@ -2696,7 +2854,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
                           voxdagi_layout_section(img, &lay, VOXDAG_SECTION_NODES),
                           voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BRICKS));
     voxdagi_encoder_free(&e);
-    if (b->opts.colors && b->voxels)
+    if (b->opts.colors && !b->opts.color_sink && b->voxels)
         memcpy(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_COLORS_RGB8), b->colors, 3 * (size_t)b->voxels);
     if (b->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), b->bounds);
     voxdagi_layout_seal(img, &lay, b->opts.no_symmetry ? 0 : VOXDAG_FILE_FLAG_SYMMETRIC, b->levels,
@@ -2723,6 +2881,7 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     }
     *out = NULL;
     st = b->failed ? b->failed : voxdagi_builder_reduce(b, 1);
+    if (st == VOXDAG_OK) st = voxdagi_builder_send_colors(b, (size_t)(b->voxels - b->colors_base), 0);
     if (st != VOXDAG_OK) {
         voxdag_builder_free(b);
         return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));

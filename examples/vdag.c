@@ -1,7 +1,7 @@
 /* vdag: build, inspect, query and render .vdag files.
 
    vdag build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E]
-              [--color-bits W|auto] [--threads T] [--stats]
+              [--color-bits W|auto] [--threads T] [--stats] [--no-colors]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -114,14 +114,24 @@ static int parse_double(const char *s, double *out) {
 typedef struct build_args {
     const char *in, *out;
     uint32_t levels, threads;
-    int no_symmetry, stats, compress;
+    int no_symmetry, no_colors, stats, compress;
     double color_error;
     uint32_t color_bits; /* 0: auto */
+    struct color_spill *spill;
+    double t0;              /* when the command started */
+    const char *last_stage; /* progress printed last */
+    int last_percent;
 } build_args;
 
+/* Prints a stage's progress when its whole percentage changes, with the
+   seconds since the command started. */
 static void progress(void *user, const char *stage, double fraction) {
-    (void)user;
-    fprintf(stderr, "vdag: %s %3.0f%%\n", stage, 100 * fraction);
+    build_args *a = (build_args *)user;
+    int percent = (int)(100 * fraction);
+    if (a->last_stage && !strcmp(a->last_stage, stage) && a->last_percent == percent) return;
+    a->last_stage = stage;
+    a->last_percent = percent;
+    fprintf(stderr, "vdag: %s %3d%% (%.1f s)\n", stage, percent, now_seconds() - a->t0);
 }
 
 /* Points to grid voxels: integer voxels as they are, point clouds and mesh
@@ -259,23 +269,51 @@ static void print_build_summary(const voxdag *dag, const voxdag_build_stats *st,
             (unsigned long long)info.color_bytes, (unsigned long long)info.file_bytes);
 }
 
-/* Replaces the RGB8 colour section of *DAG with a voxcolor stream. */
-static int compress_colors(voxdag **dag, const build_args *a) {
-    const void *rgb;
-    size_t size, bound, bytes;
+/* The builder's colours go to a temporary file as they are reduced (the
+   builder's memory then does not grow with them) and come back once the
+   geometry is done. */
+typedef struct color_spill {
+    FILE *f; /* NULL: the build has no colours */
+    uint64_t n;
+} color_spill;
+
+static int spill_colors(void *user, const uint8_t *rgb, size_t n) {
+    color_spill *s = (color_spill *)user;
+    s->n += n;
+    return fwrite(rgb, 3, n, s->f) != n;
+}
+
+/* Reads the spilled colours back and attaches them to *DAG: RGB8, or a
+   voxcolor stream when COMPRESS is set. */
+static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) {
+    size_t size = (size_t)(3 * spill->n), bound, bytes;
     voxcolor_encode_opts o;
-    uint8_t *buf;
+    uint8_t *rgb, *buf;
     voxdag *with = NULL;
     voxdag_error err;
     double t0 = now_seconds();
-    if (voxdag_colors(*dag, &rgb, &size) != VOXDAG_COLORS_RGB8) return 0;
+    rgb = (uint8_t *)malloc(size ? size : 1);
+    if (!rgb) return vdag_fail("out of memory for %llu colours", (unsigned long long)spill->n);
+    rewind(spill->f);
+    if (fread(rgb, 1, size, spill->f) != size) {
+        free(rgb);
+        return vdag_fail("cannot read back the colours");
+    }
+    if (!a->compress) {
+        int rc = voxdag_with_colors(*dag, VOXDAG_COLORS_RGB8, rgb, size, &with, &err) != VOXDAG_OK;
+        free(rgb);
+        if (rc) return vdag_fail("%s", err.message);
+        voxdag_free(*dag);
+        *dag = with;
+        return 0;
+    }
     memset(&o, 0, sizeof o);
     o.max_error = a->color_error;
     o.weight_bits = a->color_bits;
     bound = voxcolor_encode_bound(size / 3);
     buf = (uint8_t *)malloc(bound ? bound : 1);
-    if (!buf) return vdag_fail("out of memory");
-    bytes = voxcolor_encode(buf, bound, (const uint8_t *)rgb, size / 3, &o);
+    bytes = buf ? voxcolor_encode(buf, bound, rgb, size / 3, &o) : 0;
+    free(rgb);
     if (!bytes) {
         free(buf);
         return vdag_fail("colour compression failed");
@@ -293,17 +331,22 @@ static int compress_colors(voxdag **dag, const build_args *a) {
     return 0;
 }
 
-static voxdag_build_opts build_opts(const build_args *a, int colors, const double *bounds) {
-    voxdag_build_opts o;
-    memset(&o, 0, sizeof o);
-    o.levels = a->levels;
-    o.no_symmetry = a->no_symmetry;
-    o.colors = colors;
-    o.compare_structures = a->stats;
-    o.threads = a->threads;
-    o.bounds = bounds;
-    o.progress = progress;
-    return o;
+/* Options of a build; its colours, if any, go to A's spill file. */
+static int build_opts(build_args *a, int colors, const double *bounds, voxdag_build_opts *o) {
+    memset(o, 0, sizeof *o);
+    o->levels = a->levels;
+    o->no_symmetry = a->no_symmetry;
+    o->colors = colors;
+    o->compare_structures = a->stats;
+    o->threads = a->threads;
+    o->bounds = bounds;
+    o->progress = progress;
+    o->progress_user = a;
+    if (!colors) return 0;
+    if (!(a->spill->f = tmpfile())) return vdag_fail("build: cannot create a temporary file for the colours");
+    o->color_sink = spill_colors;
+    o->color_sink_user = a->spill;
+    return 0;
 }
 
 static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0);
@@ -314,15 +357,20 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     voxdag_builder *b = NULL;
     voxdag_mesh mesh;
     voxdag_error err;
-    int colors = sc->vertex_rgb || sc->material_count, rc;
+    int colors = !a->no_colors && (sc->vertex_rgb || sc->material_count), rc;
     if (!a->levels) a->levels = 10;
-    fprintf(stderr, "vdag: voxelizing %zu triangles into %u^3\n", sc->triangle_count, 1u << a->levels);
+    fprintf(stderr, "vdag: voxelizing %zu triangles into %u^3 (%.1f s)\n", sc->triangle_count, 1u << a->levels,
+            now_seconds() - t0);
     grid = mesh_to_grid(sc, a->levels, bounds);
     if (!grid) {
         vdag_scene_free(sc);
         return vdag_fail("out of memory");
     }
-    o = build_opts(a, colors, bounds);
+    if (build_opts(a, colors, bounds, &o)) {
+        free(grid);
+        vdag_scene_free(sc);
+        return 1;
+    }
     memset(&mesh, 0, sizeof mesh);
     mesh.positions = grid;
     mesh.vertex_count = sc->vertex_count;
@@ -343,6 +391,7 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
 
 static int cmd_build(int argc, char **argv) {
     build_args a;
+    color_spill spill;
     vdag_scene sc;
     char msg[256];
     voxdag_build_opts o;
@@ -353,6 +402,9 @@ static int cmd_build(int argc, char **argv) {
     size_t i;
     int k, rc;
     memset(&a, 0, sizeof a);
+    memset(&spill, 0, sizeof spill);
+    a.spill = &spill;
+    a.t0 = t0;
     a.threads = vdag_cpu_count();
     for (k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--levels") && k + 1 < argc) {
@@ -360,6 +412,8 @@ static int cmd_build(int argc, char **argv) {
                 return vdag_fail("build: --levels takes 2..%d", VOXDAG_MAX_LEVELS);
         } else if (!strcmp(argv[k], "--threads") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.threads) || !a.threads) return vdag_fail("build: --threads takes a count >= 1");
+        } else if (!strcmp(argv[k], "--no-colors")) {
+            a.no_colors = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
             a.no_symmetry = 1;
         } else if (!strcmp(argv[k], "--stats")) {
@@ -392,7 +446,12 @@ static int cmd_build(int argc, char **argv) {
         vdag_scene_free(&sc);
         return 1;
     }
-    o = build_opts(&a, sc.point_rgb != NULL, bounds);
+    rc = build_opts(&a, !a.no_colors && sc.point_rgb != NULL, bounds, &o);
+    if (rc) {
+        free(xyz);
+        vdag_scene_free(&sc);
+        return 1;
+    }
     rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
     for (i = 0; !rc && i < sc.point_count; i += 1u << 20) {
         size_t n = sc.point_count - i < (1u << 20) ? sc.point_count - i : (1u << 20);
@@ -410,13 +469,17 @@ static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxd
     voxdag *dag = NULL;
     voxdag_build_stats st;
     int rc = failed;
+    double seconds;
     if (!rc) rc = voxdag_builder_finish(b, &dag, &st, err) != VOXDAG_OK;
-    if (rc) return vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
-    print_build_summary(dag, &st, now_seconds() - t0);
-    if (a->compress && compress_colors(&dag, a)) {
+    seconds = now_seconds() - t0;
+    if (!rc && a->spill->f) rc = attach_colors(&dag, a->spill, a);
+    else if (rc) vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
+    if (a->spill->f) fclose(a->spill->f);
+    if (rc) {
         voxdag_free(dag);
         return 1;
     }
+    print_build_summary(dag, &st, seconds);
     rc = voxdag_save_file(dag, a->out, err) != VOXDAG_OK;
     voxdag_free(dag);
     if (rc) return vdag_fail("%s: %s", a->out, err->message);
@@ -572,7 +635,7 @@ static int cmd_gen(int argc, char **argv) {
 static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...\n"
           "  build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E] [--color-bits W|auto]\n"
-          "                    [--threads T] [--stats]\n"
+          "                    [--threads T] [--stats] [--no-colors]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z\n"

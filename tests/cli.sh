@@ -90,6 +90,10 @@ check "lossless colours exact" cmp -s "$T/export_l" "$T/expected_export"
 check "build --no-symmetry" "$VDAG" build "$T/in.xyz" "$T/n.vdag" --levels 5 --no-symmetry 2>/dev/null
 "$VDAG" export-voxels "$T/n.vdag" >"$T/export_n" 2>/dev/null
 check "plain SVDAG exports the same voxels" cmp -s "$T/export_n" "$T/expected_export"
+check "build --no-colors" "$VDAG" build "$T/in.xyz" "$T/g.vdag" --levels 5 --no-colors 2>/dev/null
+cut -d' ' -f1-3 "$T/expected_export" >"$T/expected_xyz"
+check "--no-colors keeps the voxels, drops the colours" sh -c "'$VDAG' info '$T/g.vdag' | grep -q 'colours *none' &&
+    '$VDAG' export-voxels '$T/g.vdag' 2>/dev/null | cut -d' ' -f1-3 | cmp -s - '$T/expected_xyz'"
 check "thread count does not change the file" sh -c "'$VDAG' build '$T/in.xyz' '$T/t1.vdag' --levels 5 --threads 1 2>/dev/null &&
     '$VDAG' build '$T/in.xyz' '$T/t3.vdag' --levels 5 --threads 3 2>/dev/null && cmp -s '$T/t1.vdag' '$T/a.vdag' && cmp -s '$T/t3.vdag' '$T/a.vdag'"
 

@@ -454,6 +454,93 @@ static void test_streaming_chunks(void) {
     scene_free(&s);
 }
 
+/* A colour sink gets the colours in voxel-index order, also when a flush
+   starts by repeating the last voxel with a new colour: attaching them to the
+   sink's colourless DAG gives the file built without a sink. A failing sink
+   fails the build. */
+typedef struct sink_buf {
+    uint8_t *rgb;
+    size_t n, fail_at;
+} sink_buf;
+
+static int sink_collect(void *user, const uint8_t *rgb, size_t n) {
+    sink_buf *s = (sink_buf *)user;
+    if (s->n + n > s->fail_at) return 1;
+    memcpy(s->rgb + 3 * s->n, rgb, 3 * n);
+    s->n += n;
+    return 0;
+}
+
+static voxdag_status build_streamed(const scene *s, const morton_voxel *sorted, size_t count, sink_buf *sink,
+                                    voxdag **out) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    size_t i;
+    memset(&o, 0, sizeof o);
+    o.levels = 7;
+    o.colors = 1;
+    o.threads = 2;
+    if (sink) {
+        o.color_sink = sink_collect;
+        o.color_sink_user = sink;
+    }
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    for (i = 0; i < count; i++) {
+        size_t c = sorted[i].cell;
+        uint32_t xyz[3];
+        uint8_t again[3];
+        xyz[0] = (uint32_t)(c % s->n);
+        xyz[1] = (uint32_t)(c / s->n % s->n);
+        xyz[2] = (uint32_t)(c / s->n / s->n);
+        CHECK(voxdag_builder_add(b, xyz, s->rgb + 3 * c, 1, NULL) == VOXDAG_OK);
+        if (i + 1 < count && sorted[i].code >> 9 != sorted[i + 1].code >> 9) {
+            voxdag_status st = voxdag_builder_flush(b, NULL);
+            if (st != VOXDAG_OK) {
+                voxdag_builder_free(b);
+                return st;
+            }
+            again[0] = (uint8_t)~s->rgb[3 * c]; /* the same voxel again: its colour changes */
+            again[1] = (uint8_t)(i * 7);
+            again[2] = 1;
+            CHECK(voxdag_builder_add(b, xyz, again, 1, NULL) == VOXDAG_OK);
+        }
+    }
+    return voxdag_builder_finish(b, out, NULL, NULL);
+}
+
+static void test_color_sink(void) {
+    scene s = make_scene(SC_SPHERE, 7, 6);
+    morton_voxel *sorted;
+    size_t count = sorted_voxels(&s, &sorted), size0, size1;
+    voxdag *ref = NULL, *d = NULL, *with = NULL;
+    sink_buf sink;
+    voxdag_info info;
+    CHECK(build_streamed(&s, sorted, count, NULL, &ref) == VOXDAG_OK);
+    sink.rgb = (uint8_t *)malloc(3 * count + 1);
+    sink.n = 0;
+    sink.fail_at = (size_t)-1;
+    CHECK(build_streamed(&s, sorted, count, &sink, &d) == VOXDAG_OK);
+    if (ref && d) {
+        const void *a, *c;
+        voxdag_get_info(d, &info);
+        CHECK(info.voxels == count && sink.n == count && info.color_kind == VOXDAG_COLORS_NONE);
+        CHECK(voxdag_with_colors(d, VOXDAG_COLORS_RGB8, sink.rgb, 3 * sink.n, &with, NULL) == VOXDAG_OK);
+        a = voxdag_image(ref, &size0);
+        c = with ? voxdag_image(with, &size1) : NULL;
+        CHECK(c && size0 == size1 && !memcmp(a, c, size0));
+    }
+    sink.n = 0;
+    sink.fail_at = count / 2;
+    voxdag_free(d);
+    d = NULL;
+    CHECK(build_streamed(&s, sorted, count, &sink, &d) == VOXDAG_ERR_IO && !d);
+    voxdag_free(with);
+    voxdag_free(ref);
+    free(sink.rgb);
+    free(sorted);
+    scene_free(&s);
+}
+
 /* Build -> image -> load (validated) -> the same answers. */
 static void test_load_roundtrip(void) {
     int kind;
@@ -652,6 +739,7 @@ const test_case test_core_cases[] = {
     {"core/mirrored_blob_merges", test_mirrored_blob_merges},
     {"core/determinism", test_determinism},
     {"core/streaming_chunks", test_streaming_chunks},
+    {"core/color_sink", test_color_sink},
     {"core/load_roundtrip", test_load_roundtrip},
     {"core/bad_arguments", test_bad_arguments},
     {"core/allocation_failures", test_allocation_failures},

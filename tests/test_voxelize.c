@@ -100,6 +100,49 @@ static void random_tris(uint64_t *r, uint32_t n, size_t count, itri *out) {
     }
 }
 
+/* Colours collected by a colour sink. */
+typedef struct sink_buf {
+    uint8_t *rgb;
+    size_t n, cap;
+} sink_buf;
+
+static int sink_collect(void *user, const uint8_t *rgb, size_t n) {
+    sink_buf *s = (sink_buf *)user;
+    if (s->n + n > s->cap) return 1;
+    memcpy(s->rgb + 3 * s->n, rgb, 3 * n);
+    s->n += n;
+    return 0;
+}
+
+/* The same mesh through a colour sink: the sink's colours attached to its
+   colourless DAG give REF's file. */
+static void check_sink(const voxdag_build_opts *opts, const voxdag_mesh *mesh, const voxdag *ref) {
+    voxdag_build_opts o = *opts;
+    voxdag_builder *b;
+    voxdag *d = NULL, *with = NULL;
+    voxdag_info info;
+    sink_buf sink;
+    size_t size0, size1 = 0;
+    const void *img0, *img1 = NULL;
+    voxdag_get_info(ref, &info);
+    sink.cap = (size_t)info.voxels;
+    sink.rgb = (uint8_t *)malloc(3 * sink.cap + 1);
+    sink.n = 0;
+    o.color_sink = sink_collect;
+    o.color_sink_user = &sink;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, mesh, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    CHECK(d && sink.n == sink.cap &&
+          voxdag_with_colors(d, VOXDAG_COLORS_RGB8, sink.rgb, 3 * sink.n, &with, NULL) == VOXDAG_OK);
+    img0 = voxdag_image(ref, &size0);
+    if (with) img1 = voxdag_image(with, &size1);
+    CHECK(img1 && size0 == size1 && !memcmp(img0, img1, size0));
+    voxdag_free(with);
+    voxdag_free(d);
+    free(sink.rgb);
+}
+
 static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t count, uint64_t seed) {
     uint32_t n = 1u << levels, x, y, z;
     uint64_t r = seed;
@@ -134,6 +177,7 @@ static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t co
     CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
     CHECK(voxdag_builder_add_mesh(b, &mesh, NULL) == VOXDAG_OK);
     CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    if (d) check_sink(&o, &mesh, d);
     for (z = 0; d && z < n; z++)
         for (y = 0; y < n; y++)
             for (x = 0; x < n; x++) {
