@@ -1229,23 +1229,54 @@ VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
     voxdagi_mem_destroy(&mem);
 }
 
-/* Runs FN on COUNT jobs (an array of SIZE-byte elements), one thread each;
-   the calling thread takes job 0 and any job a thread could not start for. */
-static void voxdagi_run_parallel(void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+/* Threads running FN on jobs FIRST..COUNT-1 of an array of SIZE-byte
+   elements, one each, while the calling thread does other work. Without
+   threads (or when one cannot start) the join runs the jobs itself. */
+typedef struct voxdagi_team {
 #ifndef VOXDAG_NO_THREADS
     pthread_t tid[VOXDAGI_MAX_THREADS];
     int started[VOXDAGI_MAX_THREADS];
-    unsigned t;
-    for (t = 1; t < count; t++) started[t] = pthread_create(&tid[t], NULL, fn, (char *)jobs + t * size) == 0;
-    fn(jobs);
-    for (t = 1; t < count; t++) {
-        if (started[t]) pthread_join(tid[t], NULL);
-        else fn((char *)jobs + t * size);
-    }
-#else
-    unsigned t;
-    for (t = 0; t < count; t++) fn((char *)jobs + t * size);
 #endif
+    void *(*fn)(void *);
+    char *jobs;
+    size_t size;
+    unsigned first, count;
+} voxdagi_team;
+
+static void voxdagi_team_start(voxdagi_team *tm, void *(*fn)(void *), void *jobs, size_t size, unsigned first,
+                               unsigned count) {
+    unsigned t;
+    tm->fn = fn;
+    tm->jobs = (char *)jobs;
+    tm->size = size;
+    tm->first = first;
+    tm->count = count;
+    for (t = first; t < count; t++) {
+#ifndef VOXDAG_NO_THREADS
+        tm->started[t] = pthread_create(&tm->tid[t], NULL, fn, tm->jobs + t * size) == 0;
+#endif
+    }
+}
+
+static void voxdagi_team_join(voxdagi_team *tm) {
+    unsigned t;
+    for (t = tm->first; t < tm->count; t++) {
+#ifndef VOXDAG_NO_THREADS
+        if (tm->started[t]) {
+            pthread_join(tm->tid[t], NULL);
+            continue;
+        }
+#endif
+        tm->fn(tm->jobs + t * tm->size);
+    }
+}
+
+/* Runs FN on COUNT jobs, one thread each; the calling thread takes job 0. */
+static void voxdagi_run_parallel(void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+    voxdagi_team tm;
+    voxdagi_team_start(&tm, fn, jobs, size, 1, count);
+    if (count) fn(jobs);
+    voxdagi_team_join(&tm);
 }
 
 /* Morton encoding and checks of voxels [begin, end) of an add call. */
@@ -1955,6 +1986,19 @@ static void *voxdagi_chunk_run(void *arg) {
     return NULL;
 }
 
+/* Gives the next chunks of the sorted (chunk, triangle) pairs from *P on to
+   up to COUNT workspaces; returns how many got one. */
+static unsigned voxdagi_chunk_assign(voxdagi_chunk *c, unsigned count, const uint64_t *pair_chunk,
+                                     const uint32_t *pair_tri, size_t pairs, size_t *p) {
+    unsigned t;
+    for (t = 0; t < count && *p < pairs; t++) {
+        c[t].code = pair_chunk[*p];
+        c[t].tri = pair_tri + *p;
+        for (c[t].tri_count = 0; *p < pairs && pair_chunk[*p] == c[t].code; ++*p) c[t].tri_count++;
+    }
+    return t;
+}
+
 /* Reduces a voxelized chunk's bricks and takes its colours. */
 static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk *c) {
     voxdag_status st;
@@ -1978,12 +2022,12 @@ static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk
 }
 
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
-    unsigned shift = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8, t, k, jobs = 0;
+    unsigned shift = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8, t, k, jobs = 0, sets, cur = 0;
     int64_t n, chunks;
     uint64_t *pair_chunk = NULL, *tmp_chunk = NULL;
     uint32_t *pair_tri = NULL, *tmp_tri = NULL;
     size_t pairs = 0, cap = 0, cap2 = 0, i = 0, p;
-    voxdagi_chunk chunk[VOXDAGI_MAX_THREADS];
+    voxdagi_chunk chunk[2 * VOXDAGI_MAX_THREADS];
     voxdag_status st = VOXDAG_OK;
     if (!b || !mesh || (mesh->triangle_count && (!mesh->indices || !mesh->positions)) ||
         (b->opts.colors && !mesh->color))
@@ -2053,21 +2097,33 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         voxdagi_free(&b->mem, tmp_chunk, pairs * sizeof *tmp_chunk);
         voxdagi_free(&b->mem, tmp_tri, pairs * sizeof *tmp_tri);
     }
-    /* Voxelize in rounds of one chunk per thread, then reduce the round's
-       chunks in Morton order. */
-    for (; jobs < b->threads && st == VOXDAG_OK && pairs; jobs++)
+    /* Voxelize in rounds of one chunk per thread and reduce each round's
+       chunks in Morton order; with threads, while the next round runs. */
+    sets = b->threads > 1 ? 2 : 1;
+    for (; jobs < sets * b->threads && st == VOXDAG_OK && pairs; jobs++)
         if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift)) st = VOXDAG_ERR_OUT_OF_MEMORY;
-    for (p = 0; p < pairs && st == VOXDAG_OK;) {
-        for (t = 0; t < jobs && p < pairs; t++) {
-            chunk[t].code = pair_chunk[p];
-            chunk[t].tri = pair_tri + p;
-            for (chunk[t].tri_count = 0; p < pairs && pair_chunk[p] == chunk[t].code; p++) chunk[t].tri_count++;
+    p = 0;
+    t = st == VOXDAG_OK ? voxdagi_chunk_assign(chunk, b->threads, pair_chunk, pair_tri, pairs, &p) : 0;
+    voxdagi_run_parallel(voxdagi_chunk_run, chunk, sizeof *chunk, t);
+    while (t) { /* chunk[cur..cur + t) are voxelized */
+        voxdagi_chunk *next = sets == 2 ? chunk + (b->threads - cur) : chunk;
+        unsigned m = 0;
+        voxdagi_team tm;
+        if (sets == 2) {
+            m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
+            voxdagi_team_start(&tm, voxdagi_chunk_run, next, sizeof *chunk, 0, st == VOXDAG_OK ? m : 0);
         }
-        voxdagi_run_parallel(voxdagi_chunk_run, chunk, sizeof *chunk, t);
-        for (k = 0; k < t && st == VOXDAG_OK; k++)
-            st = voxdagi_builder_take(b, &chunk[k]);
+        for (k = 0; k < t && st == VOXDAG_OK; k++) st = voxdagi_builder_take(b, &chunk[cur + k]);
+        if (sets == 2) {
+            voxdagi_team_join(&tm);
+        } else if (st == VOXDAG_OK) {
+            m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
+            voxdagi_run_parallel(voxdagi_chunk_run, next, sizeof *chunk, m);
+        }
         if (b->opts.progress)
             b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
+        cur = (unsigned)(next - chunk);
+        t = st == VOXDAG_OK ? m : 0;
     }
     for (t = 0; t < jobs; t++) voxdagi_chunk_free(&chunk[t]);
     voxdagi_free(&b->mem, pair_chunk, cap * sizeof *pair_chunk);

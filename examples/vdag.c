@@ -283,49 +283,85 @@ static int spill_colors(void *user, const uint8_t *rgb, size_t n) {
     return fwrite(rgb, 3, n, s->f) != n;
 }
 
-/* Reads the spilled colours back and attaches them to *DAG: RGB8, or a
-   voxcolor stream when COMPRESS is set. */
-static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) {
-    size_t size = (size_t)(3 * spill->n), bound, bytes;
+/* A voxcolor stream written into a buffer that grows. */
+typedef struct grow_buf {
+    uint8_t *data;
+    size_t size, cap;
+} grow_buf;
+
+static int write_grow(void *user, uint64_t offset, const void *bytes, size_t size) {
+    grow_buf *g = (grow_buf *)user;
+    uint64_t end = offset + size;
+    if (end > g->cap) {
+        size_t cap = g->cap ? g->cap : 1u << 20;
+        uint8_t *p;
+        while (cap < end) cap *= 2;
+        if (!(p = (uint8_t *)realloc(g->data, cap))) return 0;
+        g->data = p;
+        g->cap = cap;
+    }
+    memcpy(g->data + offset, bytes, size);
+    if (end > g->size) g->size = (size_t)end;
+    return 1;
+}
+
+/* Compresses the spilled colours, read back a slice at a time, into G. */
+static int encode_spill(FILE *f, uint64_t n, const build_args *a, grow_buf *g) {
+    enum { SLICE = 1 << 20 };
     voxcolor_encode_opts o;
-    uint8_t *rgb, *buf;
-    voxdag *with = NULL;
-    voxdag_error err;
-    double t0 = now_seconds();
-    rgb = (uint8_t *)malloc(size ? size : 1);
-    if (!rgb) return vdag_fail("out of memory for %llu colours", (unsigned long long)spill->n);
-    rewind(spill->f);
-    if (fread(rgb, 1, size, spill->f) != size) {
-        free(rgb);
-        return vdag_fail("cannot read back the colours");
-    }
-    if (!a->compress) {
-        int rc = voxdag_with_colors(*dag, VOXDAG_COLORS_RGB8, rgb, size, &with, &err) != VOXDAG_OK;
-        free(rgb);
-        if (rc) return vdag_fail("%s", err.message);
-        voxdag_free(*dag);
-        *dag = with;
-        return 0;
-    }
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    uint8_t *rgb = (uint8_t *)malloc(3 * SLICE);
+    uint64_t done = 0;
+    int ok = enc && rgb;
     memset(&o, 0, sizeof o);
     o.max_error = a->color_error;
     o.weight_bits = a->color_bits;
-    bound = voxcolor_encode_bound(size / 3);
-    buf = (uint8_t *)malloc(bound ? bound : 1);
-    bytes = buf ? voxcolor_encode(buf, bound, rgb, size / 3, &o) : 0;
+    if (ok) voxcolor_encoder_init(enc, n, &o, write_grow, g);
+    while (ok && done < n) {
+        size_t k = n - done < SLICE ? (size_t)(n - done) : SLICE;
+        ok = fread(rgb, 3, k, f) == k && voxcolor_encoder_push(enc, rgb, k);
+        done += k;
+    }
+    ok = ok && voxcolor_encoder_finish(enc) == g->size;
+    free(enc);
     free(rgb);
-    if (!bytes) {
-        free(buf);
-        return vdag_fail("colour compression failed");
+    return ok;
+}
+
+/* Reads the spilled colours back and attaches them to *DAG: RGB8, or a
+   voxcolor stream when COMPRESS is set (encoded as it is read, so only the
+   stream is held). */
+static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) {
+    uint64_t size = 3 * spill->n;
+    voxdag *with = NULL;
+    voxdag_error err;
+    double t0 = now_seconds();
+    int rc;
+    rewind(spill->f);
+    if (!a->compress) {
+        uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
+        if (!rgb) return vdag_fail("out of memory for %llu colours", (unsigned long long)spill->n);
+        if (fread(rgb, 1, (size_t)size, spill->f) != size) {
+            free(rgb);
+            return vdag_fail("cannot read back the colours");
+        }
+        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &with, &err) != VOXDAG_OK;
+        free(rgb);
+    } else {
+        grow_buf g;
+        memset(&g, 0, sizeof g);
+        if (!encode_spill(spill->f, spill->n, a, &g)) {
+            free(g.data);
+            return vdag_fail("colour compression failed (out of memory or the colours cannot be read back)");
+        }
+        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
+        free(g.data);
+        if (!rc)
+            fprintf(stderr, "vdag: colours %llu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g) in %.2f s\n",
+                    (unsigned long long)size, g.size, size ? 100.0 * (double)g.size / (double)size : 0.0,
+                    size ? 24.0 * (double)g.size / (double)size : 0.0, a->color_error, now_seconds() - t0);
     }
-    if (voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, buf, bytes, &with, &err) != VOXDAG_OK) {
-        free(buf);
-        return vdag_fail("%s", err.message);
-    }
-    fprintf(stderr, "vdag: colours %zu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g) in %.2f s\n", size, bytes,
-            size ? 100.0 * (double)bytes / (double)size : 0.0, size ? 24.0 * (double)bytes / (double)size : 0.0,
-            a->color_error, now_seconds() - t0);
-    free(buf);
+    if (rc) return vdag_fail("%s", err.message);
     voxdag_free(*dag);
     *dag = with;
     return 0;
