@@ -906,6 +906,11 @@ static void voxcolori_quantize(const int64_t v[3], unsigned precision, unsigned 
         unsigned b = voxcolori_channel_bits(c, precision), top = (1u << b) - 1;
         int64_t x = v[c];
         unsigned k = (unsigned)((x * top + 255 * 128) / (255 * 256));
+        /* 8 bits: k is round(x / 256) and exact. */
+        if (precision) {
+            q[c] = e[c] = k;
+            continue;
+        }
         /* Bit replication is not uniform: the next code may be nearer. */
         if (k < top && 256 * (int64_t)voxcolori_expand(k + 1, b) - x < x - 256 * (int64_t)voxcolori_expand(k, b)) k++;
         else if (k && x - 256 * (int64_t)voxcolori_expand(k - 1, b) < 256 * (int64_t)voxcolori_expand(k, b) - x) k--;
@@ -923,7 +928,7 @@ static void voxcolori_mix(const unsigned e0[3], const unsigned e1[3], unsigned w
 
 /* The weight index whose interpolation point is nearest to C's projection
    onto the endpoint segment. */
-static unsigned voxcolori_project(const voxcolori_fit *f, const uint8_t c[3]) {
+static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_project(const voxcolori_fit *f, const uint8_t c[3]) {
     unsigned top = (1u << f->mode) - 1, k;
     int dot = ((int)c[0] - (int)f->e0[0]) * f->d[0] + ((int)c[1] - (int)f->e0[1]) * f->d[1] +
               ((int)c[2] - (int)f->e0[2]) * f->d[2];
@@ -939,6 +944,17 @@ static unsigned voxcolori_project(const voxcolori_fit *f, const uint8_t c[3]) {
     return k;
 }
 
+/* Squared RGB distance from C of the colour weight index K of F (mode > 0)
+   decodes to: voxcolori_mix with the channels written out. */
+static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_mix_dist2(const voxcolori_fit *f, unsigned k,
+                                                            const uint8_t c[3]) {
+    int t = voxcolori_weights[f->mode][k];
+    int d0 = ((64 * (int)f->e0[0] + f->d[0] * t + 32) >> 6) - c[0];
+    int d1 = ((64 * (int)f->e0[1] + f->d[1] * t + 32) >> 6) - c[1];
+    int d2 = ((64 * (int)f->e0[2] + f->d[2] * t + 32) >> 6) - c[2];
+    return (uint32_t)(d0 * d0 + d1 * d1 + d2 * d2);
+}
+
 /* The weight index decoding closest (in RGB) to C, and that decoded colour:
    the projection or a neighbour (the 64ths are not evenly spaced). */
 static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8_t out[3]) {
@@ -947,37 +963,52 @@ static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8
     lo = k ? k - 1 : 0;
     hi = k < top ? k + 1 : top;
     for (k = lo; k <= hi; k++) {
-        uint8_t m[3];
-        uint32_t err;
-        voxcolori_mix(f->e0, f->e1, f->mode, k, m);
-        err = voxcolori_dist2(c, m);
-        if (err < best_err) best_err = err, best = k, memcpy(out, m, 3);
+        uint32_t err = voxcolori_mix_dist2(f, k, c);
+        if (err < best_err) best_err = err, best = k;
     }
+    voxcolori_mix(f->e0, f->e1, f->mode, best, out);
     return best;
 }
 
 /* 1 when colour C decodes within the bound under fit F. */
-static int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f, const uint8_t c[3]) {
+static VOXCOLORI_ALWAYS_INLINE int voxcolori_fits(const voxcolori_enc *e, const voxcolori_fit *f,
+                                                  const uint8_t c[3]) {
     uint8_t d[3];
+    if (!e->lab) {
+        unsigned k, top = (1u << f->mode) - 1;
+        int d0 = (int)f->e0[0] - c[0], d1 = (int)f->e0[1] - c[1], d2 = (int)f->e0[2] - c[2];
+        if (f->mode == 0) return (uint32_t)(d0 * d0 + d1 * d1 + d2 * d2) <= e->thr2;
+        /* The pick (the nearest of the projection's weight and its two
+           neighbours) fits when any of the three does: the projection first. */
+        k = voxcolori_project(f, c);
+        if (voxcolori_mix_dist2(f, k, c) <= e->thr2) return 1;
+        if (k && voxcolori_mix_dist2(f, k - 1, c) <= e->thr2) return 1;
+        return k < top && voxcolori_mix_dist2(f, k + 1, c) <= e->thr2;
+    }
     if (f->mode == 0) {
         d[0] = (uint8_t)f->e0[0];
         d[1] = (uint8_t)f->e0[1];
         d[2] = (uint8_t)f->e0[2];
-        return voxcolori_close(e, c, d);
+    } else {
+        voxcolori_pick(f, c, d);
     }
-    /* In RGB the pick (the nearest of the projection's weight and its two
-       neighbours) fits when any of the three does: the projection first. */
-    if (!e->lab) {
-        unsigned k = voxcolori_project(f, c), top = (1u << f->mode) - 1;
-        voxcolori_mix(f->e0, f->e1, f->mode, k, d);
-        if (voxcolori_dist2(c, d) <= e->thr2) return 1;
-        if (k) voxcolori_mix(f->e0, f->e1, f->mode, k - 1, d);
-        if (k && voxcolori_dist2(c, d) <= e->thr2) return 1;
-        if (k < top) voxcolori_mix(f->e0, f->e1, f->mode, k + 1, d);
-        return k < top && voxcolori_dist2(c, d) <= e->thr2;
-    }
-    voxcolori_pick(f, c, d);
     return voxcolori_close(e, c, d);
+}
+
+/* 1 when no line passes within R of the three colours P (R^2 = line64 / 64,
+   RGB metric): when their triangle's area A and longest side L have
+   A / L > R, i.e. |cross|^2 > 4 R^2 L^2. No block with weights can then
+   hold all three. */
+static int voxcolori_off_line(const voxcolori_enc *e, const uint8_t *p) {
+    int64_t u0 = p[3] - p[0], u1 = p[4] - p[1], u2 = p[5] - p[2];
+    int64_t v0 = p[6] - p[0], v1 = p[7] - p[1], v2 = p[8] - p[2];
+    int64_t w0 = v0 - u0, w1 = v1 - u1, w2 = v2 - u2;
+    int64_t x0 = u1 * v2 - u2 * v1, x1 = u2 * v0 - u0 * v2, x2 = u0 * v1 - u1 * v0;
+    int64_t l2 = u0 * u0 + u1 * u1 + u2 * u2, m2 = v0 * v0 + v1 * v1 + v2 * v2;
+    if (m2 > l2) l2 = m2;
+    m2 = w0 * w0 + w1 * w1 + w2 * w2;
+    if (m2 > l2) l2 = m2;
+    return 16 * (x0 * x0 + x1 * x1 + x2 * x2) > (int64_t)e->line64 * l2;
 }
 
 /* 1 when no block of MODE can hold N colours whose covariance times N^2 is
@@ -993,28 +1024,10 @@ static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, int64_
     size_t i;
     if (mode == 0) return tr > (int64_t)e->thr2 * n2;
     if (n <= 2) return 0;
-    /* No line passes within R of three colours whose triangle has area A and
-       longest side L when A / L > R: |cross|^2 > 4 R^2 L^2 (R^2 = line64 /
-       64). Short windows only (longer ones are refits of blocks that mostly
+    /* Short windows only (longer ones are refits of blocks that mostly
        pass). */
-    for (i = 0; i + 2 < n && n <= 8; i++) {
-        const uint8_t *p = rgb + 3 * i;
-        int64_t u[3], v[3], w[3], x[3], l2, m2;
-        for (a = 0; a < 3; a++) {
-            u[a] = (int64_t)p[3 + a] - p[a];
-            v[a] = (int64_t)p[6 + a] - p[a];
-            w[a] = v[a] - u[a];
-        }
-        x[0] = u[1] * v[2] - u[2] * v[1];
-        x[1] = u[2] * v[0] - u[0] * v[2];
-        x[2] = u[0] * v[1] - u[1] * v[0];
-        l2 = u[0] * u[0] + u[1] * u[1] + u[2] * u[2];
-        m2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        if (m2 > l2) l2 = m2;
-        m2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
-        if (m2 > l2) l2 = m2;
-        if (16 * (x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) > (int64_t)e->line64 * l2) return 1;
-    }
+    for (i = 0; i + 2 < n && n <= 8; i++)
+        if (voxcolori_off_line(e, rgb + 3 * i)) return 1;
     /* trace - R^2 > Frobenius norm, in 64 N^2 units, squares taken after
        dropping low bits so that nothing overflows. */
     tr = 64 * tr - (int64_t)e->line64 * n2;
@@ -1037,9 +1050,10 @@ static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, int64_
 /* Scales direction V (not all zero) so that its largest component has 15
    bits: the power iteration's products then stay below 2^53. */
 static void voxcolori_normalize(int64_t v[3]) {
-    int64_t m = 0;
-    unsigned a, bits = 0, k;
-    for (a = 0; a < 3; a++) m = v[a] > m ? v[a] : -v[a] > m ? -v[a] : m;
+    int64_t a0 = v[0] < 0 ? -v[0] : v[0], a1 = v[1] < 0 ? -v[1] : v[1], a2 = v[2] < 0 ? -v[2] : v[2];
+    int64_t m = a0 > a1 ? a0 : a1;
+    unsigned bits = 0, k;
+    m = m > a2 ? m : a2;
     if (!m) {
         v[0] = v[1] = v[2] = 1 << 14;
         return;
@@ -1052,16 +1066,40 @@ static void voxcolori_normalize(int64_t v[3]) {
         if (m >> (bits + k)) bits += k;
 #endif
     /* m has bits + 1 bits. */
-    for (a = 0; a < 3; a++) {
-        int64_t x = v[a] < 0 ? -v[a] : v[a];
-        x = bits > 14 ? x >> (bits - 14) : x << (14 - bits);
-        v[a] = v[a] < 0 ? -x : x;
+    if (bits > 14) {
+        a0 >>= bits - 14, a1 >>= bits - 14, a2 >>= bits - 14;
+    } else {
+        a0 <<= 14 - bits, a1 <<= 14 - bits, a2 <<= 14 - bits;
     }
+    v[0] = v[0] < 0 ? -a0 : a0;
+    v[1] = v[1] < 0 ? -a1 : a1;
+    v[2] = v[2] < 0 ? -a2 : a2;
 }
 
 /* NUM / DEN rounded to the nearest integer, DEN > 0. */
 static int64_t voxcolori_div_round(int64_t num, int64_t den) {
     return num >= 0 ? (num + den / 2) / den : -((den / 2 - num) / den);
+}
+
+/* The channel sums S of the N colours RGB and N^2 times their covariance C
+   (below 2^37). The sums fit 32 bits: at most 1024 colours of 255^2. */
+static void voxcolori_moments(const uint8_t *rgb, size_t n, int64_t s[3], int64_t c[3][3]) {
+    uint32_t s0 = 0, s1 = 0, s2 = 0, q00 = 0, q01 = 0, q02 = 0, q11 = 0, q12 = 0, q22 = 0;
+    int64_t nn = (int64_t)n;
+    size_t i;
+    for (i = 0; i < n; i++, rgb += 3) {
+        uint32_t r = rgb[0], g = rgb[1], b = rgb[2];
+        s0 += r, s1 += g, s2 += b;
+        q00 += r * r, q01 += r * g, q02 += r * b;
+        q11 += g * g, q12 += g * b, q22 += b * b;
+    }
+    s[0] = s0, s[1] = s1, s[2] = s2;
+    c[0][0] = nn * q00 - s[0] * s[0];
+    c[1][1] = nn * q11 - s[1] * s[1];
+    c[2][2] = nn * q22 - s[2] * s[2];
+    c[0][1] = c[1][0] = nn * q01 - s[0] * s[1];
+    c[0][2] = c[2][0] = nn * q02 - s[0] * s[2];
+    c[1][2] = c[2][1] = nn * q12 - s[1] * s[2];
 }
 
 /* Chooses endpoints for the N colours RGB; returns 0 when no block of F's
@@ -1071,21 +1109,11 @@ static int64_t voxcolori_div_round(int64_t num, int64_t den) {
    All in integers, so that the stream does not depend on floating point. */
 static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                    voxcolori_fit *f) {
-    int64_t s[3] = {0, 0, 0}, ss[3][3], c[3][3], v[3], w[3], lo[3], hi[3], tmin = 0, tmax = 0, vv;
+    int64_t s[3], c[3][3], v[3], w[3], lo[3], hi[3], tmin = 0, tmax = 0, vv;
     int64_t nn = (int64_t)n;
-    unsigned a, b, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
+    unsigned a, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
     size_t i;
-    memset(ss, 0, sizeof ss);
-    for (i = 0; i < n; i++) {
-        const uint8_t *p = rgb + 3 * i;
-        for (a = 0; a < 3; a++) {
-            s[a] += p[a];
-            for (b = a; b < 3; b++) ss[a][b] += (int64_t)p[a] * p[b];
-        }
-    }
-    /* N^2 times the covariance: below 2^37. */
-    for (a = 0; a < 3; a++)
-        for (b = a; b < 3; b++) c[a][b] = c[b][a] = nn * ss[a][b] - s[a] * s[b];
+    voxcolori_moments(rgb, n, s, c);
     if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, c, n, f->mode)) return 0;
     if (f->mode == 0) {
         for (i = 0; i < n; i++)
@@ -1265,10 +1293,21 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
         voxcolori_fit best, f;
         size_t best_len = 0, best_bits = 0, len;
         unsigned m, p;
+        /* Blocks are at least 2 colours long, those with weights 3: these
+           tests fail every block starting here as fitting would, sooner. A
+           single colour (mode 0) lies within R of the first two only if they
+           lie within 2 R of each other. */
+        int no_single = !e->lab && n - pos >= 2 && voxcolori_dist2(rgb + 3 * pos, rgb + 3 * pos + 3) > 4 * e->thr2;
+        int no_line = !e->lab && n - pos >= 3 && voxcolori_off_line(e, rgb + 3 * pos);
+        if (no_single && no_line) {
+            pos++;
+            continue;
+        }
         memset(&best, 0, sizeof best);
         cache[0].start = cache[1].start = pos;
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
+            if (f.mode ? no_line : no_single) continue;
             /* A wider mode costs more than f.mode bits per colour. */
             if (best_len && best_bits <= f.mode * best_len) break;
             for (p = 0; p < e->precision_count; p++) {
