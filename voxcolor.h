@@ -897,26 +897,32 @@ static void voxcolori_fit_segment(voxcolori_fit *f) {
     f->inverse = f->dd ? (1ull << 40) / (2 * (uint64_t)f->dd) : 0;
 }
 
+/* The code of B bits whose expansion is nearest to X (in 256ths, 0 .. 255 *
+   256). */
+static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_quantize_channel(int64_t x, unsigned b) {
+    unsigned top = (1u << b) - 1, k = (unsigned)((x * top + 255 * 128) / (255 * 256));
+    /* Bit replication is not uniform: the next code may be nearer. */
+    if (k < top && 256 * (int64_t)voxcolori_expand(k + 1, b) - x < x - 256 * (int64_t)voxcolori_expand(k, b)) k++;
+    else if (k && x - 256 * (int64_t)voxcolori_expand(k - 1, b) < 256 * (int64_t)voxcolori_expand(k, b) - x) k--;
+    return k;
+}
+
 /* Rounds V (channels in 256ths, 0 .. 255 * 256) to the nearest endpoint of
    PRECISION. */
 static void voxcolori_quantize(const int64_t v[3], unsigned precision, unsigned q[3],
                                unsigned e[3]) {
     unsigned c;
-    for (c = 0; c < 3; c++) {
-        unsigned b = voxcolori_channel_bits(c, precision), top = (1u << b) - 1;
-        int64_t x = v[c];
-        unsigned k = (unsigned)((x * top + 255 * 128) / (255 * 256));
-        /* 8 bits: k is round(x / 256) and exact. */
-        if (precision) {
-            q[c] = e[c] = k;
-            continue;
-        }
-        /* Bit replication is not uniform: the next code may be nearer. */
-        if (k < top && 256 * (int64_t)voxcolori_expand(k + 1, b) - x < x - 256 * (int64_t)voxcolori_expand(k, b)) k++;
-        else if (k && x - 256 * (int64_t)voxcolori_expand(k - 1, b) < 256 * (int64_t)voxcolori_expand(k, b) - x) k--;
-        q[c] = k;
-        e[c] = voxcolori_expand(k, b);
+    if (precision) {
+        /* 8 bits: round(x / 256). */
+        for (c = 0; c < 3; c++) q[c] = e[c] = (unsigned)((v[c] + 128) >> 8);
+        return;
     }
+    q[0] = voxcolori_quantize_channel(v[0], 5);
+    q[1] = voxcolori_quantize_channel(v[1], 6);
+    q[2] = voxcolori_quantize_channel(v[2], 5);
+    e[0] = voxcolori_expand(q[0], 5);
+    e[1] = voxcolori_expand(q[1], 6);
+    e[2] = voxcolori_expand(q[2], 5);
 }
 
 /* Interpolated colour for weight index K of a width-W block. */
@@ -1102,27 +1108,28 @@ static void voxcolori_moments(const uint8_t *rgb, size_t n, int64_t s[3], int64_
     c[1][2] = c[2][1] = nn * q12 - s[1] * s[2];
 }
 
-/* Chooses endpoints for the N colours RGB; returns 0 when no block of F's
-   mode can hold them (voxcolori_hopeless), else 1. Mode 0: the centre of
-   their bounding box. Else the extreme projections on their principal axis
-   (power iteration on the covariance; two colours are their own extremes).
-   All in integers, so that the stream does not depend on floating point. */
-static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
-                                   voxcolori_fit *f) {
-    int64_t s[3], c[3][3], v[3], w[3], lo[3], hi[3], tmin = 0, tmax = 0, vv;
+/* Chooses a segment for the N colours RGB, its ends LO and HI in 256ths of
+   a channel unit; returns 0 when no block of MODE can hold them
+   (voxcolori_hopeless), else 1. Mode 0: the centre of their bounding box
+   (in LO). Else the extreme projections on their principal axis (power
+   iteration on the covariance; two colours are their own extremes). All in
+   integers, so that the stream does not depend on floating point. */
+static int voxcolori_fit_line(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                              unsigned mode, int64_t lo[3], int64_t hi[3]) {
+    int64_t s[3], c[3][3], v[3], w[3], tmin, tmax, vv;
     int64_t nn = (int64_t)n;
+    int32_t pmin, pmax;
     unsigned a, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
     size_t i;
     voxcolori_moments(rgb, n, s, c);
-    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, c, n, f->mode)) return 0;
-    if (f->mode == 0) {
+    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, c, n, mode)) return 0;
+    if (mode == 0) {
         for (i = 0; i < n; i++)
             for (a = 0; a < 3; a++) {
                 mn[a] = rgb[3 * i + a] < mn[a] ? rgb[3 * i + a] : mn[a];
                 mx[a] = rgb[3 * i + a] > mx[a] ? rgb[3 * i + a] : mx[a];
             }
         for (a = 0; a < 3; a++) lo[a] = 128 * (int64_t)(mn[a] + mx[a]);
-        voxcolori_quantize(lo, f->precision, f->q0, f->e0);
         return 1;
     }
     if (n <= 2) {
@@ -1131,88 +1138,109 @@ static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, s
             lo[a] = 256 * (int64_t)rgb[a];
             hi[a] = 256 * (int64_t)rgb[3 * (n - 1) + a];
         }
-    } else {
-        /* Start from the widest channel's column. */
-        it = c[1][1] > c[0][0] ? 1u : 0u;
-        if (c[2][2] > c[it][it]) it = 2;
-        for (a = 0; a < 3; a++) v[a] = c[a][it] + (a == it);
-        for (it = 0; it < 4; it++) {
-            voxcolori_normalize(v);
-            for (a = 0; a < 3; a++) w[a] = c[a][0] * v[0] + c[a][1] * v[1] + c[a][2] * v[2];
-            if (!w[0] && !w[1] && !w[2]) break;
-            memcpy(v, w, sizeof v);
-        }
-        voxcolori_normalize(v);
-        vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-        /* Projections, times N: (N c - S) . v. */
-        for (i = 0; i < n; i++) {
-            const uint8_t *p = rgb + 3 * i;
-            int64_t t = (nn * p[0] - s[0]) * v[0] + (nn * p[1] - s[1]) * v[1] + (nn * p[2] - s[2]) * v[2];
-            if (t < tmin) tmin = t;
-            if (t > tmax) tmax = t;
-        }
-        /* Endpoints mean + t v / (N vv), in 256ths (below 2^59). */
-        for (a = 0; a < 3; a++) {
-            lo[a] = voxcolori_div_round(256 * (s[a] * vv + tmin * v[a]), nn * vv);
-            hi[a] = voxcolori_div_round(256 * (s[a] * vv + tmax * v[a]), nn * vv);
-        }
+        return 1;
     }
+    /* Start from the widest channel's column. */
+    it = c[1][1] > c[0][0] ? 1u : 0u;
+    if (c[2][2] > c[it][it]) it = 2;
+    for (a = 0; a < 3; a++) v[a] = c[a][it] + (a == it);
+    for (it = 0; it < 4; it++) {
+        voxcolori_normalize(v);
+        for (a = 0; a < 3; a++) w[a] = c[a][0] * v[0] + c[a][1] * v[1] + c[a][2] * v[2];
+        if (!w[0] && !w[1] && !w[2]) break;
+        memcpy(v, w, sizeof v);
+    }
+    voxcolori_normalize(v);
+    vv = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    /* Extreme projections c . v (below 2^25: v has 15 bits), then centred
+       and times N: (N c - S) . v. */
+    for (i = 0, pmin = INT32_MAX, pmax = INT32_MIN; i < n; i++) {
+        const uint8_t *p = rgb + 3 * i;
+        int32_t t = p[0] * (int32_t)v[0] + p[1] * (int32_t)v[1] + p[2] * (int32_t)v[2];
+        pmin = t < pmin ? t : pmin;
+        pmax = t > pmax ? t : pmax;
+    }
+    tmin = nn * pmin - (s[0] * v[0] + s[1] * v[1] + s[2] * v[2]);
+    tmax = nn * pmax - (s[0] * v[0] + s[1] * v[1] + s[2] * v[2]);
+    /* Ends mean + t v / (N vv), in 256ths (below 2^59), in the colour cube. */
     for (a = 0; a < 3; a++) {
+        lo[a] = voxcolori_div_round(256 * (s[a] * vv + tmin * v[a]), nn * vv);
+        hi[a] = voxcolori_div_round(256 * (s[a] * vv + tmax * v[a]), nn * vv);
         lo[a] = lo[a] < 0 ? 0 : lo[a] > 255 * 256 ? 255 * 256 : lo[a];
         hi[a] = hi[a] < 0 ? 0 : hi[a] > 255 * 256 ? 255 * 256 : hi[a];
     }
+    return 1;
+}
+
+/* Sets F's endpoints to the segment LO..HI (LO alone for mode 0) rounded to
+   F's precision. */
+static void voxcolori_fit_quantize(voxcolori_fit *f, const int64_t lo[3], const int64_t hi[3]) {
     voxcolori_quantize(lo, f->precision, f->q0, f->e0);
+    if (!f->mode) return;
     voxcolori_quantize(hi, f->precision, f->q1, f->e1);
     voxcolori_fit_segment(f);
-    return 1;
 }
 
 /* 1 when all N colours RGB decode within the bound under F. */
 static int voxcolori_fits_all(const voxcolori_enc *e, const voxcolori_fit *f, const uint8_t *rgb,
                               size_t n) {
     size_t i;
-    for (i = 0; i < n; i++)
+    /* From the last: the colour a refit was made for, the likeliest miss. */
+    for (i = n; i--;)
         if (!voxcolori_fits(e, f, rgb + 3 * i)) return 0;
     return 1;
 }
 
-/* Endpoints for windows of colours of one page, by start and length, as
-   fitted for modes 1..4 (they all get the same): each mode's search reuses
-   the fits of the others. Direct-mapped by length. */
+/* Segments for windows of colours of one page, by start and length, as
+   fitted for modes 1..4 (they all get the same), and their endpoints for
+   each precision: each mode's and precision's search reuses the fits of the
+   others. Direct-mapped by length. */
 #define VOXCOLORI_CACHE_SIZE 32u
 typedef struct voxcolori_cache {
     size_t start;                     /* of the windows fitted now */
     size_t key[VOXCOLORI_CACHE_SIZE]; /* start * 2048 + length; 0: empty */
     int fitted[VOXCOLORI_CACHE_SIZE];
-    voxcolori_fit fit[VOXCOLORI_CACHE_SIZE];
+    int64_t lo[VOXCOLORI_CACHE_SIZE][3], hi[VOXCOLORI_CACHE_SIZE][3];
+    size_t fit_key[2][VOXCOLORI_CACHE_SIZE]; /* by precision, as key */
+    voxcolori_fit fit[2][VOXCOLORI_CACHE_SIZE];
 } voxcolori_cache;
 
-/* voxcolori_fit_endpoints through CACHE (for F's precision) when F has
-   weights. */
-static int voxcolori_fit_cached(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
-                                voxcolori_fit *f, voxcolori_cache *cache) {
-    unsigned slot = (unsigned)(n % VOXCOLORI_CACHE_SIZE), mode = f->mode;
+/* Chooses endpoints of F's mode and precision for the N colours RGB, through
+   CACHE when F has weights; returns 0 when no block of F's mode can hold
+   them. */
+static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                                   voxcolori_fit *f, voxcolori_cache *cache) {
+    unsigned slot = (unsigned)(n % VOXCOLORI_CACHE_SIZE), mode = f->mode, p = f->precision;
     size_t key = cache->start * 2048 + n;
-    if (!mode) return voxcolori_fit_endpoints(e, rgb, n, f);
+    int64_t lo[3], hi[3];
+    if (!mode) {
+        if (!voxcolori_fit_line(e, rgb, n, 0, lo, hi)) return 0;
+        voxcolori_fit_quantize(f, lo, hi);
+        return 1;
+    }
     if (cache->key[slot] != key) {
         cache->key[slot] = key;
-        cache->fit[slot] = *f;
-        cache->fitted[slot] = voxcolori_fit_endpoints(e, rgb, n, &cache->fit[slot]);
+        cache->fitted[slot] = voxcolori_fit_line(e, rgb, n, mode, cache->lo[slot], cache->hi[slot]);
     }
-    *f = cache->fit[slot];
+    if (!cache->fitted[slot]) return 0;
+    if (cache->fit_key[p][slot] != key) {
+        cache->fit_key[p][slot] = key;
+        cache->fit[p][slot] = *f;
+        voxcolori_fit_quantize(&cache->fit[p][slot], cache->lo[slot], cache->hi[slot]);
+    }
+    *f = cache->fit[p][slot];
     f->mode = mode;
-    return cache->fitted[slot];
+    return 1;
 }
 
 static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                voxcolori_fit *f, voxcolori_cache *cache) {
-    return voxcolori_fit_cached(e, rgb, n, f, cache) && voxcolori_fits_all(e, f, rgb, n);
+    return voxcolori_fit_endpoints(e, rgb, n, f, cache) && voxcolori_fits_all(e, f, rgb, n);
 }
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
    precision encodes within the bound, with its endpoints in F; 0 when not
-   even the first MIN colours fit (shorter blocks would not pay for their
-   entry). Colours that fit the current endpoints are accepted as they are;
+   even the first MIN colours fit (shorter blocks would not pay). Colours that fit the current endpoints are accepted as they are;
    one that does not triggers a refit including it, and repeated refits a
    refit over twice the length (so gradients cost O(n log n)). */
 static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n, size_t min,
@@ -1286,9 +1314,9 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
     /* A block's directory entry and its share of the checkpoints (one per 8
        blocks, rounded up). */
     size_t pos = 0, raw_start = 0, blocks = 0, entry = 8 * voxcolori_index_bytes(e->page_shift) + 4 + 2;
-    voxcolori_cache cache[2];
-    memset(cache[0].key, 0, sizeof cache[0].key);
-    memset(cache[1].key, 0, sizeof cache[1].key);
+    voxcolori_cache cache; /* 7 KiB */
+    memset(cache.key, 0, sizeof cache.key);
+    memset(cache.fit_key, 0, sizeof cache.fit_key);
     while (pos < n) {
         voxcolori_fit best, f;
         size_t best_len = 0, best_bits = 0, len;
@@ -1304,7 +1332,7 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
             continue;
         }
         memset(&best, 0, sizeof best);
-        cache[0].start = cache[1].start = pos;
+        cache.start = pos;
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
             if (f.mode ? no_line : no_single) continue;
@@ -1316,8 +1344,17 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
                 /* Blocks shorter than this cost more than raw colours. */
                 fixed = 2 * entry + voxcolori_endpoint_bits(f.mode, f.precision);
                 len = (fixed + 23 - f.mode) / (24 - f.mode);
+                /* Only blocks of BEAT colours or more beat the best one yet:
+                   the search starts there, but at most 8 colours further (a
+                   fit over many more colours fails where growing one would
+                   not). */
+                if (best_len) {
+                    size_t beat = (fixed - entry) * best_len / (best_bits - f.mode * best_len) + 1;
+                    if (beat > n - pos) continue;
+                    len = beat < len ? len : beat < len + 8 ? beat : len + 8;
+                }
                 if (len > n - pos) len = n - pos;
-                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f, &cache[p]);
+                len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f, &cache);
                 if (!len) continue;
                 bits = entry + voxcolori_endpoint_bits(f.mode, f.precision) + f.mode * len;
                 if (!best_len || bits * best_len < best_bits * len ||
