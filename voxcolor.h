@@ -167,7 +167,7 @@ typedef struct voxcolori_enc {
     uint32_t thr2;      /* RGB: largest squared distance allowed */
     int lab;            /* 1: CIELAB metric */
     double lab_thr2;    /* CIELAB: largest squared delta E allowed */
-    uint64_t line64;    /* RGB: 64 (sqrt(thr2) + sqrt(3) / 2)^2, rounded up */
+    uint64_t line64;    /* RGB: 64 (sqrt(thr2) + 1 / 2)^2, rounded up */
     double linear[256]; /* CIELAB: sRGB channel value to linear light */
     unsigned page_shift;
     unsigned modes[5], mode_count;
@@ -860,9 +860,12 @@ static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) 
         else hi = mid - 1;
     }
     e->thr2 = lo;
-    /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line:
-       64 (r + 0.87)^2 <= 64 r^2 + sqrt(12402 r^2) + 49 for r^2 = thr2. */
-    e->line64 = 64 * (uint64_t)e->thr2 + voxcolori_isqrt_up(12402 * (uint64_t)e->thr2) + 49;
+    /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line
+       (each channel rounded), but blocks that need more than 1 / 2 there are
+       next to none: the tests on lines allow 1 / 2 and reject far more
+       windows early. 64 (r + 1 / 2)^2 <= 64 r^2 + sqrt(4096 r^2) + 16 for
+       r^2 = thr2. */
+    e->line64 = 64 * (uint64_t)e->thr2 + voxcolori_isqrt_up(4096 * (uint64_t)e->thr2) + 16;
     if (e->lab)
         for (i = 0; i < 256; i++) {
             double c = i / 255.0, s = (c + 0.055) / 1.055;
@@ -1003,8 +1006,8 @@ static VOXCOLORI_ALWAYS_INLINE int voxcolori_fits(const voxcolori_enc *e, const 
 
 /* 1 when no line passes within R of the three colours P (R^2 = line64 / 64,
    RGB metric): when their triangle's area A and longest side L have
-   A / L > R, i.e. |cross|^2 > 4 R^2 L^2. No block with weights can then
-   hold all three. */
+   A / L > R, i.e. |cross|^2 > 4 R^2 L^2. No block with weights then holds
+   all three (but for rounding: see line64). */
 static int voxcolori_off_line(const voxcolori_enc *e, const uint8_t *p) {
     int64_t u0 = p[3] - p[0], u1 = p[4] - p[1], u2 = p[5] - p[2];
     int64_t v0 = p[6] - p[0], v1 = p[7] - p[1], v2 = p[8] - p[2];
@@ -1023,17 +1026,11 @@ static int voxcolori_off_line(const voxcolori_enc *e, const uint8_t *p) {
    least its trace minus its Frobenius norm), exceeds what the bound allows.
    Rejects most failing windows before any endpoint is fitted. Integer
    arithmetic: the same answer on every compiler and processor. */
-static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, int64_t c[3][3],
-                              size_t n, unsigned mode) {
+static int voxcolori_hopeless(const voxcolori_enc *e, int64_t c[3][3], size_t n, unsigned mode) {
     int64_t n2 = (int64_t)n * (int64_t)n, tr = c[0][0] + c[1][1] + c[2][2], big, fro = 0;
     unsigned a, b, shift = 0;
-    size_t i;
     if (mode == 0) return tr > (int64_t)e->thr2 * n2;
     if (n <= 2) return 0;
-    /* Short windows only (longer ones are refits of blocks that mostly
-       pass). */
-    for (i = 0; i + 2 < n && n <= 8; i++)
-        if (voxcolori_off_line(e, rgb + 3 * i)) return 1;
     /* trace - R^2 > Frobenius norm, in 64 N^2 units, squares taken after
        dropping low bits so that nothing overflows. */
     tr = 64 * tr - (int64_t)e->line64 * n2;
@@ -1057,9 +1054,8 @@ static int voxcolori_hopeless(const voxcolori_enc *e, const uint8_t *rgb, int64_
    bits: the power iteration's products then stay below 2^53. */
 static void voxcolori_normalize(int64_t v[3]) {
     int64_t a0 = v[0] < 0 ? -v[0] : v[0], a1 = v[1] < 0 ? -v[1] : v[1], a2 = v[2] < 0 ? -v[2] : v[2];
-    int64_t m = a0 > a1 ? a0 : a1;
+    int64_t m = a0 | a1 | a2; /* the largest's top bit */
     unsigned bits = 0, k;
-    m = m > a2 ? m : a2;
     if (!m) {
         v[0] = v[1] = v[2] = 1 << 14;
         return;
@@ -1122,7 +1118,7 @@ static int voxcolori_fit_line(const voxcolori_enc *e, const uint8_t *rgb, size_t
     unsigned a, it, mn[3] = {255, 255, 255}, mx[3] = {0, 0, 0};
     size_t i;
     voxcolori_moments(rgb, n, s, c);
-    if (!e->lab && n > 1 && voxcolori_hopeless(e, rgb, c, n, mode)) return 0;
+    if (!e->lab && n > 1 && voxcolori_hopeless(e, c, n, mode)) return 0;
     if (mode == 0) {
         for (i = 0; i < n; i++)
             for (a = 0; a < 3; a++) {
@@ -1140,11 +1136,12 @@ static int voxcolori_fit_line(const voxcolori_enc *e, const uint8_t *rgb, size_t
         }
         return 1;
     }
-    /* Start from the widest channel's column. */
+    /* Start from the widest channel's column (one iteration); two more
+       settle the axis well enough for the extremes. */
     it = c[1][1] > c[0][0] ? 1u : 0u;
     if (c[2][2] > c[it][it]) it = 2;
     for (a = 0; a < 3; a++) v[a] = c[a][it] + (a == it);
-    for (it = 0; it < 4; it++) {
+    for (it = 0; it < 2; it++) {
         voxcolori_normalize(v);
         for (a = 0; a < 3; a++) w[a] = c[a][0] * v[0] + c[a][1] * v[1] + c[a][2] * v[2];
         if (!w[0] && !w[1] && !w[2]) break;
@@ -1203,7 +1200,20 @@ typedef struct voxcolori_cache {
     int64_t lo[VOXCOLORI_CACHE_SIZE][3], hi[VOXCOLORI_CACHE_SIZE][3];
     size_t fit_key[2][VOXCOLORI_CACHE_SIZE]; /* by precision, as key */
     voxcolori_fit fit[2][VOXCOLORI_CACHE_SIZE];
+    size_t line_ok; /* no three of the first LINE_OK colours lie off every line */
 } voxcolori_cache;
+
+/* 1 when three consecutive colours of the N from CACHE's start lie off every
+   line (RGB metric), so that no block with weights holds them: checks only
+   windows of up to 8 colours (longer ones are refits of blocks that mostly
+   pass), and only colours past those known to pass. */
+static int voxcolori_off_lines(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
+                               voxcolori_cache *cache) {
+    if (e->lab || n > 8) return 0;
+    for (; cache->line_ok < n; cache->line_ok++)
+        if (voxcolori_off_line(e, rgb + 3 * (cache->line_ok - 2))) return 1;
+    return 0;
+}
 
 /* Chooses endpoints of F's mode and precision for the N colours RGB, through
    CACHE when F has weights; returns 0 when no block of F's mode can hold
@@ -1220,7 +1230,8 @@ static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, s
     }
     if (cache->key[slot] != key) {
         cache->key[slot] = key;
-        cache->fitted[slot] = voxcolori_fit_line(e, rgb, n, mode, cache->lo[slot], cache->hi[slot]);
+        cache->fitted[slot] = !voxcolori_off_lines(e, rgb, n, cache) &&
+                              voxcolori_fit_line(e, rgb, n, mode, cache->lo[slot], cache->hi[slot]);
     }
     if (!cache->fitted[slot]) return 0;
     if (cache->fit_key[p][slot] != key) {
@@ -1333,6 +1344,7 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
         }
         memset(&best, 0, sizeof best);
         cache.start = pos;
+        cache.line_ok = 3; /* the first three pass no_line */
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
             if (f.mode ? no_line : no_single) continue;
