@@ -944,12 +944,12 @@ static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_project(const voxcolori_fit *f
     uint64_t num, den = 2 * (uint64_t)f->dd;
     if (f->dd == 0 || dot <= 0) return 0;
     if (dot >= f->dd) return top;
-    /* k = floor(num / den) for num = 2 dot top + dd, from the inverse, then
-       corrected to the exact quotient. */
+    /* k = floor(num / den) for num = 2 dot top + dd, from the inverse (never
+       above: it is rounded down, and at most 1 below), then corrected to the
+       exact quotient. */
     num = 2 * (uint64_t)dot * top + (uint64_t)f->dd;
     k = (unsigned)((num * f->inverse) >> 40);
     if ((k + 1) * den <= num) k++;
-    if (k * den > num) k--;
     return k;
 }
 
@@ -964,18 +964,14 @@ static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_mix_dist2(const voxcolori_fit 
     return (uint32_t)(d0 * d0 + d1 * d1 + d2 * d2);
 }
 
-/* The weight index decoding closest (in RGB) to C, and that decoded colour:
-   the projection or a neighbour (the 64ths are not evenly spaced). */
-static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3], uint8_t out[3]) {
-    unsigned top = (1u << f->mode) - 1, k = voxcolori_project(f, c), lo, hi, best = 0;
-    uint32_t best_err = UINT32_MAX;
-    lo = k ? k - 1 : 0;
-    hi = k < top ? k + 1 : top;
-    for (k = lo; k <= hi; k++) {
-        uint32_t err = voxcolori_mix_dist2(f, k, c);
-        if (err < best_err) best_err = err, best = k;
-    }
-    voxcolori_mix(f->e0, f->e1, f->mode, best, out);
+/* The weight index decoding closest (in RGB) to C: the projection or a
+   neighbour (the 64ths are not evenly spaced). */
+static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3]) {
+    unsigned top = (1u << f->mode) - 1, k = voxcolori_project(f, c), best = k;
+    uint32_t err = voxcolori_mix_dist2(f, k, c), lower;
+    /* Ties go to the lower index. */
+    if (k && (lower = voxcolori_mix_dist2(f, k - 1, c)) <= err) best = k - 1, err = lower;
+    if (k < top && err && voxcolori_mix_dist2(f, k + 1, c) < err) best = k + 1;
     return best;
 }
 
@@ -999,7 +995,7 @@ static VOXCOLORI_ALWAYS_INLINE int voxcolori_fits(const voxcolori_enc *e, const 
         d[1] = (uint8_t)f->e0[1];
         d[2] = (uint8_t)f->e0[2];
     } else {
-        voxcolori_pick(f, c, d);
+        voxcolori_mix(f->e0, f->e1, f->mode, voxcolori_pick(f, c), d);
     }
     return voxcolori_close(e, c, d);
 }
@@ -1436,10 +1432,7 @@ static void voxcolori_write_page(voxcolori_writer *w, const uint8_t *rgb, const 
         voxcolori_fit_segment(&f);
         voxcolori_put_endpoint(w, f.q0, f.precision);
         if (mode) voxcolori_put_endpoint(w, f.q1, f.precision);
-        for (i = 0; i < n && mode; i++) {
-            uint8_t d[3];
-            voxcolori_put(w, voxcolori_pick(&f, rgb + 3 * i, d), mode);
-        }
+        for (i = 0; i < n && mode; i++) voxcolori_put(w, voxcolori_pick(&f, rgb + 3 * i), mode);
         rgb += 3 * n;
     }
 }
