@@ -1174,16 +1174,6 @@ static void voxcolori_fit_quantize(voxcolori_fit *f, const int64_t lo[3], const 
     voxcolori_fit_segment(f);
 }
 
-/* 1 when all N colours RGB decode within the bound under F. */
-static int voxcolori_fits_all(const voxcolori_enc *e, const voxcolori_fit *f, const uint8_t *rgb,
-                              size_t n) {
-    size_t i;
-    /* From the last: the colour a refit was made for, the likeliest miss. */
-    for (i = n; i--;)
-        if (!voxcolori_fits(e, f, rgb + 3 * i)) return 0;
-    return 1;
-}
-
 /* Segments for windows of colours of one page, by start and length, as
    fitted for modes 1..4 (they all get the same), and their endpoints for
    each precision: each mode's and precision's search reuses the fits of the
@@ -1197,6 +1187,7 @@ typedef struct voxcolori_cache {
     size_t fit_key[2][VOXCOLORI_CACHE_SIZE]; /* by precision, as key */
     voxcolori_fit fit[2][VOXCOLORI_CACHE_SIZE];
     size_t line_ok; /* no three of the first LINE_OK colours lie off every line */
+    size_t miss;    /* the colour that failed the last check, the likeliest next */
 } voxcolori_cache;
 
 /* 1 when three consecutive colours of the N from CACHE's start lie off every
@@ -1240,9 +1231,21 @@ static int voxcolori_fit_endpoints(const voxcolori_enc *e, const uint8_t *rgb, s
     return 1;
 }
 
+/* Fits endpoints of F's mode and precision to the N colours RGB from
+   CACHE's start; 1 when all of them decode within the bound. */
 static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_t n,
                                voxcolori_fit *f, voxcolori_cache *cache) {
-    return voxcolori_fit_endpoints(e, rgb, n, f, cache) && voxcolori_fits_all(e, f, rgb, n);
+    size_t i;
+    if (!voxcolori_fit_endpoints(e, rgb, n, f, cache)) return 0;
+    /* The likeliest misses first: the last one, then from the last colour
+       (the one a refit was made for). */
+    if (cache->miss < n && !voxcolori_fits(e, f, rgb + 3 * cache->miss)) return 0;
+    for (i = n; i--;)
+        if (!voxcolori_fits(e, f, rgb + 3 * i)) {
+            cache->miss = i;
+            return 0;
+        }
+    return 1;
 }
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
@@ -1341,6 +1344,7 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
         memset(&best, 0, sizeof best);
         cache.start = pos;
         cache.line_ok = 3; /* the first three pass no_line */
+        cache.miss = 0;
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
             if (f.mode ? no_line : no_single) continue;
