@@ -1357,13 +1357,15 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
                 fixed = 2 * entry + voxcolori_endpoint_bits(f.mode, f.precision);
                 len = (fixed + 23 - f.mode) / (24 - f.mode);
                 /* Only blocks of BEAT colours or more beat the best one yet:
-                   the search starts there, but at most 8 colours further (a
-                   fit over many more colours fails where growing one would
-                   not). */
+                   the search starts there, or just past the best block if
+                   that is sooner (a window the searches of every mode and
+                   precision share, and growing a fit from there finds
+                   blocks one fit over BEAT colours would miss). */
                 if (best_len) {
                     size_t beat = (fixed - entry) * best_len / (best_bits - f.mode * best_len) + 1;
                     if (beat > n - pos) continue;
-                    len = beat < len ? len : beat < len + 8 ? beat : len + 8;
+                    beat = beat < best_len + 1 ? beat : best_len + 1;
+                    len = beat < len ? len : beat;
                 }
                 if (len > n - pos) len = n - pos;
                 len = voxcolori_extend(e, rgb + 3 * pos, n - pos, len, &f, &cache);
