@@ -167,7 +167,7 @@ typedef struct voxcolori_enc {
     uint32_t thr2;      /* RGB: largest squared distance allowed */
     int lab;            /* 1: CIELAB metric */
     double lab_thr2;    /* CIELAB: largest squared delta E allowed */
-    uint64_t line64;    /* RGB: 64 (sqrt(thr2) + 1 / 2)^2, rounded up */
+    uint64_t line64;    /* RGB: 64 (sqrt(thr2) + 1 / 4)^2 rounded up, or 16 */
     double linear[256]; /* CIELAB: sRGB channel value to linear light */
     unsigned page_shift;
     unsigned modes[5], mode_count;
@@ -861,11 +861,12 @@ static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) 
     }
     e->thr2 = lo;
     /* An interpolated colour lies within sqrt(3) / 2 of its endpoints' line
-       (each channel rounded), but blocks that need more than 1 / 2 there are
-       next to none: the tests on lines allow 1 / 2 and reject far more
-       windows early. 64 (r + 1 / 2)^2 <= 64 r^2 + sqrt(4096 r^2) + 16 for
-       r^2 = thr2. */
-    e->line64 = 64 * (uint64_t)e->thr2 + voxcolori_isqrt_up(4096 * (uint64_t)e->thr2) + 16;
+       (each channel rounded), but blocks that need more than 1 / 2 there
+       (lossless), or 1 / 4 (with any room in the bound), are next to none on
+       the bench sets: the tests on lines allow that much and reject far more
+       windows early. 64 (r + 1 / 4)^2 <= 64 r^2 + sqrt(1024 r^2) + 4 for
+       r^2 = thr2, and 64 (1 / 2)^2 = 16. */
+    e->line64 = e->thr2 ? 64 * (uint64_t)e->thr2 + voxcolori_isqrt_up(1024 * (uint64_t)e->thr2) + 4 : 16;
     if (e->lab)
         for (i = 0; i < 256; i++) {
             double c = i / 255.0, s = (c + 0.055) / 1.055;
@@ -1332,11 +1333,15 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
         size_t best_len = 0, best_bits = 0, len;
         unsigned m, p;
         /* Blocks are at least 2 colours long, those with weights 3: these
-           tests fail every block starting here as fitting would, sooner. A
+           tests fail blocks starting here sooner than fitting them would. A
            single colour (mode 0) lies within R of the first two only if they
-           lie within 2 R of each other. */
-        int no_single = !e->lab && n - pos >= 2 && voxcolori_dist2(rgb + 3 * pos, rgb + 3 * pos + 3) > 4 * e->thr2;
-        int no_line = !e->lab && n - pos >= 3 && voxcolori_off_line(e, rgb + 3 * pos);
+           lie within 2 R of each other; of three colours, two share one of
+           the two colours of mode 1. */
+        const uint8_t *c = rgb + 3 * pos;
+        int no_single = !e->lab && n - pos >= 2 && voxcolori_dist2(c, c + 3) > 4 * e->thr2;
+        int no_pair = no_single && n - pos >= 3 && voxcolori_dist2(c, c + 6) > 4 * e->thr2 &&
+                      voxcolori_dist2(c + 3, c + 6) > 4 * e->thr2;
+        int no_line = !e->lab && n - pos >= 3 && voxcolori_off_line(e, c);
         if (no_single && no_line) {
             pos++;
             continue;
@@ -1347,7 +1352,7 @@ static size_t voxcolori_plan_page(const voxcolori_enc *e, const uint8_t *rgb, si
         cache.miss = 0;
         for (m = 0; m < e->mode_count; m++) {
             f.mode = e->modes[m];
-            if (f.mode ? no_line : no_single) continue;
+            if (f.mode == 0 ? no_single : no_line || (f.mode == 1 && no_pair)) continue;
             /* A wider mode costs more than f.mode bits per colour. */
             if (best_len && best_bits <= f.mode * best_len) break;
             for (p = 0; p < e->precision_count; p++) {
