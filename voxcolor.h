@@ -1024,25 +1024,23 @@ static int voxcolori_off_line(const voxcolori_enc *e, const uint8_t *p) {
    Rejects most failing windows before any endpoint is fitted. Integer
    arithmetic: the same answer on every compiler and processor. */
 static int voxcolori_hopeless(const voxcolori_enc *e, int64_t c[3][3], size_t n, unsigned mode) {
-    int64_t n2 = (int64_t)n * (int64_t)n, tr = c[0][0] + c[1][1] + c[2][2], big, fro = 0;
-    unsigned a, b, shift = 0;
+    int64_t n2 = (int64_t)n * (int64_t)n, tr = c[0][0] + c[1][1] + c[2][2], big, fro = 0, x[6];
+    unsigned a, shift = 0;
     if (mode == 0) return tr > (int64_t)e->thr2 * n2;
     if (n <= 2) return 0;
     /* trace - R^2 > Frobenius norm, in 64 N^2 units, squares taken after
-       dropping low bits so that nothing overflows. */
+       dropping low bits (of magnitudes: shifts, no division) so that nothing
+       overflows. */
     tr = 64 * tr - (int64_t)e->line64 * n2;
     if (tr <= 0) return 0;
-    for (big = tr, a = 0; a < 3; a++)
-        for (b = 0; b < 3; b++) {
-            int64_t x = 64 * (c[a][b] < 0 ? -c[a][b] : c[a][b]);
-            big = x > big ? x : big;
-        }
+    x[0] = c[0][0], x[1] = c[1][1], x[2] = c[2][2], x[3] = c[0][1], x[4] = c[0][2], x[5] = c[1][2];
+    for (big = tr, a = 0; a < 6; a++) {
+        x[a] = 64 * (x[a] < 0 ? -x[a] : x[a]);
+        big = x[a] > big ? x[a] : big;
+    }
     while (big >> shift >= (1ll << 29)) shift++;
-    for (a = 0; a < 3; a++)
-        for (b = 0; b < 3; b++) {
-            int64_t x = 64 * c[a][b] / ((int64_t)1 << shift);
-            fro += x * x;
-        }
+    /* Each off-diagonal entry appears twice. */
+    for (a = 0; a < 6; a++) fro += (a < 3 ? 1 : 2) * (x[a] >> shift) * (x[a] >> shift);
     tr >>= shift;
     return tr * tr > fro;
 }
