@@ -967,7 +967,7 @@ static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_mix_dist2(const voxcolori_fit 
 
 /* The weight index decoding closest (in RGB) to C: the projection or a
    neighbour (the 64ths are not evenly spaced). */
-static unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3]) {
+static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_pick(const voxcolori_fit *f, const uint8_t c[3]) {
     unsigned top = (1u << f->mode) - 1, k = voxcolori_project(f, c), best = k;
     uint32_t err = voxcolori_mix_dist2(f, k, c), lower;
     /* Ties go to the lower index. */
