@@ -61,6 +61,21 @@ static inline uint32_t test_rand_below(uint64_t *state, uint32_t n) {
     return (uint32_t)(test_rand(state) % n);
 }
 
+/* A builder colour sink collecting the colours it gets into RGB; a push
+   past CAP colours fails (so that tests can exercise a failing sink). */
+typedef struct sink_buf {
+    uint8_t *rgb;
+    size_t n, cap;
+} sink_buf;
+
+static inline int sink_collect(void *user, const uint8_t *rgb, size_t n) {
+    sink_buf *s = (sink_buf *)user;
+    if (s->n + n > s->cap) return 1;
+    memcpy(s->rgb + 3 * s->n, rgb, 3 * n);
+    s->n += n;
+    return 0;
+}
+
 /* Path of the test data folder (tests/data), overridable by VOXDAG_TEST_DATA. */
 const char *test_data_dir(void);
 

@@ -100,20 +100,6 @@ static void random_tris(uint64_t *r, uint32_t n, size_t count, itri *out) {
     }
 }
 
-/* Colours collected by a colour sink. */
-typedef struct sink_buf {
-    uint8_t *rgb;
-    size_t n, cap;
-} sink_buf;
-
-static int sink_collect(void *user, const uint8_t *rgb, size_t n) {
-    sink_buf *s = (sink_buf *)user;
-    if (s->n + n > s->cap) return 1;
-    memcpy(s->rgb + 3 * s->n, rgb, 3 * n);
-    s->n += n;
-    return 0;
-}
-
 /* The same mesh through a colour sink: the sink's colours attached to its
    colourless DAG give REF's file. */
 static void check_sink(const voxdag_build_opts *opts, const voxdag_mesh *mesh, const voxdag *ref) {
