@@ -1046,8 +1046,9 @@ static int voxcolori_hopeless(const voxcolori_enc *e, int64_t c[3][3], size_t n,
 }
 
 /* Scales direction V (not all zero) so that its largest component has 15
-   bits: the power iteration's products then stay below 2^53. */
-static void voxcolori_normalize(int64_t v[3]) {
+   bits: the power iteration's products then stay below 2^53. Inlined: as a
+   call it costs gcc about 5 % of the encoder's time. */
+static VOXCOLORI_ALWAYS_INLINE void voxcolori_normalize(int64_t v[3]) {
     int64_t a0 = v[0] < 0 ? -v[0] : v[0], a1 = v[1] < 0 ? -v[1] : v[1], a2 = v[2] < 0 ? -v[2] : v[2];
     int64_t m = a0 | a1 | a2; /* the largest's top bit */
     unsigned bits = 0, k;
