@@ -619,15 +619,30 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
 }
 
 /* Prefetches the start of PAGE and the part where colour J's payload likely
-   is (at its share of the page), so that both arrive together. Returns the
-   page's offset. */
-static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_prefetch_page(const voxcolor_view *view,
-                                                                uint64_t page, uint64_t j) {
+   is (at its share of the page): two lines, for lookups issued well ahead. */
+static VOXCOLORI_ALWAYS_INLINE void voxcolori_prefetch_guess(const voxcolor_view *view,
+                                                             uint64_t page, uint64_t j) {
     uint64_t at = voxcolori_page_offset(view, page);
     VOXCOLORI_PREFETCH(view->data + at);
     if ((page + 1) << view->page_shift < view->count)
         VOXCOLORI_PREFETCH(view->data + at +
                            (((voxcolori_page_offset(view, page + 1) - at) * j) >> view->page_shift));
+}
+
+/* Prefetches the first VOXCOLORI_PREFETCH_LINES cache lines of PAGE (fewer
+   when it is shorter), so that its directory and the payload a lookup needs
+   arrive together: guessing the payload's line misses on pages with large
+   directories. Returns the page's offset. */
+#define VOXCOLORI_PREFETCH_LINES 8u
+static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_prefetch_page(const voxcolor_view *view,
+                                                                uint64_t page) {
+    uint64_t at = voxcolori_page_offset(view, page), end = at + 1, k;
+    if ((page + 1) << view->page_shift < view->count) end = voxcolori_page_offset(view, page + 1);
+    VOXCOLORI_PREFETCH(view->data + at);
+    for (k = 1; k < VOXCOLORI_PREFETCH_LINES; k++) {
+        uint64_t line = at + 64 * k;
+        VOXCOLORI_PREFETCH(view->data + (line < end ? line : end - 1));
+    }
     return at;
 }
 
@@ -644,14 +659,15 @@ static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_count_below(uint64_t x, uint64
 }
 
 /* voxcolor_view_get for pages with WIDE indices, a constant in each call so
-   that every index read compiles to one load. */
+   that every index read compiles to one load. Prefetches the page unless
+   PREFETCHED (done well ahead by the caller). */
 static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_get(const voxcolor_view *view, uint64_t index,
-                                                      unsigned wide) {
+                                                      unsigned wide, int prefetched) {
     const uint8_t *data = view->data, *ends;
     unsigned s = view->page_shift, lanes = 8u >> wide, n;
     uint64_t j = index & ((1ull << s) - 1), page = index >> s, at, groups, g, w, r, start, pos, modes;
     voxcolori_page p;
-    at = voxcolori_prefetch_page(view, page, j);
+    at = prefetched ? voxcolori_page_offset(view, page) : voxcolori_prefetch_page(view, page);
     voxcolori_page_open(data, at, wide, &p);
     groups = (p.last >> VOXCOLORI_GROUP_SHIFT) + 1;
     /* Group g holding colour j: the number of groups ending before j,
@@ -684,11 +700,17 @@ static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_get(const voxcolor_view *view,
     return voxcolori_block_color(data, pos, (unsigned)modes & 15, j - start);
 }
 
+/* Colour INDEX to RGB_OUT (see voxcolori_get). */
+static VOXCOLORI_ALWAYS_INLINE void voxcolori_lookup(const voxcolor_view *view, uint64_t index,
+                                                     uint8_t *rgb_out, int prefetched) {
+    voxcolori_store_rgb(rgb_out, view->page_shift > 8 ? voxcolori_get(view, index, 1, prefetched)
+                                                      : voxcolori_get(view, index, 0, prefetched));
+}
+
 VOXCOLOR_API void voxcolor_view_get(const voxcolor_view *view, uint64_t index,
                                     uint8_t rgb_out[3]) {
     VOXCOLOR_ASSERT(view && rgb_out && index < view->count);
-    voxcolori_store_rgb(rgb_out, view->page_shift > 8 ? voxcolori_get(view, index, 1)
-                                                      : voxcolori_get(view, index, 0));
+    voxcolori_lookup(view, index, rgb_out, 0);
 }
 
 VOXCOLOR_API void voxcolor_view_get_many(const voxcolor_view *view, const uint64_t *indices,
@@ -704,9 +726,10 @@ VOXCOLOR_API void voxcolor_view_get_many(const voxcolor_view *view, const uint64
         if (i + 8 < n) {
             uint64_t ahead = indices[i + 8];
             VOXCOLOR_ASSERT(ahead < view->count);
-            voxcolori_prefetch_page(view, ahead >> s, ahead & ((1ull << s) - 1));
+            voxcolori_prefetch_guess(view, ahead >> s, ahead & ((1ull << s) - 1));
         }
-        voxcolor_view_get(view, indices[i], rgb_out + 3 * i);
+        VOXCOLOR_ASSERT(indices[i] < view->count);
+        voxcolori_lookup(view, indices[i], rgb_out + 3 * i, 1);
     }
 }
 
