@@ -238,6 +238,7 @@ typedef struct voxcolor_view {
     uint64_t count;       /* number of colours */
     uint32_t page_shift;
     uint32_t wide;        /* 1: 8-byte page table entries, 0: 4-byte */
+    uint64_t data_size;   /* bytes of block data */
 } voxcolor_view;
 
 /* Validates SIZE bytes at SRC completely (header, version, page table, every
@@ -613,6 +614,7 @@ VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void 
     if (data_size < 8 || data_size > UINT64_MAX / 8) return VOXCOLOR_ERR_CORRUPT;
     v.table = p + VOXCOLOR_HEADER_SIZE;
     v.data = v.table + (size_t)(pages * entry);
+    v.data_size = data_size;
     st = voxcolori_check_pages(&v, data_size);
     if (st == VOXCOLOR_OK) *view = v;
     return st;
@@ -629,20 +631,20 @@ static VOXCOLORI_ALWAYS_INLINE void voxcolori_prefetch_guess(const voxcolor_view
                            (((voxcolori_page_offset(view, page + 1) - at) * j) >> view->page_shift));
 }
 
-/* Prefetches the first VOXCOLORI_PREFETCH_LINES cache lines of PAGE (fewer
-   when it is shorter), so that its directory and the payload a lookup needs
-   arrive together: guessing the payload's line misses on pages with large
-   directories. Returns the page's offset. */
+/* Prefetches the first VOXCOLORI_PREFETCH_LINES cache lines from PAGE's
+   start (only the first near the end of the data), so that its directory and
+   the payload a lookup needs arrive together: guessing the payload's line
+   misses on pages with large directories. Lines past a short page cost a
+   prefetch each, fewer instructions than stopping at its end. Returns the
+   page's offset. */
 #define VOXCOLORI_PREFETCH_LINES 8u
 static VOXCOLORI_ALWAYS_INLINE uint64_t voxcolori_prefetch_page(const voxcolor_view *view,
                                                                 uint64_t page) {
-    uint64_t at = voxcolori_page_offset(view, page), end = at + 1, k;
-    if ((page + 1) << view->page_shift < view->count) end = voxcolori_page_offset(view, page + 1);
+    uint64_t at = voxcolori_page_offset(view, page);
+    unsigned k;
     VOXCOLORI_PREFETCH(view->data + at);
-    for (k = 1; k < VOXCOLORI_PREFETCH_LINES; k++) {
-        uint64_t line = at + 64 * k;
-        VOXCOLORI_PREFETCH(view->data + (line < end ? line : end - 1));
-    }
+    if (at + 64 * VOXCOLORI_PREFETCH_LINES <= view->data_size)
+        for (k = 1; k < VOXCOLORI_PREFETCH_LINES; k++) VOXCOLORI_PREFETCH(view->data + at + 64 * k);
     return at;
 }
 
