@@ -2811,6 +2811,18 @@ static voxdag_status voxdagi_new_dag(voxdagi_mem *m, voxdag **out) {
     return VOXDAG_OK;
 }
 
+/* Copies OPTS (NULL: defaults) to O and checks what every loader needs. */
+static voxdag_status voxdagi_load_opts(const voxdag_load_opts *opts, voxdag_load_opts *o,
+                                       voxdag_error *err) {
+    memset(o, 0, sizeof *o);
+    if (opts) *o = *opts;
+    if (o->zero_begin || o->zero_end)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "load options not zero-initialized");
+    if ((o->allocator.alloc == NULL) != (o->allocator.free == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
+    return VOXDAG_OK;
+}
+
 VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
                                             const voxdag_load_opts *opts, voxdag **out,
                                             voxdag_error *err) {
@@ -2820,12 +2832,8 @@ VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
     voxdag_status st;
     if (!out || (!data && size)) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "data or out is NULL");
     *out = NULL;
-    memset(&o, 0, sizeof o);
-    if (opts) o = *opts;
-    if (o.zero_begin || o.zero_end)
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "load options not zero-initialized");
-    if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
+    st = voxdagi_load_opts(opts, &o, err);
+    if (st != VOXDAG_OK) return st;
     if (o.max_input_bytes && size > o.max_input_bytes)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "input larger than max_input_bytes");
     if (!o.max_levels || o.max_levels > VOXDAG_MAX_LEVELS) o.max_levels = VOXDAG_MAX_LEVELS;
@@ -3392,12 +3400,8 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     voxdag_status st;
     if (!path || !out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "path or out is NULL");
     *out = NULL;
-    memset(&o, 0, sizeof o);
-    if (opts) o = *opts;
-    if (o.zero_begin || o.zero_end)
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "load options not zero-initialized");
-    if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator needs both alloc and free");
+    st = voxdagi_load_opts(opts, &o, err);
+    if (st != VOXDAG_OK) return st;
     f = fopen(path, "rb");
     if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot open the file");
     if (fseek(f, 0, SEEK_END) || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
