@@ -1009,14 +1009,16 @@ static void vi_tex_free(vi_buf *cache) {
 }
 
 /* Sets *IMAGE to the scene image of texture FILE (named in a file in DIR),
-   decoding it on first use; -1, with a warning, if it cannot be decoded:
-   the material then keeps its Kd colour. */
+   decoding it on first use; -1, with a warning, if it cannot be decoded, or
+   -1 when the caller skips textures: the material then keeps its Kd colour. */
 static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, vi_span file, int32_t *image) {
-    char *path = vi_path(c, dir, file), why[512];
+    char *path, why[512];
     vi_tex *e;
     vdag_image img;
     size_t i;
-    if (!path) return 0;
+    *image = -1;
+    if (c->limits.skip_textures) return 1;
+    if (!(path = vi_path(c, dir, file))) return 0;
     for (i = 0; i < cache->count; i++)
         if (!strcmp(((vi_tex *)cache->data)[i].path, path)) {
             free(path);

@@ -61,6 +61,8 @@ typedef struct vdag_import_limits {
     uint64_t max_points;      /* 0: VDAG_IMPORT_MAX_POINTS */
     uint64_t max_vertices;    /* 0: VDAG_IMPORT_MAX_VERTICES */
     uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
+    int skip_textures;        /* 1: do not decode texture images (materials keep
+                                 their colours; for callers that need no colours) */
 } vdag_import_limits;
 
 #ifndef VDAG_IMPORT_MAX_INPUT_BYTES

@@ -429,6 +429,7 @@ static int cmd_build(int argc, char **argv) {
     build_args a;
     color_spill spill;
     vdag_scene sc;
+    vdag_import_limits limits;
     char msg[256];
     voxdag_build_opts o;
     voxdag_builder *b;
@@ -476,7 +477,9 @@ static int cmd_build(int argc, char **argv) {
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--no-symmetry] ...");
     fprintf(stderr, "vdag: reading %s\n", a.in);
-    if (!vdag_import_file(a.in, NULL, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    memset(&limits, 0, sizeof limits);
+    limits.skip_textures = a.no_colors; /* no colours kept: nothing to decode them for */
+    if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);

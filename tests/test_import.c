@@ -534,6 +534,7 @@ static void test_obj_file(void) {
     bytes ppm = {NULL, 0, 0};
     vdag_scene s;
     vdag_image probe;
+    vdag_import_limits limits;
     int decodes;
     CHECK(mkdtemp(dir) != NULL);
     snprintf(path, sizeof path, "%s/scene.OBJ", dir);
@@ -568,6 +569,16 @@ static void test_obj_file(void) {
         } else {
             CHECK(s.image_count == 0 && s.materials[1].image == -1);
         }
+        vdag_scene_free(&s);
+    }
+    /* Callers that keep no colours skip the texture: the material keeps Kd. */
+    memset(&limits, 0, sizeof limits);
+    limits.skip_textures = 1;
+    if (!vdag_import_file(path, &limits, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.material_count == 3 && s.image_count == 0 && s.materials[1].image == -1);
+        CHECK(s.materials[1].rgb[0] == 128 && s.uv != NULL);
         vdag_scene_free(&s);
     }
     remove(tex);
