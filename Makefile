@@ -72,7 +72,7 @@ $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
 # (tests/fuzz_replay.h); `make test` replays and sweeps every corpus.
 FUZZ_NAMES   := import voxcolor load roundtrip
 FUZZ_SECONDS ?= 120
-FUZZ_DEPS    := tests/fuzz_replay.h tests/count_alloc.h tests/golden.h $(HEADERS) \
+FUZZ_DEPS    := tests/fuzz_replay.h tests/fuzz_require.h tests/count_alloc.h tests/golden.h $(HEADERS) \
                 examples/import.c examples/import_scene.c examples/import.h examples/image.h
 FUZZ_EXTRA_import := examples/import.c examples/image_none.c -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
 FUZZ_FLAGS   = $(CSTD) $(WARN) -g $(THREADS) -I. tests/fuzz_$*.c $(FUZZ_EXTRA_$*) -lm

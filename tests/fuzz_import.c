@@ -5,6 +5,7 @@
    "N passed, N failed". Broken invariants abort, as sanitizer errors do. */
 #define _POSIX_C_SOURCE 200809L
 #include "examples/import.h"
+#include "fuzz_require.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -24,13 +25,7 @@ void *fuzz_import_realloc(void *ptr, size_t size) {
     return realloc(ptr, size);
 }
 
-#define REQUIRE(cond)                                                                      \
-    do {                                                                                   \
-        if (!(cond)) {                                                                     \
-            fprintf(stderr, "fuzz_import: %s:%d: invariant broken: %s\n", __FILE__, __LINE__, #cond); \
-            abort();                                                                       \
-        }                                                                                  \
-    } while (0)
+#define REQUIRE(cond) require(cond, "invariant broken: " #cond)
 
 /* What every imported scene promises (import.h). */
 static void check_scene(const vdag_scene *s) {

@@ -21,6 +21,7 @@
 #include "voxdag.h"
 #include "golden.h"
 #include "count_alloc.h"
+#include "fuzz_require.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -31,13 +32,6 @@
 /* Allocation failure sweeps of the replay main (fuzz_replay.h). */
 #define FUZZ_ALLOC_SWEEP
 static long fuzz_fail_at = -1, fuzz_alloc_calls;
-
-static void require(int ok, const char *what) {
-    if (!ok) {
-        fprintf(stderr, "fuzz_load: %s\n", what);
-        abort();
-    }
-}
 
 // -- Queries on a loaded DAG
 

@@ -35,6 +35,7 @@
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
 #include "count_alloc.h"
+#include "fuzz_require.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -44,13 +45,6 @@
 /* Allocation failure sweeps of the replay main (fuzz_replay.h). */
 #define FUZZ_ALLOC_SWEEP
 static long fuzz_fail_at = -1, fuzz_alloc_calls;
-
-static void require(int ok, const char *what) {
-    if (!ok) {
-        fprintf(stderr, "fuzz_roundtrip: %s\n", what);
-        abort();
-    }
-}
 
 // -- The scene and its oracle
 

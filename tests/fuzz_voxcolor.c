@@ -14,6 +14,7 @@
    corpus tests/data/fuzz/voxcolor) and prints "N passed, N failed". */
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
+#include "fuzz_require.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -21,13 +22,6 @@
 #include <string.h>
 
 #define FUZZ_MAX_DECODE 65536
-
-static void require(int ok, const char *what) {
-    if (!ok) {
-        fprintf(stderr, "fuzz_voxcolor: %s\n", what);
-        abort();
-    }
-}
 
 static void fuzz_decode(const uint8_t *data, size_t size) {
     voxcolor_view v;
