@@ -1275,9 +1275,10 @@ static int voxcolori_fit_block(const voxcolori_enc *e, const uint8_t *rgb, size_
 
 /* Length of the longest prefix of RGB[0..n) that one block of F's mode and
    precision encodes within the bound, with its endpoints in F; 0 when not
-   even the first MIN colours fit (shorter blocks would not pay). Colours that fit the current endpoints are accepted as they are;
-   one that does not triggers a refit including it, and repeated refits a
-   refit over twice the length (so gradients cost O(n log n)). */
+   even the first MIN colours fit (shorter blocks would not pay). Colours
+   that fit the current endpoints are accepted as they are; one that does
+   not triggers a refit including it, and repeated refits a refit over twice
+   the length (so gradients cost O(n log n)). */
 static size_t voxcolori_extend(const voxcolori_enc *e, const uint8_t *rgb, size_t n, size_t min,
                                voxcolori_fit *f, voxcolori_cache *cache) {
     voxcolori_fit t = *f;

@@ -117,6 +117,13 @@ v = [tuple(map(int, l.split())) for l in sys.stdin]
 assert sorted(p[:3] for p in v) == sorted((x, y, 0) for x in range(8) for y in range(8)), v[:5]
 assert all(p[3:] == (255, 0, 0) for p in v)
 \""
+# A texture that cannot be decoded warns when colours are kept; --no-colors
+# does not read textures at all.
+printf 'newmtl t\nKd 1 0 0\nmap_Kd broken.png\n' >"$T/tex.mtl"
+printf 'not an image' >"$T/broken.png"
+printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl t\nf 1/1 2/2 3/3\n' >"$T/tex.obj"
+check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
+check "--no-colors skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors 2>'$T/err' && ! grep -q warning '$T/err'"
 
 # -- the demo scene generator
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
