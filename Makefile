@@ -137,9 +137,16 @@ BENCH_DEPS   := bench/scenes.h $(HEADERS) examples/import.c examples/import.h ex
 $(BUILD)/bench/bench_build: bench/bench_build.c $(BENCH_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
-$(BUILD)/bench/bench_geometry: bench/bench_geometry.c $(BENCH_DEPS)
+# Format version 2's sizes, side by side: its voxdag.h from the last
+# version-2 commit (git history; without it the column reads 0).
+VOXDAG_V2_COMMIT := 3013133
+$(BUILD)/bench/v2/voxdag.h:
 	@mkdir -p $(@D)
-	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
+	@git show $(VOXDAG_V2_COMMIT):voxdag.h > $@ 2>/dev/null || rm -f $@
+$(BUILD)/bench/bench_geometry: bench/bench_geometry.c bench/v2_size.c $(BENCH_DEPS) $(BUILD)/bench/v2/voxdag.h
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) $(if $(wildcard $(BUILD)/bench/v2/voxdag.h),-I$(BUILD)/bench,-DBENCH_NO_V2) -c -o $(BUILD)/bench/v2_size.o bench/v2_size.c
+	$(CC) $(BENCH_CFLAGS) -o $@ $< $(BUILD)/bench/v2_size.o examples/import.c examples/image_none.c -lm
 
 bench-data:
 	@sh bench/deps.sh

@@ -56,7 +56,7 @@
 #define VOXDAG_VERSION_PATCH 0
 #define VOXDAG_VERSION \
     (VOXDAG_VERSION_MAJOR * 10000 + VOXDAG_VERSION_MINOR * 100 + VOXDAG_VERSION_PATCH)
-#define VOXDAG_FORMAT_VERSION 2
+#define VOXDAG_FORMAT_VERSION 3
 
 #ifndef VOXDAG_MAX_LEVELS
 #define VOXDAG_MAX_LEVELS 21
@@ -123,15 +123,32 @@ typedef struct voxdag_allocator {
 
 // -- Building
 
+/* The symmetries under which a build stores equal subtrees once (SSVDAG
+   paper section 3, extended to the whole cube group). */
+typedef enum voxdag_symmetry {
+    VOXDAG_SYMMETRY_DEFAULT = 0, /* FULL */
+    VOXDAG_SYMMETRY_NONE = 1,    /* identical subtrees only (SVDAG) */
+    VOXDAG_SYMMETRY_REFLECT = 2, /* equal up to the 8 reflections (SSVDAG) */
+    VOXDAG_SYMMETRY_FULL = 3,    /* equal up to the 48 symmetries of the cube:
+                                    reflections and axis permutations */
+    VOXDAG_SYMMETRY_COUNT,
+    VOXDAG_SYMMETRY_FORCE_32BIT = 0x7fffffff
+} voxdag_symmetry;
+
+/* Capacity of the per-level arrays of public structs: fixed, so that units
+   compiled with different VOXDAG_MAX_LEVELS agree on every layout. */
+#define VOXDAG_LEVEL_CAPACITY 21
+
 typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
 
 /* Build options. A NULL pointer or an all-zero struct means defaults. */
 typedef struct voxdag_build_opts {
     uint32_t zero_begin;         /* must be 0 */
     uint32_t levels;             /* L, 2..VOXDAG_MAX_LEVELS; 0 means 10 */
-    int no_symmetry;             /* 1: plain SVDAG (share identical subtrees only) */
+    voxdag_symmetry symmetry;    /* 0: VOXDAG_SYMMETRY_FULL */
     int colors;                  /* 1: every voxel carries an RGB8 colour */
-    int compare_structures;      /* 1: also count SVDAG and SSVDAG nodes (2x work) */
+    int compare_structures;      /* 1: also count the nodes under the other two
+                                    symmetry groups (3x work) */
     uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit */
@@ -206,16 +223,19 @@ typedef struct voxdag_mesh {
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
                                                  voxdag_error *err);
 
-/* Per-level node counts and timing of a build, filled by voxdag_builder_finish.
-   Arrays are indexed by level 0..levels-2; the last entry counts 4^3 bricks. */
+/* Per-level node counts of a build, filled by voxdag_builder_finish. Arrays
+   are indexed by level 0..levels-2; the last entry counts 4^3 bricks. With
+   compare_structures, the same voxels are also reduced under every symmetry
+   group; else those three arrays are 0 but the one of the build's group. */
 typedef struct voxdag_build_stats {
     uint32_t levels;
     uint64_t voxels;
-    uint64_t nodes[VOXDAG_MAX_LEVELS];        /* stored unique nodes of the result */
-    uint64_t svo_nodes[VOXDAG_MAX_LEVELS];    /* nodes of the equivalent octree */
-    uint64_t svdag_nodes[VOXDAG_MAX_LEVELS];  /* 0 unless compare_structures */
-    uint64_t ssvdag_nodes[VOXDAG_MAX_LEVELS]; /* 0 unless compare_structures */
-    uint64_t peak_memory;                     /* bytes held by the builder at most */
+    uint64_t nodes[VOXDAG_LEVEL_CAPACITY];         /* stored unique nodes of the result */
+    uint64_t svo_nodes[VOXDAG_LEVEL_CAPACITY];     /* nodes of the equivalent octree */
+    uint64_t svdag_nodes[VOXDAG_LEVEL_CAPACITY];   /* identical subtrees shared */
+    uint64_t reflect_nodes[VOXDAG_LEVEL_CAPACITY]; /* shared up to reflections */
+    uint64_t full_nodes[VOXDAG_LEVEL_CAPACITY];    /* shared up to all 48 symmetries */
+    uint64_t peak_memory;                          /* bytes held by the builder at most */
 } voxdag_build_stats;
 
 /* Finishes the build: encodes the DAG and frees the builder (also on error).
@@ -289,10 +309,12 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
 
 typedef struct voxdag_info {
     uint32_t levels;
-    uint32_t symmetric;         /* built with reflections */
+    voxdag_symmetry symmetry;   /* the group it was built with (never DEFAULT) */
     uint64_t voxels;
-    uint64_t nodes[VOXDAG_MAX_LEVELS]; /* stored nodes per level; last = bricks */
-    uint64_t level_bytes[VOXDAG_MAX_LEVELS];
+    uint32_t voxel_box[6];      /* the occupied voxels: min x y z, max x y z (half-open,
+                                   grid units); all 0 when there are none */
+    uint64_t nodes[VOXDAG_LEVEL_CAPACITY]; /* stored nodes per level; last = bricks */
+    uint64_t level_bytes[VOXDAG_LEVEL_CAPACITY];
     uint64_t file_bytes;
     uint64_t node_bytes;        /* all inner levels */
     uint64_t brick_bytes;
@@ -374,7 +396,7 @@ VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
 
 // -- File layout (FORMAT.md): byte offsets and codes, checked by the tests
 
-#define VOXDAG_FILE_HEADER_SIZE 64
+#define VOXDAG_FILE_HEADER_SIZE 96
 #define VOXDAG_FILE_OFF_MAGIC 0
 #define VOXDAG_FILE_OFF_VERSION 8
 #define VOXDAG_FILE_OFF_ENDIAN 12
@@ -383,17 +405,19 @@ VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
 #define VOXDAG_FILE_OFF_FILE_SIZE 24
 #define VOXDAG_FILE_OFF_VOXELS 32
 #define VOXDAG_FILE_OFF_LEVELS 40
-#define VOXDAG_FILE_OFF_ROOT_MIRROR 41
+#define VOXDAG_FILE_OFF_ROOT_TRANSFORM 41
+#define VOXDAG_FILE_OFF_SYMMETRY 42
 #define VOXDAG_FILE_OFF_SECTION_COUNT 44
 #define VOXDAG_FILE_OFF_TABLE_CRC 48
 #define VOXDAG_FILE_OFF_HEADER_CRC 52
+#define VOXDAG_FILE_OFF_VOXEL_BOX 56
+#define VOXDAG_FILE_OFF_RESERVED 80
 #define VOXDAG_FILE_SECTION_ENTRY_SIZE 32
-#define VOXDAG_FILE_LEVEL_ENTRY_SIZE 24
+#define VOXDAG_FILE_LEVEL_ENTRY_SIZE 80
 #define VOXDAG_FILE_ENDIAN_TAG 0x0A0B0C0Du
-#define VOXDAG_FILE_FLAG_SYMMETRIC 1u
 #define VOXDAG_FILE_SECTION_OPTIONAL 1u
 #define VOXDAG_FILE_MAX_SECTIONS 16
-#define VOXDAG_FILE_NODE_PADDING 8
+#define VOXDAG_FILE_NODE_PADDING 16
 
 enum {
     VOXDAG_SECTION_LEVELS = 1,
@@ -463,6 +487,15 @@ static voxdag_status voxdagi_ok(voxdag_error *err) {
     }
     return VOXDAG_OK;
 }
+
+/* For the few helpers on the ray path that compilers would otherwise call. */
+#if defined(__GNUC__) || defined(__clang__)
+#define VOXDAGI_INLINE static inline __attribute__((always_inline))
+#elif defined(_MSC_VER)
+#define VOXDAGI_INLINE static __forceinline
+#else
+#define VOXDAGI_INLINE static
+#endif
 
 #define VOXDAGI_FAIL(err, status, msg) voxdagi_fail(err, status, msg, UINT64_MAX, UINT64_MAX)
 
@@ -665,7 +698,94 @@ static unsigned voxdagi_bytes_for(uint64_t v) { /* bytes to hold v, >= 1 */
     return n;
 }
 
-// -- Reflections (DESIGN 2, 3.2): the group {0..7} under XOR
+// -- The cube group: the 48 symmetries of a cube (SSVDAG 3, extended)
+//
+// A transform T = (perm, m) first moves axis a to axis perm[a], then mirrors
+// every axis a whose bit is set in m about the cube's centre. T is numbered
+// perm * 8 + m, the permutations in lexicographic order, so 0 is the identity
+// and 0..7 are the eight reflections (a group of their own). T acts the same
+// way on a child octant (bit a: the upper half along axis a) and on each of
+// the two coordinate-bit triples of a Morton position inside a 4^3 brick.
+// Every table below is derived from this definition when it is built, and
+// the tests check them against transforming points.
+
+#define VOXDAGI_TRANSFORMS 48
+
+typedef struct voxdagi_cube {
+    uint8_t act[VOXDAGI_TRANSFORMS][8];  /* T(i) for octant i */
+    uint8_t comp[VOXDAGI_TRANSFORMS][VOXDAGI_TRANSFORMS]; /* comp[A][B]: B, then A */
+    uint8_t inv[VOXDAGI_TRANSFORMS];
+    uint8_t swap[6][2];    /* axis-pair swaps (0..2; 3: none) that permute like perm */
+    uint64_t delta[3][2];  /* per axis pair: delta-swap masks of the low and high bit */
+} voxdagi_cube;
+
+static const uint8_t voxdagi_axis_pair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+
+/* The permutation numbered P: axis a goes to axis perm[a]. */
+static void voxdagi_perm(unsigned p, unsigned perm[3]) {
+    unsigned n = 0, a, b, c;
+    for (a = 0; a < 3; a++)
+        for (b = 0; b < 3; b++)
+            for (c = 0; c < 3; c++)
+                if (a != b && b != c && a != c && n++ == p) {
+                    perm[0] = a, perm[1] = b, perm[2] = c;
+                    return;
+                }
+}
+
+static unsigned voxdagi_permute_bits(unsigned x, const unsigned perm[3]) {
+    return (x & 1) << perm[0] | (x >> 1 & 1) << perm[1] | (x >> 2 & 1) << perm[2];
+}
+
+/* Swapping bits I < J of every Morton position exchanges the positions with
+   bit I set and bit J clear (this mask) with those 2^J - 2^I above them. */
+static uint64_t voxdagi_delta_mask(unsigned i, unsigned j) {
+    uint64_t m = 0;
+    unsigned p;
+    for (p = 0; p < 64; p++)
+        if ((p >> i & 1) && !(p >> j & 1)) m |= 1ull << p;
+    return m;
+}
+
+static void voxdagi_cube_init(voxdagi_cube *c) {
+    unsigned perm[6][3], T, A, B, i, k, s0, s1;
+    for (A = 0; A < 6; A++) voxdagi_perm(A, perm[A]);
+    for (T = 0; T < VOXDAGI_TRANSFORMS; T++)
+        for (i = 0; i < 8; i++) c->act[T][i] = (uint8_t)(voxdagi_permute_bits(i, perm[T >> 3]) ^ (T & 7));
+    for (A = 0; A < VOXDAGI_TRANSFORMS; A++)
+        for (B = 0; B < VOXDAGI_TRANSFORMS; B++) {
+            unsigned pc[3], p;
+            for (k = 0; k < 3; k++) pc[k] = perm[A >> 3][perm[B >> 3][k]];
+            for (p = 0; memcmp(perm[p], pc, sizeof pc); p++) {}
+            c->comp[A][B] = (uint8_t)(p << 3 | (voxdagi_permute_bits(B & 7, perm[A >> 3]) ^ (A & 7)));
+            if (c->comp[A][B] == 0) c->inv[A] = (uint8_t)B;
+        }
+    /* Each permutation as at most two axis swaps, found by trying them. */
+    for (A = 0; A < 6; A++)
+        for (s0 = 0; s0 < 4; s0++)
+            for (s1 = 0; s1 < 4; s1++) {
+                unsigned ok = 1;
+                for (i = 0; i < 8; i++) {
+                    unsigned x = i, s[2], n;
+                    s[0] = s0, s[1] = s1;
+                    for (n = 0; n < 2; n++)
+                        if (s[n] < 3) {
+                            unsigned a = voxdagi_axis_pair[s[n]][0], b = voxdagi_axis_pair[s[n]][1];
+                            unsigned xa = x >> a & 1, xb = x >> b & 1;
+                            x = (x & ~(1u << a | 1u << b)) | xa << b | xb << a;
+                        }
+                    ok &= x == voxdagi_permute_bits(i, perm[A]);
+                }
+                if (ok) {
+                    c->swap[A][0] = (uint8_t)s0, c->swap[A][1] = (uint8_t)s1;
+                    s0 = s1 = 4; /* the first found */
+                }
+            }
+    for (k = 0; k < 3; k++) {
+        c->delta[k][0] = voxdagi_delta_mask(voxdagi_axis_pair[k][0], voxdagi_axis_pair[k][1]);
+        c->delta[k][1] = voxdagi_delta_mask(voxdagi_axis_pair[k][0] + 3, voxdagi_axis_pair[k][1] + 3);
+    }
+}
 
 /* Reflecting a 4^3 brick by m moves Morton position p to p ^ (m | m << 3):
    one swap stage per set bit. */
@@ -682,27 +802,40 @@ static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
     return x;
 }
 
-/* Reflecting an 8-bit child mask by m moves octant i to i ^ m. */
-static unsigned voxdagi_reflect_mask8(unsigned x, unsigned m) {
-    if (m & 1) x = (x & 0x55) << 1 | ((x >> 1) & 0x55);
-    if (m & 2) x = (x & 0x33) << 2 | ((x >> 2) & 0x33);
-    if (m & 4) x = (x & 0x0F) << 4 | ((x >> 4) & 0x0F);
-    return x & 0xFF;
+/* Transforming a 4^3 brick by T moves the voxel at Morton position p to T(p):
+   the axis swaps of T's permutation (two delta swaps each), then its mirror. */
+static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsigned T) {
+    unsigned n, h;
+    for (n = 0; n < 2; n++) {
+        unsigned k = c->swap[T >> 3][n];
+        if (k > 2) continue;
+        for (h = 0; h < 2; h++) {
+            unsigned d = (1u << (voxdagi_axis_pair[k][1] + 3 * h)) - (1u << (voxdagi_axis_pair[k][0] + 3 * h));
+            uint64_t t = ((x >> d) ^ x) & c->delta[k][h];
+            x ^= t ^ (t << d);
+        }
+    }
+    return voxdagi_reflect_brick(x, T & 7);
+}
+
+/* Morton position T(p) inside a brick: T on each coordinate-bit triple. */
+static unsigned voxdagi_transform_pos(const voxdagi_cube *c, unsigned p, unsigned T) {
+    return (unsigned)(c->act[T][p & 7] | c->act[T][p >> 3] << 3);
 }
 
 // -- Unique node stores (one per level) with hash-consing
 
 #define VOXDAGI_NONE 0xFFFFFFFFu    /* an absent child reference */
-#define VOXDAGI_MAX_IDS (1u << 29)  /* references pack (id << 3 | mirror) */
+#define VOXDAGI_MAX_IDS (1u << 26)  /* references pack (id << 6 | transform) */
 
 /* The unique nodes of one level. Inner nodes keep 8 child references (each
-   (id << 3 | tag) into the next level, tag normalized by the child's
+   (id << 6 | tag) into the next level, tag normalized by the child's
    stabilizer) and a fingerprint; bricks keep their 64-bit mask in KEY. */
 typedef struct voxdagi_store {
     uint32_t *child;   /* 8 per node; NULL on the brick level */
     uint64_t *key;     /* fingerprint (inner) or mask (brick) */
     uint64_t *count;   /* voxels below (inner only) */
-    uint8_t *stab;     /* stabilizer: bit s set when reflecting by s is identity */
+    uint64_t *stab;    /* stabilizer: bit s set when transform s maps the node to itself */
     size_t n, cap;
     uint32_t *slot;    /* open-addressing table of id + 1; 0 = free */
     size_t slot_count; /* power of two */
@@ -713,7 +846,7 @@ static void voxdagi_store_free_arrays(voxdagi_mem *m, voxdagi_store *s) {
     voxdagi_free(m, s->child, s->cap * 8 * sizeof *s->child);
     voxdagi_free(m, s->key, s->cap * sizeof *s->key);
     voxdagi_free(m, s->count, s->cap * sizeof *s->count);
-    voxdagi_free(m, s->stab, s->cap);
+    voxdagi_free(m, s->stab, s->cap * sizeof *s->stab);
 }
 
 static void voxdagi_store_free(voxdagi_mem *m, voxdagi_store *s) {
@@ -736,19 +869,19 @@ static int voxdagi_store_same(const voxdagi_store *s, uint32_t id, uint64_t key,
 static int voxdagi_store_reserve(voxdagi_mem *m, voxdagi_store *s, int inner) {
     size_t cap = s->cap ? s->cap * 2 : 256;
     uint64_t *key = (uint64_t *)voxdagi_alloc(m, cap * sizeof *key);
-    uint8_t *stab = (uint8_t *)voxdagi_alloc(m, cap);
+    uint64_t *stab = (uint64_t *)voxdagi_alloc(m, cap * sizeof *stab);
     uint32_t *child = inner ? (uint32_t *)voxdagi_alloc(m, cap * 8 * sizeof *child) : NULL;
     uint64_t *count = inner ? (uint64_t *)voxdagi_alloc(m, cap * sizeof *count) : NULL;
     if (!key || !stab || (inner && (!child || !count))) {
         voxdagi_free(m, key, cap * sizeof *key);
-        voxdagi_free(m, stab, cap);
+        voxdagi_free(m, stab, cap * sizeof *stab);
         voxdagi_free(m, child, cap * 8 * sizeof *child);
         voxdagi_free(m, count, cap * sizeof *count);
         return 0;
     }
     if (s->n) {
         memcpy(key, s->key, s->n * sizeof *key);
-        memcpy(stab, s->stab, s->n);
+        memcpy(stab, s->stab, s->n * sizeof *stab);
         if (inner) {
             memcpy(child, s->child, s->n * 8 * sizeof *child);
             memcpy(count, s->count, s->n * sizeof *count);
@@ -767,7 +900,7 @@ static int voxdagi_store_reserve(voxdagi_mem *m, voxdagi_store *s, int inner) {
    when out of memory or ids. */
 static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner,
                                      uint64_t key, const uint32_t *child,
-                                     uint64_t count, unsigned stab) {
+                                     uint64_t count, uint64_t stab) {
     uint64_t h = inner ? key : voxdagi_mix64(key);
     size_t i, mask;
     uint32_t id;
@@ -794,7 +927,7 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
     if (s->n == s->cap && !voxdagi_store_reserve(m, s, inner)) return VOXDAGI_NONE;
     id = (uint32_t)s->n++;
     s->key[id] = key;
-    s->stab[id] = (uint8_t)stab;
+    s->stab[id] = stab;
     if (inner) {
         memcpy(s->child + 8 * (size_t)id, child, 8 * sizeof *child);
         s->count[id] = count;
@@ -805,110 +938,129 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
     return id;
 }
 
-// -- Canonical forms under reflection (DESIGN 3.3)
+// -- Canonical forms under a group of cube symmetries (SSVDAG 3.3, exact)
+//
+// A reference (n, t) is "stored node n transformed by t". It names the same
+// subtree as (n, t o s) for every s in the stabilizer S(n) (the transforms
+// mapping n to itself), so keys use the smallest tag of that coset. A node's
+// key is its 8 (child, tag) slots; transforming the node by T puts the child
+// of octant i, with tag T o t, in slot T(i). The canonical form is the
+// transform with the smallest key; all transforms reaching it are T* o S.
 
-/* norm[S][t]: the smallest tag of the coset { t ^ s : s in S } for every
-   stabilizer bitmask S. References (n, t) and (n, t ^ s) with s in S(n) name
-   the same subtree; keys use the smallest so that equal subtrees compare equal. */
+/* The transforms a build shares nodes under (0..count-1: 1 for none, the 8
+   reflections, or all 48), and the tables canonicalization uses. */
 typedef struct voxdagi_group {
-    uint8_t norm[256][8];
-    unsigned reflections; /* 8 with symmetry, 1 without */
+    voxdagi_cube cube;
+    uint8_t src[VOXDAGI_TRANSFORMS][8];      /* octant whose child lands in slot i: T^-1(i) */
+    uint8_t mask8[VOXDAGI_TRANSFORMS][256];  /* a child-presence mask seen through T */
+    unsigned count;
 } voxdagi_group;
 
-static void voxdagi_group_init(voxdagi_group *g, int symmetric) {
-    unsigned S, t, s;
-    for (S = 0; S < 256; S++)
-        for (t = 0; t < 8; t++) {
-            unsigned best = t;
-            for (s = 0; s < 8; s++)
-                if ((S >> s & 1) && (t ^ s) < best) best = t ^ s;
-            g->norm[S][t] = (uint8_t)best;
-        }
-    g->reflections = symmetric ? 8 : 1;
-}
-
-/* A reference to the canonical node ID reached through reflection M. */
-typedef struct voxdagi_canon {
-    uint64_t key;
-    unsigned mirror, stab;
-} voxdagi_canon;
-
-/* Bricks: the canonical form is the reflection with the smallest mask. */
-static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
-    voxdagi_canon c;
-    uint64_t r[8];
-    unsigned m;
-    c.key = mask;
-    c.mirror = 0;
-    for (m = 0; m < g->reflections; m++) {
-        r[m] = m ? voxdagi_reflect_brick(mask, m) : mask;
-        if (r[m] < c.key) {
-            c.key = r[m];
-            c.mirror = m;
+static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
+    unsigned T, x, i;
+    voxdagi_cube_init(&g->cube);
+    for (T = 0; T < VOXDAGI_TRANSFORMS; T++) {
+        for (i = 0; i < 8; i++) g->src[T][i] = g->cube.act[g->cube.inv[T]][i];
+        for (x = 0; x < 256; x++) {
+            unsigned y = 0;
+            for (i = 0; i < 8; i++) y |= (x >> i & 1) << g->cube.act[T][i];
+            g->mask8[T][x] = (uint8_t)y;
         }
     }
+    g->count = symmetry == VOXDAG_SYMMETRY_NONE ? 1 : symmetry == VOXDAG_SYMMETRY_REFLECT ? 8 : 48;
+}
+
+/* The smallest tag of the coset T o S. */
+static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t S) {
+    unsigned best = t;
+    S &= ~1ull; /* the identity gives t itself */
+    while (S) {
+        unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1), u = c->comp[t][s];
+        if (u < best) best = u;
+        S &= S - 1;
+    }
+    return best;
+}
+
+/* A reference to the canonical form: its key, the tag that maps the canonical
+   node back to the input, and the canonical node's stabilizer. */
+typedef struct voxdagi_canon {
+    uint64_t key, stab;
+    unsigned tag;
+} voxdagi_canon;
+
+/* Bricks: the canonical form is the transform with the smallest mask. */
+static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
+    voxdagi_canon c;
+    uint64_t r[VOXDAGI_TRANSFORMS];
+    unsigned T, best = 0;
+    r[0] = mask;
+    for (T = 1; T < g->count; T++) {
+        r[T] = voxdagi_transform_brick(&g->cube, mask, T);
+        if (r[T] < r[best]) best = T;
+    }
+    c.key = r[best];
+    c.tag = g->cube.inv[best];
     c.stab = 0;
-    for (m = 0; m < g->reflections; m++)
-        if (r[m] == mask) c.stab |= 1u << m;
+    for (T = 0; T < g->count; T++)
+        if (r[T] == r[best]) c.stab |= 1ull << g->cube.comp[T][c.tag];
     return c;
 }
 
-/* The slots of an inner node seen through reflection m: slot i holds the
-   child of octant i ^ m with its tag composed with m and normalized. */
+/* The children of an inner node as the reducer sees them. */
 typedef struct voxdagi_children {
     unsigned present;  /* bit j: octant j has a child */
     uint32_t id[8];
     unsigned tag[8];
-    unsigned stab[8];
+    uint64_t stab[8];
     uint64_t fp[8];    /* the child's fingerprint */
 } voxdagi_children;
 
-/* Total order on reflections of one node: presence mask first, then per slot
-   the child's fingerprint, normalized tag and id. Fingerprints come first so
-   that the choice does not depend on id numbering (which varies with thread
-   count); ids only break fingerprint collisions, keeping the order total. */
-static int voxdagi_compare_reflections(const voxdagi_group *g, const voxdagi_children *c,
-                                       unsigned present, unsigned a, unsigned b) {
+/* Total order on transforms of one node with presence mask PRESENT under
+   both: per slot the child's fingerprint, normalized tag and id. Fingerprints
+   come first so that the choice does not depend on id numbering (which
+   varies with thread count); ids only break fingerprint collisions, keeping
+   the order total. */
+static int voxdagi_compare_transforms(const voxdagi_group *g, const voxdagi_children *c,
+                                      unsigned present, unsigned a, unsigned b) {
     unsigned i;
     for (i = 0; i < 8; i++) {
-        unsigned ja = i ^ a, jb = i ^ b, ta, tb;
+        unsigned ja = g->src[a][i], jb = g->src[b][i], ta, tb;
         if (!(present >> i & 1)) continue;
         if (c->fp[ja] != c->fp[jb]) return c->fp[ja] < c->fp[jb] ? -1 : 1;
-        ta = g->norm[c->stab[ja]][c->tag[ja] ^ a];
-        tb = g->norm[c->stab[jb]][c->tag[jb] ^ b];
+        ta = voxdagi_normalize(&g->cube, g->cube.comp[a][c->tag[ja]], c->stab[ja]);
+        tb = voxdagi_normalize(&g->cube, g->cube.comp[b][c->tag[jb]], c->stab[jb]);
         if (ta != tb) return ta < tb ? -1 : 1;
         if (c->id[ja] != c->id[jb]) return c->id[ja] < c->id[jb] ? -1 : 1;
     }
     return 0;
 }
 
-/* Inner nodes: the canonical key (child slots) is the smallest reflection in
-   the order above; all reflections reaching it form mirror ^ stabilizer. */
+/* Inner nodes: the canonical slots (presence mask first, then the order
+   above) and their fingerprint. */
 static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_children *c,
                                         uint32_t slots[8]) {
     voxdagi_canon r;
-    unsigned m, i, best_present = 0x100;
+    unsigned T, i, best = 0, best_present = 0x100;
     uint64_t h = 0x9E3779B97F4A7C15ull;
-    r.mirror = 0;
-    for (m = 0; m < g->reflections; m++) {
-        unsigned p = voxdagi_reflect_mask8(c->present, m);
-        if (p < best_present ||
-            (p == best_present && voxdagi_compare_reflections(g, c, p, m, r.mirror) < 0)) {
+    for (T = 0; T < g->count; T++) {
+        unsigned p = g->mask8[T][c->present];
+        if (p < best_present || (p == best_present && voxdagi_compare_transforms(g, c, p, T, best) < 0)) {
             best_present = p;
-            r.mirror = m;
+            best = T;
         }
     }
+    r.tag = g->cube.inv[best];
     r.stab = 0;
-    for (m = 0; m < g->reflections; m++)
-        if (voxdagi_reflect_mask8(c->present, m) == best_present &&
-            voxdagi_compare_reflections(g, c, best_present, m, r.mirror) == 0)
-            r.stab |= 1u << (m ^ r.mirror);
+    for (T = 0; T < g->count; T++)
+        if (g->mask8[T][c->present] == best_present && voxdagi_compare_transforms(g, c, best_present, T, best) == 0)
+            r.stab |= 1ull << g->cube.comp[T][r.tag];
     for (i = 0; i < 8; i++) {
-        unsigned j = i ^ r.mirror, t;
+        unsigned j = g->src[best][i], t;
         uint64_t v = 0;
         if (best_present >> i & 1) {
-            t = g->norm[c->stab[j]][c->tag[j] ^ r.mirror];
-            slots[i] = c->id[j] << 3 | t;
+            t = voxdagi_normalize(&g->cube, g->cube.comp[best][c->tag[j]], c->stab[j]);
+            slots[i] = c->id[j] << 6 | t;
             v = c->fp[j] + (uint64_t)(t + 1) * 0xD6E8FEB86659FD93ull;
         } else {
             slots[i] = VOXDAGI_NONE;
@@ -987,7 +1139,7 @@ static void voxdagi_reducer_free(voxdagi_reducer *r) {
     r->memo = NULL;
 }
 
-/* Interns a brick mask; returns the reference (id << 3 | mirror). */
+/* Interns a brick mask; returns the reference (id << 6 | transform). */
 static uint32_t voxdagi_reduce_brick(voxdagi_reducer *r, uint64_t mask) {
     uint32_t word[8] = {0}, *memo, id;
     voxdagi_canon c;
@@ -1001,8 +1153,8 @@ static uint32_t voxdagi_reduce_brick(voxdagi_reducer *r, uint64_t mask) {
         r->failed = 1;
         return VOXDAGI_NONE;
     }
-    if (memo) *memo = id << 3 | c.mirror;
-    return id << 3 | c.mirror;
+    if (memo) *memo = id << 6 | c.tag;
+    return id << 6 | c.tag;
 }
 
 /* Interns the inner node of level L with child references REF[8] (into level
@@ -1019,13 +1171,14 @@ static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const ui
     for (j = 0; j < 8; j++) {
         if (ref[j] == VOXDAGI_NONE) {
             c.id[j] = 0;
-            c.tag[j] = c.stab[j] = 0;
+            c.tag[j] = 0;
+            c.stab[j] = 0;
             c.fp[j] = 0;
             continue;
         }
         c.present |= 1u << j;
-        c.id[j] = ref[j] >> 3;
-        c.tag[j] = ref[j] & 7;
+        c.id[j] = ref[j] >> 6;
+        c.tag[j] = ref[j] & 63;
         c.stab[j] = cs->stab[c.id[j]];
         c.fp[j] = cs->key[c.id[j]];
         count += voxdagi_store_count(cs, c.id[j]);
@@ -1036,8 +1189,8 @@ static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const ui
         r->failed = 1;
         return VOXDAGI_NONE;
     }
-    if (memo) *memo = id << 3 | k.mirror;
-    return id << 3 | k.mirror;
+    if (memo) *memo = id << 6 | k.tag;
+    return id << 6 | k.tag;
 }
 
 static void voxdagi_reducer_push(voxdagi_reducer *r, uint32_t level, uint64_t key, uint32_t ref);
@@ -1147,8 +1300,9 @@ struct voxdag_builder {
     uint32_t threads;
     int has_bounds;
     double bounds[6];
-    voxdagi_group group[2];      /* [0]: as requested, [1]: plain (comparison) */
-    voxdagi_reducer red[2];      /* the result, and the other structure when compared */
+    voxdag_symmetry symmetry;    /* resolved: NONE, REFLECT or FULL */
+    voxdagi_group group[3];      /* [0]: as requested, [1], [2]: the others (comparison) */
+    voxdagi_reducer red[3];      /* the result, and the other structures when compared */
     unsigned red_count;
     uint64_t *pend_code;         /* buffered voxels */
     uint32_t *pend_rgb;
@@ -1167,7 +1321,7 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     voxdag_build_opts o;
     voxdagi_mem mem;
     voxdag_builder *b;
-    unsigned k;
+    unsigned k, n;
     if (!out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "out is NULL");
     *out = NULL;
     memset(&o, 0, sizeof o);
@@ -1176,6 +1330,8 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
                             "build options not zero-initialized");
     if (!o.levels) o.levels = 10;
+    if ((unsigned)o.symmetry >= VOXDAG_SYMMETRY_COUNT)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "symmetry is not a voxdag_symmetry");
     if (o.levels < 2 || o.levels > VOXDAG_MAX_LEVELS)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "levels outside 2..VOXDAG_MAX_LEVELS");
     if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
@@ -1207,9 +1363,11 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
         memcpy(b->bounds, o.bounds, sizeof b->bounds);
     }
     b->opts.bounds = NULL;
-    voxdagi_group_init(&b->group[0], !o.no_symmetry);
-    voxdagi_group_init(&b->group[1], o.no_symmetry);
-    b->red_count = o.compare_structures ? 2 : 1;
+    b->symmetry = o.symmetry ? o.symmetry : VOXDAG_SYMMETRY_FULL;
+    voxdagi_group_init(&b->group[0], b->symmetry);
+    for (k = VOXDAG_SYMMETRY_NONE, n = 1; k <= VOXDAG_SYMMETRY_FULL; k++)
+        if (k != (unsigned)b->symmetry) voxdagi_group_init(&b->group[n++], (voxdag_symmetry)k);
+    b->red_count = o.compare_structures ? 3 : 1;
     for (k = 0; k < b->red_count; k++)
         voxdagi_reducer_init(&b->red[k], &b->mem, &b->group[k], b->levels, 0);
     *out = b;
@@ -1423,12 +1581,12 @@ static void voxdagi_reducer_close_below(voxdagi_reducer *r, uint32_t level) {
    depend on how the work was split). */
 typedef struct voxdagi_piece {
     size_t begin, end;  /* range of buffered voxels */
-    uint32_t root[2];   /* the worker's root reference, per reducer */
+    uint32_t root[3];   /* the worker's root reference, per reducer */
 } voxdagi_piece;
 
 typedef struct voxdagi_worker {
     voxdag_builder *b;
-    voxdagi_reducer red[2];
+    voxdagi_reducer red[3];
     voxdagi_piece *piece;
     size_t piece_count;
     const uint64_t *code;
@@ -1451,6 +1609,11 @@ static void *voxdagi_worker_run(void *arg) {
     return NULL;
 }
 
+/* The reference "T applied to reference REF": the same node, tag T o t. */
+static uint32_t voxdagi_ref_compose(const voxdagi_group *g, unsigned T, uint32_t ref) {
+    return (ref & ~63u) | g->cube.comp[T][ref & 63];
+}
+
 /* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
    receives, per worker id, the reference in R. Returns 0 when out of memory. */
 static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map, size_t *map_size) {
@@ -1468,15 +1631,19 @@ static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map,
             if (s->child) /* children as references into R; SAME: any not in W's orientation */
                 for (j = 0; j < 8; j++) {
                     uint32_t x = s->child[8 * i + j];
-                    c[j] = x == VOXDAGI_NONE ? x : map[l + 1][x >> 3] ^ (x & 7);
-                    if (x != VOXDAGI_NONE) same |= map[l + 1][x >> 3] & 7;
+                    if (x == VOXDAGI_NONE) {
+                        c[j] = x;
+                        continue;
+                    }
+                    c[j] = voxdagi_ref_compose(r->group, x & 63, map[l + 1][x >> 6]);
+                    same |= map[l + 1][x >> 6] & 63;
                 }
             if (!same) {
                 /* Canonical forms do not depend on ids (fingerprints decide),
                    so W's node is already canonical in R: intern it as is. */
                 id = voxdagi_store_intern(r->mem, &r->store[l], s->child != NULL, s->key[i], s->child ? c : NULL,
                                           s->child ? s->count[i] : 0, s->stab[i]);
-                ref = id == VOXDAGI_NONE ? id : id << 3;
+                ref = id == VOXDAGI_NONE ? id : id << 6;
             } else { /* a fingerprint collision made the orientations differ */
                 ref = voxdagi_reduce_node(r, l, c);
             }
@@ -1562,7 +1729,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
                 st = VOXDAG_ERR_OUT_OF_MEMORY;
             for (p = 0; p < worker[t].piece_count && st == VOXDAG_OK; p++) {
                 uint32_t x = worker[t].piece[p].root[k];
-                worker[t].piece[p].root[k] = map[split][x >> 3] ^ (x & 7);
+                worker[t].piece[p].root[k] = voxdagi_ref_compose(b->red[k].group, x & 63, map[split][x >> 6]);
             }
             for (i = 0; i < VOXDAG_MAX_LEVELS; i++) voxdagi_free(&b->mem, map[i], map_size[i]);
         }
@@ -2177,20 +2344,28 @@ static uint8_t *voxdagi_layout_section(uint8_t *image, const voxdagi_layout *lay
     return NULL;
 }
 
+/* What the header says about the scene. */
+typedef struct voxdagi_scene {
+    uint32_t levels, root_transform;
+    voxdag_symmetry symmetry;
+    uint64_t voxels;
+    uint32_t voxel_box[6];
+} voxdagi_scene;
+
 /* Writes the header and section table (with checksums) of a filled image. */
-static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, uint32_t flags,
-                                uint32_t levels, uint32_t root_mirror, uint64_t voxels) {
+static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, const voxdagi_scene *sc) {
     uint8_t *table = img + VOXDAG_FILE_HEADER_SIZE;
     uint32_t i;
     memcpy(img + VOXDAG_FILE_OFF_MAGIC, voxdagi_magic, 8);
     voxdagi_put_le(img + VOXDAG_FILE_OFF_VERSION, VOXDAG_FORMAT_VERSION, 4);
     voxdagi_put_le(img + VOXDAG_FILE_OFF_ENDIAN, VOXDAG_FILE_ENDIAN_TAG, 4);
     voxdagi_put_le(img + VOXDAG_FILE_OFF_HEADER_SIZE, VOXDAG_FILE_HEADER_SIZE, 4);
-    voxdagi_put_le(img + VOXDAG_FILE_OFF_FLAGS, flags, 4);
     voxdagi_put_le(img + VOXDAG_FILE_OFF_FILE_SIZE, lay->total, 8);
-    voxdagi_put_le(img + VOXDAG_FILE_OFF_VOXELS, voxels, 8);
-    img[VOXDAG_FILE_OFF_LEVELS] = (uint8_t)levels;
-    img[VOXDAG_FILE_OFF_ROOT_MIRROR] = (uint8_t)root_mirror;
+    voxdagi_put_le(img + VOXDAG_FILE_OFF_VOXELS, sc->voxels, 8);
+    img[VOXDAG_FILE_OFF_LEVELS] = (uint8_t)sc->levels;
+    img[VOXDAG_FILE_OFF_ROOT_TRANSFORM] = (uint8_t)sc->root_transform;
+    img[VOXDAG_FILE_OFF_SYMMETRY] = (uint8_t)sc->symmetry;
+    for (i = 0; i < 6; i++) voxdagi_put_le(img + VOXDAG_FILE_OFF_VOXEL_BOX + 4 * i, sc->voxel_box[i], 4);
     voxdagi_put_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, lay->count, 4);
     for (i = 0; i < lay->count; i++) {
         uint8_t *e = table + i * VOXDAG_FILE_SECTION_ENTRY_SIZE;
@@ -2206,18 +2381,49 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, uint32_
     voxdagi_put_le(img + VOXDAG_FILE_OFF_HEADER_CRC, voxdagi_crc32c(img, VOXDAG_FILE_HEADER_SIZE), 4);
 }
 
-// -- Compact encoding (DESIGN 4; SSVDAG 4.3, extended with voxel counts)
+// -- Compact encoding (FORMAT.md; SSVDAG 4.3, extended)
 //
 // Per level, nodes are ordered by reference count (most referenced first) so
-// that most pointers are short. A node record is: a 16-bit header with a
-// 2-bit tag per child octant (0 absent, else one of the level's three pointer
-// sizes), the node's voxel count in the level's count width (levels above
-// L-3 only: an L-3 count is the popcount of its bricks), then the present
-// children's pointers in octant order. A pointer is (target << 3 | mirror),
-// little-endian; the target is a byte offset into the next level, or a brick
-// index. Each level picks its three pointer sizes (of 1..8 bytes) for the
-// fewest bytes, where the paper fixes 2 and 4; with byte-aligned, unpadded
-// records this is what pays for the counts.
+// that most pointers are short, and every node is stored in the orientation
+// most of its references see it in, so that most pointers carry no
+// transform. A record is byte-aligned: a 16-bit header with a 2-bit tag per
+// child octant (0 absent, else one of the level's three pointer classes), the
+// node's voxel count in the level's count width C in bits (none at level L-3,
+// whose counts are the popcounts of its bricks), then the present children's
+// pointers in octant order, bit-packed. A pointer of class t has W_t = O_t +
+// K_t bits: the target (byte offset in the next level, or brick index) above
+// a K_t-bit code into the level's transform table (sorted by frequency, so
+// code 0 is the most common transform). Each level picks its classes for the
+// fewest bits.
+
+/* The number of bits of V (0 for 0). */
+static unsigned voxdagi_bit_length(uint64_t v) {
+    unsigned n = 0;
+    while (v) n++, v >>= 1;
+    return n;
+}
+
+/* ORs the low N bits of V into P at bit POS (P zeroed beforehand). */
+static void voxdagi_put_bits(uint8_t *p, uint64_t pos, uint64_t v, unsigned n) {
+    while (n) {
+        unsigned sh = (unsigned)(pos & 7), take = 8 - sh < n ? 8 - sh : n;
+        p[pos >> 3] = (uint8_t)(p[pos >> 3] | (v & ((1u << take) - 1)) << sh);
+        v >>= take, pos += take, n -= take;
+    }
+}
+
+/* N <= 57 bits at bit POS of P; 8 bytes from byte POS / 8 must be readable. */
+VOXDAGI_INLINE uint64_t voxdagi_get_bits(const uint8_t *p, uint64_t pos, unsigned n) {
+    return voxdagi_le_fast(p + (pos >> 3), 8) >> (pos & 7) & ((1ull << n) - 1);
+}
+
+/* N <= 64 bits at bit POS of P; 9 bytes from byte POS / 8 must be readable. */
+static uint64_t voxdagi_get_bits_wide(const uint8_t *p, uint64_t pos, unsigned n) {
+    unsigned sh = (unsigned)(pos & 7);
+    uint64_t v = voxdagi_le_fast(p + (pos >> 3), 8) >> sh;
+    if (sh + n > 64) v |= (uint64_t)p[(pos >> 3) + 8] << (64 - sh);
+    return n < 64 ? v & ((1ull << n) - 1) : v;
+}
 
 /* Storage order of a level: most referenced first, ties by fingerprint (or
    mask), then by id; two stable radix sorts. Fills ORDER with ids. Returns 0
@@ -2246,30 +2452,59 @@ static int voxdagi_storage_order(voxdagi_mem *m, const voxdagi_store *s, const u
     return ok;
 }
 
-/* The tag (1..3) of the smallest pointer size of the level that holds V. */
-static unsigned voxdagi_pointer_tag(uint64_t v, const unsigned char size[4]) {
-    unsigned need = voxdagi_bytes_for(v);
-    return need <= size[1] ? 1 : need <= size[2] ? 2 : 3;
+/* A level's pointer classes: tag t (1..3) holds O[t] target bits above K[t]
+   code bits. */
+typedef struct voxdagi_classes {
+    unsigned char O[4], K[4];
+} voxdagi_classes;
+
+/* The cheapest class (1..3) that holds a target of OB bits and a code of KB
+   bits, or 0 when none does. */
+static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigned kb) {
+    unsigned t, best = 0;
+    for (t = 1; t <= 3; t++)
+        if (c->O[t] >= ob && c->K[t] >= kb && (!best || c->O[t] + c->K[t] < c->O[best] + c->K[best])) best = t;
+    return best;
 }
 
-/* Chooses a level's three pointer sizes (1..8 bytes, increasing) for the
-   fewest pointer bytes, given how many pointers need 1..8 bytes. */
-static void voxdagi_choose_sizes(const uint64_t need[9], unsigned char size[4]) {
-    unsigned a, b, c, top = 8, k;
-    uint64_t best = UINT64_MAX;
-    while (top > 1 && !need[top]) top--;
-    size[0] = 0;
-    for (a = 1; a <= 8; a++)
-        for (b = a + 1; b <= 8; b++)
-            for (c = b + 1; c <= 8; c++) {
+/* Chooses three classes for the fewest pointer bits, given how many pointers
+   need OB target bits and KB code bits (HIST[ob][kb]). Candidate classes
+   take a target width that occurs and any code width up to the largest. */
+static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) {
+    unsigned cand[7 * 58][2], cell[58 * 7][2], nc = 0, ncell = 0, ob, kb, kmax = 0, a, b, c, i;
+    uint64_t best_cost = UINT64_MAX;
+    for (ob = 0; ob < 58; ob++)
+        for (kb = 0; kb < 7; kb++)
+            if (hist[ob][kb]) {
+                cell[ncell][0] = ob, cell[ncell][1] = kb, ncell++;
+                if (kb > kmax) kmax = kb;
+            }
+    for (ob = 0; ob < 58; ob++) {
+        int any = 0;
+        for (kb = 0; kb < 7; kb++) any |= hist[ob][kb] != 0;
+        if (!any) continue;
+        for (kb = 0; kb <= kmax; kb++) cand[nc][0] = ob, cand[nc][1] = kb, nc++;
+    }
+    memset(best, 0, sizeof *best);
+    best->O[1] = best->O[2] = best->O[3] = 57 - 6;
+    best->K[1] = best->K[2] = best->K[3] = 6;
+    for (a = 0; a < nc; a++)
+        for (b = a; b < nc; b++)
+            for (c = b; c < nc; c++) {
+                voxdagi_classes t;
                 uint64_t cost = 0;
-                if (c < top) continue;
-                for (k = 1; k <= 8; k++) cost += need[k] * (k <= a ? a : k <= b ? b : c);
-                if (cost < best) {
-                    best = cost;
-                    size[1] = (unsigned char)a;
-                    size[2] = (unsigned char)b;
-                    size[3] = (unsigned char)c;
+                int ok = 1;
+                const unsigned *pick[3];
+                pick[0] = cand[a], pick[1] = cand[b], pick[2] = cand[c];
+                for (i = 0; i < 3; i++) t.O[i + 1] = (unsigned char)pick[i][0], t.K[i + 1] = (unsigned char)pick[i][1];
+                for (i = 0; i < ncell && ok; i++) {
+                    unsigned k = voxdagi_class_for(&t, cell[i][0], cell[i][1]);
+                    if (!k) ok = 0;
+                    else cost += hist[cell[i][0]][cell[i][1]] * (t.O[k] + t.K[k]);
+                }
+                if (ok && cost < best_cost) {
+                    best_cost = cost;
+                    *best = t;
                 }
             }
 }
@@ -2277,12 +2512,18 @@ static void voxdagi_choose_sizes(const uint64_t need[9], unsigned char size[4]) 
 typedef struct voxdagi_encoder {
     voxdagi_mem *mem;
     const voxdagi_reducer *r;
+    const voxdagi_cube *cube;
     uint32_t levels;
-    uint32_t *order[VOXDAG_MAX_LEVELS]; /* ids in storage order */
-    uint64_t *pos[VOXDAG_MAX_LEVELS];   /* per id: byte offset, or brick index */
-    uint64_t size[VOXDAG_MAX_LEVELS];   /* bytes of each inner level */
-    unsigned count_bytes[VOXDAG_MAX_LEVELS];
-    unsigned char ptr_bytes[VOXDAG_MAX_LEVELS][4]; /* size of tags 1..3 */
+    uint32_t *order[VOXDAG_MAX_LEVELS];  /* ids in storage order */
+    uint64_t *pos[VOXDAG_MAX_LEVELS];    /* per id: byte offset, or brick index */
+    uint8_t *orient[VOXDAG_MAX_LEVELS];  /* per id: R, the node is stored as R(canonical) */
+    uint64_t size[VOXDAG_MAX_LEVELS];    /* bytes of each inner level */
+    unsigned count_bits[VOXDAG_MAX_LEVELS];
+    voxdagi_classes cls[VOXDAG_MAX_LEVELS];
+    uint8_t code[VOXDAG_MAX_LEVELS][VOXDAGI_TRANSFORMS];  /* transform -> code */
+    uint8_t table[VOXDAG_MAX_LEVELS][VOXDAGI_TRANSFORMS]; /* code -> transform */
+    unsigned table_len[VOXDAG_MAX_LEVELS];
+    unsigned root_transform;
 } voxdagi_encoder;
 
 static void voxdagi_encoder_free(voxdagi_encoder *e) {
@@ -2291,41 +2532,147 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
         size_t n = e->r->store[l].n;
         voxdagi_free(e->mem, e->order[l], n * sizeof(uint32_t));
         voxdagi_free(e->mem, e->pos[l], n * sizeof(uint64_t));
+        voxdagi_free(e->mem, e->orient[l], n);
     }
 }
 
-/* Count bytes C of each inner level: enough for its largest count, and 0
-   (counts derived from the children's) at level L-3, whose children are
+/* The stored transform of the reference from a node stored as RP(canonical)
+   to child reference X (id << 6 | t) of level L + 1: RP o t o s o RC^-1 for
+   s in the child's stabilizer, the smallest of them. */
+static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigned rp, uint32_t x) {
+    const voxdagi_cube *c = e->cube;
+    unsigned u = c->comp[rp][x & 63], rc_inv = c->inv[e->orient[l + 1][x >> 6]];
+    unsigned best = c->comp[u][rc_inv];
+    uint64_t S = e->r->store[l + 1].stab[x >> 6] & ~1ull;
+    while (S) {
+        unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1), v = c->comp[c->comp[u][s]][rc_inv];
+        if (v < best) best = v;
+        S &= S - 1;
+    }
+    return best;
+}
+
+/* Orientations, top-down: a node is stored as R(canonical) for the R that
+   makes the most references to it carry the identity (ties: the smallest R).
+   A reference (n, t) from a parent stored as RP does so for every R in
+   RP o t o S(n). The references into a level are gathered per node first. */
+static int voxdagi_orient(voxdagi_encoder *e) {
+    const voxdagi_reducer *r = e->r;
+    const voxdagi_cube *c = e->cube;
+    uint32_t B = e->levels - 2, l;
+    for (l = 0; l <= B; l++) {
+        const voxdagi_store *s = &r->store[l], *ps = l ? &r->store[l - 1] : NULL;
+        size_t n = s->n, i, p, total = l ? 0 : 1;
+        uint64_t *first = (uint64_t *)voxdagi_alloc(e->mem, (n + 1) * sizeof *first);
+        uint8_t *seen;
+        if (!first) return 0;
+        memset(first, 0, (n + 1) * sizeof *first);
+        if (l) {
+            for (p = 0; p < 8 * ps->n; p++)
+                if (ps->child[p] != VOXDAGI_NONE) first[(ps->child[p] >> 6) + 1]++, total++;
+        } else {
+            first[(r->root >> 6) + 1]++;
+        }
+        for (i = 0; i < n; i++) first[i + 1] += first[i];
+        seen = (uint8_t *)voxdagi_alloc(e->mem, total);
+        if (!seen) {
+            voxdagi_free(e->mem, first, (n + 1) * sizeof *first);
+            return 0;
+        }
+        if (l) { /* RP o t per reference; FIRST[id] advances to the next free slot */
+            for (p = 0; p < 8 * ps->n; p++)
+                if (ps->child[p] != VOXDAGI_NONE)
+                    seen[first[ps->child[p] >> 6]++] = c->comp[e->orient[l - 1][p >> 3]][ps->child[p] & 63];
+        } else {
+            seen[first[r->root >> 6]++] = (uint8_t)(r->root & 63);
+        }
+        for (i = n; i > 0; i--) first[i] = first[i - 1]; /* back to the starts */
+        first[0] = 0;
+        for (i = 0; i < n; i++) {
+            unsigned votes[VOXDAGI_TRANSFORMS], T, best = 0;
+            uint64_t k;
+            memset(votes, 0, sizeof votes);
+            for (k = first[i]; k < first[i + 1]; k++) {
+                uint64_t S = s->stab[i];
+                while (S) {
+                    votes[c->comp[seen[k]][voxdagi_popcount64((S & (0 - S)) - 1)]]++;
+                    S &= S - 1;
+                }
+            }
+            for (T = 1; T < VOXDAGI_TRANSFORMS; T++)
+                if (votes[T] > votes[best]) best = T;
+            e->orient[l][i] = (uint8_t)best;
+        }
+        voxdagi_free(e->mem, seen, total);
+        voxdagi_free(e->mem, first, (n + 1) * sizeof *first);
+    }
+    return 1;
+}
+
+/* Count widths C (bits) of each inner level: enough for its largest count,
+   and 0 (counts derived from the children's) at level L-3, whose children are
    bricks. A derived count costs the voxel index one sum over at most 8 stored
    counts per sibling, so on large DAGs, where that sum misses the cache, the
    counts stay; the writer derives at most one more level, the one among
-   0..L-5 where counts take the most bytes (the deepest on ties), and only
-   when they are at least 1/32 of an estimate of the geometry's bytes (2-byte
-   headers, counts, 1-byte pointers, bricks): small DAGs, which are mostly
+   0..L-5 where counts take the most bits (the deepest on ties), and only
+   when they are at least 1/32 of an estimate of the geometry's bits (16-bit
+   headers, counts, 16-bit pointers, bricks): small DAGs, which are mostly
    counts and stay in the cache. */
 static void voxdagi_count_widths(voxdagi_encoder *e) {
     uint32_t B = e->levels - 2, l, drop = B;
-    uint64_t most = 0, estimate = 8 * (uint64_t)e->r->store[B].n;
+    uint64_t most = 0, estimate = 64 * (uint64_t)e->r->store[B].n;
     for (l = 0; l < B; l++) {
         const voxdagi_store *s = &e->r->store[l];
-        uint64_t max_count = 0, bytes;
+        uint64_t max_count = 0, bits;
         size_t i;
         for (i = 0; i < s->n; i++)
             if (s->count[i] > max_count) max_count = s->count[i];
-        for (i = 0; i < 8 * s->n; i++) estimate += s->child[i] != VOXDAGI_NONE;
-        e->count_bytes[l] = l + 1 < B ? voxdagi_bytes_for(max_count) : 0;
-        bytes = (uint64_t)s->n * e->count_bytes[l];
-        estimate += 2 * (uint64_t)s->n + bytes;
-        if (l + 2 < B && bytes >= most) {
-            most = bytes;
+        for (i = 0; i < 8 * s->n; i++) estimate += s->child[i] != VOXDAGI_NONE ? 16u : 0u;
+        e->count_bits[l] = l + 1 < B ? voxdagi_bit_length(max_count) : 0;
+        bits = (uint64_t)s->n * e->count_bits[l];
+        estimate += 16 * (uint64_t)s->n + bits;
+        if (l + 2 < B && bits >= most) {
+            most = bits;
             drop = l;
         }
     }
-    if (drop < B && most >= estimate / 32) e->count_bytes[drop] = 0;
+    if (drop < B && most >= estimate / 32) e->count_bits[drop] = 0;
 }
 
-/* Orders every level and computes record offsets, bottom-up (pointer sizes
-   depend on where the next level put its nodes). Returns 0 when out of memory. */
+/* The transform table of inner level L: the stored transforms of its
+   pointers by decreasing frequency (ties: the smaller transform first). */
+static void voxdagi_transform_table(voxdagi_encoder *e, uint32_t l) {
+    const voxdagi_store *s = &e->r->store[l];
+    uint64_t freq[VOXDAGI_TRANSFORMS];
+    unsigned T, k, n = 0;
+    size_t p;
+    memset(freq, 0, sizeof freq);
+    for (p = 0; p < 8 * s->n; p++)
+        if (s->child[p] != VOXDAGI_NONE) freq[voxdagi_stored_tag(e, l, e->orient[l][p >> 3], s->child[p])]++;
+    for (T = 0; T < VOXDAGI_TRANSFORMS; T++) {
+        if (!freq[T]) continue;
+        for (k = n; k > 0 && freq[e->table[l][k - 1]] < freq[T]; k--) e->table[l][k] = e->table[l][k - 1];
+        e->table[l][k] = (uint8_t)T;
+        n++;
+    }
+    for (k = 0; k < n; k++) e->code[l][e->table[l][k]] = (uint8_t)k;
+    e->table_len[l] = n;
+}
+
+/* Bits of the pointer X of a node of level L (stored as RP): target and code
+   widths, and its value. */
+static uint64_t voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, unsigned rp, uint32_t x, unsigned *ob,
+                                unsigned *kb) {
+    uint64_t target = e->pos[l + 1][x >> 6];
+    unsigned code = e->code[l][voxdagi_stored_tag(e, l, rp, x)];
+    *ob = voxdagi_bit_length(target);
+    *kb = voxdagi_bit_length(code);
+    return target << e->cls[l].K[voxdagi_class_for(&e->cls[l], *ob, *kb)] | code;
+}
+
+/* Orders every level and computes record offsets, bottom-up (pointer widths
+   depend on where the next level put its nodes). Returns 0 when out of
+   memory or when a level needs pointers wider than 57 bits. */
 static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     uint32_t B = e->levels - 2, l;
@@ -2337,20 +2684,35 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         refs[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
         e->order[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
         e->pos[l] = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof(uint64_t));
-        if (!refs[l] || !e->order[l] || !e->pos[l]) ok = 0;
+        e->orient[l] = (uint8_t *)voxdagi_alloc(e->mem, n);
+        if (!refs[l] || !e->order[l] || !e->pos[l] || !e->orient[l]) ok = 0;
         else memset(refs[l], 0, n * sizeof(uint32_t));
     }
     if (ok) {
-        refs[0][r->root >> 3] = 1;
+        refs[0][r->root >> 6] = 1;
         for (l = 0; l < B; l++) { /* reference counts, saturating */
             const voxdagi_store *s = &r->store[l];
             size_t i;
             for (i = 0; i < 8 * s->n; i++)
-                if (s->child[i] != VOXDAGI_NONE && refs[l + 1][s->child[i] >> 3] != UINT32_MAX)
-                    refs[l + 1][s->child[i] >> 3]++;
+                if (s->child[i] != VOXDAGI_NONE && refs[l + 1][s->child[i] >> 6] != UINT32_MAX)
+                    refs[l + 1][s->child[i] >> 6]++;
         }
+        voxdagi_count_widths(e);
+        ok = voxdagi_orient(e);
     }
-    if (ok) voxdagi_count_widths(e);
+    if (ok) { /* the root's transform: world = root tag o R^-1 (stored root) */
+        const voxdagi_cube *c = e->cube;
+        uint32_t x = r->root;
+        unsigned best = c->comp[x & 63][c->inv[e->orient[0][x >> 6]]];
+        uint64_t S = r->store[0].stab[x >> 6];
+        while (S) {
+            unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1);
+            unsigned v = c->comp[c->comp[x & 63][s]][c->inv[e->orient[0][x >> 6]]];
+            if (v < best) best = v;
+            S &= S - 1;
+        }
+        e->root_transform = best;
+    }
     for (l = B + 1; ok && l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
         size_t n = s->n, i;
@@ -2360,22 +2722,31 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
             break;
         }
         if (l < B) {
-            uint64_t need[9] = {0};
-            unsigned j;
-            for (i = 0; i < 8 * n; i++)
-                if (s->child[i] != VOXDAGI_NONE)
-                    need[voxdagi_bytes_for(e->pos[l + 1][s->child[i] >> 3] << 3 | (s->child[i] & 7))]++;
-            voxdagi_choose_sizes(need, e->ptr_bytes[l]);
+            uint64_t hist[58][7];
+            unsigned j, ob, kb;
+            voxdagi_transform_table(e, l);
+            memset(hist, 0, sizeof hist);
+            for (i = 0; i < 8 * n && ok; i++) {
+                if (s->child[i] == VOXDAGI_NONE) continue;
+                voxdagi_pointer(e, l, e->orient[l][i >> 3], s->child[i], &ob, &kb);
+                if (ob > 57 - kb) ok = 0;
+                else hist[ob][kb]++;
+            }
+            if (!ok) break;
+            voxdagi_choose_classes(hist, &e->cls[l]);
             for (i = 0; i < n; i++) {
                 uint32_t id = e->order[l][i];
+                uint64_t bits = 16 + e->count_bits[l];
                 e->pos[l][id] = at;
-                at += 2 + e->count_bytes[l];
                 for (j = 0; j < 8; j++) {
                     uint32_t x = s->child[8 * (size_t)id + j];
-                    if (x != VOXDAGI_NONE)
-                        at += e->ptr_bytes[l][voxdagi_pointer_tag(e->pos[l + 1][x >> 3] << 3 | (x & 7),
-                                                                  e->ptr_bytes[l])];
+                    unsigned t;
+                    if (x == VOXDAGI_NONE) continue;
+                    voxdagi_pointer(e, l, e->orient[l][id], x, &ob, &kb);
+                    t = voxdagi_class_for(&e->cls[l], ob, kb);
+                    bits += e->cls[l].O[t] + e->cls[l].K[t];
                 }
+                at += (bits + 7) / 8;
             }
         } else {
             for (i = 0; i < n; i++) e->pos[l][e->order[l][i]] = i;
@@ -2386,43 +2757,58 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     return ok;
 }
 
-/* Writes the inner levels into NODES and the bricks into BRICKS. */
+/* Writes the level table, the inner levels into NODES (zeroed) and the
+   bricks into BRICKS. */
 static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_table, uint8_t *nodes,
                                   uint8_t *bricks) {
     const voxdagi_reducer *r = e->r;
+    const voxdagi_cube *c = e->cube;
     uint32_t B = e->levels - 2, l;
     uint64_t level_at = 0;
     size_t i;
     for (l = 0; l < B; l++) {
         const voxdagi_store *s = &r->store[l];
+        const voxdagi_classes *cls = &e->cls[l];
         uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
+        unsigned t;
         voxdagi_put_le(te, level_at, 8);
         voxdagi_put_le(te + 8, e->size[l], 8);
         voxdagi_put_le(te + 16, s->n, 4);
-        te[20] = (uint8_t)e->count_bytes[l];
-        memcpy(te + 21, e->ptr_bytes[l] + 1, 3);
+        te[20] = (uint8_t)e->count_bits[l];
+        te[21] = (uint8_t)e->table_len[l];
+        for (t = 1; t <= 3; t++) {
+            te[21 + t] = cls->O[t];
+            te[24 + t] = cls->K[t];
+        }
+        memcpy(te + 32, e->table[l], e->table_len[l]);
         for (i = 0; i < s->n; i++) {
             uint32_t id = e->order[l][i];
+            unsigned rp = e->orient[l][id], header = 0, j, ob, kb;
             const uint32_t *ch = s->child + 8 * (size_t)id;
-            unsigned header = 0, j, at = 2 + e->count_bytes[l];
-            voxdagi_put_le(p + 2, s->count[id], e->count_bytes[l]);
+            uint64_t bits = 16 + e->count_bits[l];
+            uint32_t stored[8];
+            for (j = 0; j < 8; j++) stored[j] = VOXDAGI_NONE;
+            for (j = 0; j < 8; j++) /* canonical octant j is stored octant R(j) */
+                if (ch[j] != VOXDAGI_NONE) stored[c->act[rp][j]] = ch[j];
+            voxdagi_put_bits(p, 16, s->count[id], e->count_bits[l]);
             for (j = 0; j < 8; j++) {
                 uint64_t v;
-                unsigned n;
-                if (ch[j] == VOXDAGI_NONE) continue;
-                v = e->pos[l + 1][ch[j] >> 3] << 3 | (ch[j] & 7);
-                n = e->ptr_bytes[l][voxdagi_pointer_tag(v, e->ptr_bytes[l])];
-                header |= voxdagi_pointer_tag(v, e->ptr_bytes[l]) << (2 * j);
-                voxdagi_put_le(p + at, v, n);
-                at += n;
+                if (stored[j] == VOXDAGI_NONE) continue;
+                v = voxdagi_pointer(e, l, rp, stored[j], &ob, &kb);
+                t = voxdagi_class_for(cls, ob, kb);
+                header |= t << (2 * j);
+                voxdagi_put_bits(p, bits, v, cls->O[t] + cls->K[t]);
+                bits += cls->O[t] + cls->K[t];
             }
             voxdagi_put_le(p, header, 2);
-            p += at;
+            p += (bits + 7) / 8;
         }
         level_at += e->size[l];
     }
-    for (i = 0; i < r->store[B].n; i++)
-        voxdagi_put_le(bricks + 8 * i, r->store[B].key[e->order[B][i]], 8);
+    for (i = 0; i < r->store[B].n; i++) {
+        uint32_t id = e->order[B][i];
+        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(c, r->store[B].key[id], e->orient[B][id]), 8);
+    }
 }
 
 // -- The DAG: a parsed view of a file image
@@ -2430,8 +2816,13 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
 typedef struct voxdagi_level {
     const uint8_t *data;
     uint64_t size, nodes;
-    unsigned count_bytes;
-    unsigned char ptr_bytes[4]; /* pointer size of tags 1..3 ([0] = 0) */
+    unsigned count_bits;
+    unsigned char width[4];    /* pointer bits of tags 1..3 ([0] = 0) */
+    unsigned char code_bits[4];
+    uint64_t code_mask[4];
+    uint8_t table_inv[64];     /* code -> inverse of its transform */
+    uint8_t table[64];         /* code -> transform */
+    unsigned table_len;
 } voxdagi_level;
 
 struct voxdag {
@@ -2440,8 +2831,10 @@ struct voxdag {
     size_t owned_size;
     const uint8_t *image;
     size_t image_size;
-    uint32_t levels, root_mirror, flags;
+    uint32_t levels, root_transform;
+    voxdag_symmetry symmetry;
     uint64_t voxels;
+    uint32_t voxel_box[6];
     voxdagi_level level[VOXDAG_MAX_LEVELS]; /* inner levels 0..L-3 */
     uint64_t node_bytes;
     const uint8_t *bricks;
@@ -2451,6 +2844,8 @@ struct voxdag {
     uint64_t color_size;
     int has_bounds;
     double bounds[6];
+    voxdagi_cube cube;
+    uint8_t occupancy[VOXDAGI_TRANSFORMS][256]; /* [MI][stored presence]: world presence */
 };
 
 static void voxdagi_release(const voxdag_allocator *a, void *p, size_t size) {
@@ -2474,23 +2869,57 @@ VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size) {
 
 // -- Node access on the encoded form
 
-/* Byte offset of child octant S's pointer inside a record with HEADER: the
-   sum of the pointer sizes of the lower octants (popcounts over the tags). */
-static unsigned voxdagi_child_offset(unsigned header, unsigned s, const unsigned char size[4]) {
+/* The octants with a child, from a record header (bit i: tag i non-zero). */
+static unsigned voxdagi_presence(unsigned header) {
+    unsigned x = (header | header >> 1) & 0x5555;
+    x = (x | x >> 1) & 0x3333;
+    x = (x | x >> 2) & 0x0F0F;
+    return (x | x >> 4) & 0xFF;
+}
+
+/* A stored brick mask seen through world-to-stored transform MI, in world
+   order: byte w of the result (the 2^3 cell w) is stored byte MI(w) with its
+   bits mapped the same way; branch-free, one table lookup a byte. */
+VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, unsigned MI) {
+    const uint8_t *to_stored = d->cube.act[MI], *occ = d->occupancy[MI];
+    uint64_t w = 0;
+    unsigned k;
+    for (k = 0; k < 8; k++) w |= (uint64_t)occ[(mask >> 8 * to_stored[k]) & 0xFF] << 8 * k;
+    return w;
+}
+
+/* occupancy[MI][p]: the world octants w holding a child, for stored presence
+   P seen through world-to-stored transform MI (w is full when MI(w) is). */
+static void voxdagi_occupancy_init(voxdag *d) {
+    unsigned T, p, w;
+    for (T = 0; T < VOXDAGI_TRANSFORMS; T++)
+        for (p = 0; p < 256; p++) {
+            unsigned o = 0;
+            for (w = 0; w < 8; w++) o |= (p >> d->cube.act[T][w] & 1) << w;
+            d->occupancy[T][p] = (uint8_t)o;
+        }
+}
+
+/* Bit offset of child octant S's pointer inside a record with HEADER: the
+   widths of the lower octants' pointers (popcounts over the tags). */
+VOXDAGI_INLINE unsigned voxdagi_child_bit(const voxdagi_level *lv, unsigned header, unsigned s) {
     unsigned h = header & ((1u << (2 * s)) - 1);
     unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
-    return size[1] * (unsigned)voxdagi_popcount64(lo & ~hi) + size[2] * (unsigned)voxdagi_popcount64(hi & ~lo) +
-           size[3] * (unsigned)voxdagi_popcount64(lo & hi);
+    return 16 + lv->count_bits + lv->width[1] * (unsigned)voxdagi_popcount64(lo & ~hi) +
+           lv->width[2] * (unsigned)voxdagi_popcount64(hi & ~lo) + lv->width[3] * (unsigned)voxdagi_popcount64(lo & hi);
 }
 
-static unsigned voxdagi_record_size(const voxdagi_level *lv, unsigned header) {
-    return 2 + lv->count_bytes + voxdagi_child_offset(header, 8, lv->ptr_bytes);
+static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
+    return voxdagi_child_bit(lv, header, 8);
 }
 
-/* The pointer of stored octant S (which must be present): target << 3 | mirror. */
-static uint64_t voxdagi_child(const voxdagi_level *lv, const uint8_t *rec, unsigned header, unsigned s) {
-    unsigned n = lv->ptr_bytes[header >> (2 * s) & 3];
-    return voxdagi_le_fast(rec + 2 + lv->count_bytes + voxdagi_child_offset(header, s, lv->ptr_bytes), n);
+/* The pointer of stored octant S (which must be present): its target << 6
+   | the code's transform, inverted when INVERSE (what traversals compose). */
+VOXDAGI_INLINE uint64_t voxdagi_child_ref(const voxdagi_level *lv, const uint8_t *rec, unsigned header, unsigned s,
+                                  int inverse) {
+    unsigned t = header >> (2 * s) & 3;
+    uint64_t v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
+    return (v >> lv->code_bits[t]) << 6 | (inverse ? lv->table_inv : lv->table)[v & lv->code_mask[t]];
 }
 
 static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
@@ -2501,7 +2930,7 @@ static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
    counts (or below brick OFFSET when L is the brick level). */
 static uint64_t voxdagi_stored_count(const voxdag *d, uint32_t l, uint64_t offset) {
     if (l == d->levels - 2) return (uint64_t)voxdagi_popcount64(voxdagi_brick(d, offset));
-    return voxdagi_le_fast(d->level[l].data + offset + 2, d->level[l].count_bytes);
+    return voxdagi_get_bits_wide(d->level[l].data + offset, 16, d->level[l].count_bits);
 }
 
 /* Voxels below the node at byte OFFSET of inner level L (or brick OFFSET when
@@ -2509,22 +2938,19 @@ static uint64_t voxdagi_stored_count(const voxdag *d, uint32_t l, uint64_t offse
    sum of its children's, whose level stores them (validated on load). */
 static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset) {
     const voxdagi_level *lv;
-    const uint8_t *p;
-    unsigned header;
+    const uint8_t *rec;
+    unsigned header, s;
     uint64_t sum = 0;
-    if (l == d->levels - 2 || d->level[l].count_bytes) return voxdagi_stored_count(d, l, offset);
+    if (l == d->levels - 2 || d->level[l].count_bits) return voxdagi_stored_count(d, l, offset);
     lv = &d->level[l];
-    p = lv->data + offset + 2; /* the pointers, one after the other */
-    for (header = (unsigned)voxdagi_le(p - 2, 2); header; header >>= 2) {
-        unsigned n = lv->ptr_bytes[header & 3];
-        if (!n) continue;
-        sum += voxdagi_stored_count(d, l + 1, voxdagi_le_fast(p, n) >> 3);
-        p += n;
-    }
+    rec = lv->data + offset;
+    header = (unsigned)voxdagi_le(rec, 2);
+    for (s = 0; s < 8; s++)
+        if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(lv, rec, header, s, 0) >> 6);
     return sum;
 }
 
-// -- Loading: header, sections and full structural validation (DESIGN 4)
+// -- Loading: header, sections and full structural validation (FORMAT.md)
 
 /* Bitmap helpers for validation: which byte offsets start a record, and which
    records some parent points to. */
@@ -2551,12 +2977,12 @@ static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
     b->start = b->ref = NULL;
 }
 
-/* Every record of every inner level, bottom-up: sizes, pointer targets (a
-   record start of the next level, or a brick), counts (the sum of the
-   children's), every node and brick referenced, one root holding every voxel. */
+/* Every record of every inner level, bottom-up: sizes, zero padding, pointer
+   codes (inside the level's transform table), targets (a record start of
+   the next level, or a brick), counts (the sum of the children's), every
+   node and brick referenced, one root holding every voxel. */
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
     uint32_t B = d->levels - 2, l;
-    int symmetric = (d->flags & VOXDAG_FILE_FLAG_SYMMETRIC) != 0;
     uint64_t base = B ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
     voxdagi_bitmaps child, cur;
     voxdag_status st = VOXDAG_OK;
@@ -2594,23 +3020,27 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         while (at < lv->size) {
             const uint8_t *rec = lv->data + at;
             unsigned header, s;
-            uint64_t sum = 0;
+            uint64_t sum = 0, bits, bytes;
             where = base + (uint64_t)(rec - d->level[0].data);
             node = records;
             if (lv->size - at < 2) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
             header = (unsigned)voxdagi_le(rec, 2);
             if (!header) { st = VOXDAG_ERR_CORRUPT; msg = "node without children"; break; }
-            if (lv->size - at < voxdagi_record_size(lv, header)) {
-                st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break;
+            bits = voxdagi_record_bits(lv, header);
+            bytes = (bits + 7) / 8;
+            if (lv->size - at < bytes) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
+            if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) {
+                st = VOXDAG_ERR_CORRUPT; msg = "record padding bits not zero"; break;
             }
             for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
-                uint64_t target, c;
-                if (!(header >> (2 * s) & 3)) continue;
-                target = voxdagi_child(lv, rec, header, s);
-                if (!symmetric && (target & 7)) {
-                    st = VOXDAG_ERR_CORRUPT; msg = "mirror bits in a file built without symmetry"; break;
+                unsigned t = header >> (2 * s) & 3;
+                uint64_t v, target, c;
+                if (!t) continue;
+                v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
+                if ((v & lv->code_mask[t]) >= lv->table_len) {
+                    st = VOXDAG_ERR_CORRUPT; msg = "transform code outside the level's table"; break;
                 }
-                target >>= 3;
+                target = v >> lv->code_bits[t];
                 if (target >= child_units || !voxdagi_bit(child.start, target)) {
                     st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
                 }
@@ -2620,11 +3050,11 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
                 sum += c;
             }
             if (st != VOXDAG_OK) break;
-            if (lv->count_bytes && voxdagi_le(rec + 2, lv->count_bytes) != sum) {
+            if (lv->count_bits && voxdagi_get_bits_wide(rec, 16, lv->count_bits) != sum) {
                 st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
             }
             voxdagi_set_bit(cur.start, at);
-            at += voxdagi_record_size(lv, header);
+            at += bytes;
             records++;
         }
         if (st == VOXDAG_OK && records != lv->nodes) {
@@ -2652,6 +3082,49 @@ static int voxdagi_all_zero(const uint8_t *p, uint64_t n) {
     return 1;
 }
 
+/* The number of transforms of a symmetry group (a transform code is valid
+   below it). */
+static unsigned voxdagi_group_size(voxdag_symmetry s) {
+    return s == VOXDAG_SYMMETRY_NONE ? 1 : s == VOXDAG_SYMMETRY_REFLECT ? 8 : VOXDAGI_TRANSFORMS;
+}
+
+/* Parses level entry L of a validated level table into D. Returns NULL, or
+   what is wrong. */
+static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, uint64_t level_at,
+                                       uint64_t nodes_size) {
+    voxdagi_level *lv = &d->level[l];
+    unsigned t, k, group = voxdagi_group_size(d->symmetry);
+    lv->size = voxdagi_le(e + 8, 8);
+    lv->nodes = voxdagi_le(e + 16, 4);
+    lv->count_bits = e[20];
+    lv->table_len = e[21];
+    if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at || lv->nodes > lv->size / 2)
+        return "bad level entry";
+    if (l + 3 == d->levels ? lv->count_bits != 0 : lv->count_bits > 64) return "bad level count width";
+    if (l && !lv->count_bits && !d->level[l - 1].count_bits) /* derived counts sum stored ones */
+        return "two levels in a row without counts";
+    if (!lv->table_len || lv->table_len > VOXDAGI_TRANSFORMS || !voxdagi_all_zero(e + 28, 4) ||
+        !voxdagi_all_zero(e + 32 + lv->table_len, VOXDAGI_TRANSFORMS - lv->table_len))
+        return "bad level transform table";
+    memset(lv->table, 0, sizeof lv->table);
+    memset(lv->table_inv, 0, sizeof lv->table_inv);
+    for (k = 0; k < lv->table_len; k++) {
+        if (e[32 + k] >= group) return "transform outside the file's symmetry group";
+        lv->table[k] = e[32 + k];
+        lv->table_inv[k] = d->cube.inv[e[32 + k]];
+    }
+    lv->width[0] = lv->code_bits[0] = 0;
+    lv->code_mask[0] = 0;
+    for (t = 1; t <= 3; t++) {
+        unsigned o = e[21 + t], c = e[24 + t];
+        if (c > 6 || o + c > 57) return "bad pointer class";
+        lv->width[t] = (unsigned char)(o + c);
+        lv->code_bits[t] = (unsigned char)c;
+        lv->code_mask[t] = (1ull << c) - 1;
+    }
+    return NULL;
+}
+
 /* Parses header and sections of IMG into D. DEEP: also verify checksums and
    every record (skipped only for images this library just wrote). */
 static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, int deep,
@@ -2667,9 +3140,15 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its header", size, UINT64_MAX);
     if (memcmp(img, voxdagi_magic, 8))
         return voxdagi_fail(err, VOXDAG_ERR_BAD_MAGIC, "bad magic bytes", 0, UINT64_MAX);
-    if (voxdagi_le(img + VOXDAG_FILE_OFF_VERSION, 4) != VOXDAG_FORMAT_VERSION)
-        return voxdagi_fail(err, VOXDAG_ERR_VERSION, "unsupported format version",
-                            VOXDAG_FILE_OFF_VERSION, UINT64_MAX);
+    {
+        uint64_t version = voxdagi_le(img + VOXDAG_FILE_OFF_VERSION, 4);
+        if (version != VOXDAG_FORMAT_VERSION)
+            return voxdagi_fail(err, VOXDAG_ERR_VERSION,
+                                version < VOXDAG_FORMAT_VERSION
+                                    ? "format version 1 or 2 (an older voxdag): rebuild the file, this reader needs version 3"
+                                    : "format version newer than 3 (a newer voxdag): this reader needs version 3",
+                                VOXDAG_FILE_OFF_VERSION, UINT64_MAX);
+    }
     {
         uint8_t h[VOXDAG_FILE_HEADER_SIZE];
         memcpy(h, img, sizeof h);
@@ -2680,11 +3159,15 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     }
     if (voxdagi_le(img + VOXDAG_FILE_OFF_ENDIAN, 4) != VOXDAG_FILE_ENDIAN_TAG ||
         voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_SIZE, 4) != VOXDAG_FILE_HEADER_SIZE ||
-        img[42] || img[43] || !voxdagi_all_zero(img + 56, 8))
+        img[VOXDAG_FILE_OFF_SYMMETRY + 1] || !voxdagi_all_zero(img + VOXDAG_FILE_OFF_RESERVED, VOXDAG_FILE_HEADER_SIZE - VOXDAG_FILE_OFF_RESERVED))
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad header field", VOXDAG_FILE_OFF_ENDIAN, UINT64_MAX);
-    d->flags = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_FLAGS, 4);
-    if (d->flags & ~VOXDAG_FILE_FLAG_SYMMETRIC)
+    if (voxdagi_le(img + VOXDAG_FILE_OFF_FLAGS, 4))
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "unknown header flags", VOXDAG_FILE_OFF_FLAGS, UINT64_MAX);
+    d->symmetry = (voxdag_symmetry)img[VOXDAG_FILE_OFF_SYMMETRY];
+    if (d->symmetry < VOXDAG_SYMMETRY_NONE || d->symmetry > VOXDAG_SYMMETRY_FULL)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "unknown symmetry group", VOXDAG_FILE_OFF_SYMMETRY, UINT64_MAX);
+    voxdagi_cube_init(&d->cube);
+    voxdagi_occupancy_init(d);
     end = voxdagi_le(img + VOXDAG_FILE_OFF_FILE_SIZE, 8);
     if (end > size)
         return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its declared size", size, UINT64_MAX);
@@ -2692,14 +3175,19 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the file", end, UINT64_MAX);
     d->voxels = voxdagi_le(img + VOXDAG_FILE_OFF_VOXELS, 8);
     d->levels = img[VOXDAG_FILE_OFF_LEVELS];
-    d->root_mirror = img[VOXDAG_FILE_OFF_ROOT_MIRROR];
+    d->root_transform = img[VOXDAG_FILE_OFF_ROOT_TRANSFORM];
     if (d->levels < 2 || d->levels > max_levels)
         return voxdagi_fail(err, VOXDAG_ERR_LIMIT, "levels outside the accepted range",
                             VOXDAG_FILE_OFF_LEVELS, UINT64_MAX);
-    if (d->root_mirror > 7 || (d->root_mirror && !(d->flags & VOXDAG_FILE_FLAG_SYMMETRIC)) ||
-        d->voxels > (1ull << (3 * d->levels)))
-        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad root mirror or voxel count",
+    if (d->root_transform >= voxdagi_group_size(d->symmetry) || d->voxels > (1ull << (3 * d->levels)))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad root transform or voxel count",
                             VOXDAG_FILE_OFF_VOXELS, UINT64_MAX);
+    for (i = 0; i < 6; i++) d->voxel_box[i] = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_VOXEL_BOX + 4 * i, 4);
+    for (i = 0; i < 3; i++)
+        if (d->voxels ? !(d->voxel_box[i] < d->voxel_box[i + 3] && d->voxel_box[i + 3] <= 1u << d->levels)
+                      : d->voxel_box[i] || d->voxel_box[i + 3])
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxel box outside the grid or not matching the voxel count",
+                                VOXDAG_FILE_OFF_VOXEL_BOX, UINT64_MAX);
     count = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
     if (count > VOXDAG_FILE_MAX_SECTIONS)
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "too many sections", VOXDAG_FILE_OFF_SECTION_COUNT, UINT64_MAX);
@@ -2775,19 +3263,8 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     for (l = 0; l < B; l++) {
         const uint8_t *e = levels + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
         voxdagi_level *lv = &d->level[l];
-        uint64_t at = (uint64_t)(e - img);
-        lv->size = voxdagi_le(e + 8, 8);
-        lv->nodes = voxdagi_le(e + 16, 4);
-        lv->count_bytes = e[20];
-        lv->ptr_bytes[0] = 0;
-        memcpy(lv->ptr_bytes + 1, e + 21, 3);
-        if (voxdagi_le(e, 8) != level_at || lv->size > nodes_size - level_at ||
-            lv->nodes > lv->size / 2 || !lv->ptr_bytes[1] || lv->ptr_bytes[1] >= lv->ptr_bytes[2] ||
-            lv->ptr_bytes[2] >= lv->ptr_bytes[3] || lv->ptr_bytes[3] > 8 ||
-            (l + 1 < B ? lv->count_bytes > 8 : lv->count_bytes != 0))
-            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad level entry", at, l);
-        if (l && !lv->count_bytes && !d->level[l - 1].count_bytes) /* derived counts sum stored ones */
-            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "two levels in a row without counts", at + 20, l);
+        const char *bad = voxdagi_parse_level(d, l, e, level_at, nodes_size);
+        if (bad) return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, bad, (uint64_t)(e - img), l);
         lv->data = nodes + level_at;
         level_at += lv->size;
         node_sum += lv->nodes;
@@ -2875,10 +3352,74 @@ static void voxdagi_write_bounds(uint8_t *p, const double *bounds) {
     }
 }
 
+/* Transforms the box B (min xyz, max xyz, half-open) of a cube of side SIDE
+   by T: axis a moves to axis perm[a], then mirrored axes flip. */
+static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned T, uint32_t side) {
+    uint32_t t[6];
+    unsigned a;
+    for (a = 0; a < 3; a++) {
+        unsigned to = (unsigned)voxdagi_popcount64(c->act[T & ~7u][1u << a] - 1u); /* perm[a] */
+        t[to] = b[a], t[to + 3] = b[a + 3];
+    }
+    for (a = 0; a < 3; a++) {
+        if (T >> a & 1) b[a] = side - t[a + 3], b[a + 3] = side - t[a];
+        else b[a] = t[a], b[a + 3] = t[a + 3];
+    }
+}
+
+/* The occupied voxel box of the scene, bottom-up over the unique nodes (each
+   box in its node's canonical frame). Returns 0 when out of memory. */
+static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const voxdagi_cube *c, uint32_t box[6]) {
+    uint32_t B = r->levels - 2, l, *below = NULL, *cur = NULL;
+    size_t below_n = 0, i, k;
+    memset(box, 0, 6 * sizeof *box);
+    if (r->root == VOXDAGI_NONE) return 1;
+    for (l = B + 1; l-- > 0;) {
+        const voxdagi_store *s = &r->store[l];
+        cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur + 1);
+        if (!cur) {
+            voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+            return 0;
+        }
+        for (i = 0; i < s->n; i++) {
+            uint32_t *o = cur + 6 * i, half = 1u << (r->levels - l - 1), cb[6];
+            o[0] = o[1] = o[2] = UINT32_MAX;
+            o[3] = o[4] = o[5] = 0;
+            for (k = 0; k < (l == B ? 64u : 8u); k++) {
+                unsigned a;
+                if (l == B) { /* a voxel of the brick */
+                    uint32_t x, y, z;
+                    if (!(s->key[i] >> k & 1)) continue;
+                    voxdag_morton_decode(k, &x, &y, &z);
+                    cb[0] = x, cb[1] = y, cb[2] = z, cb[3] = x + 1, cb[4] = y + 1, cb[5] = z + 1;
+                } else { /* a child's box, transformed and moved to its octant */
+                    uint32_t x = s->child[8 * i + k];
+                    if (x == VOXDAGI_NONE) continue;
+                    memcpy(cb, below + 6 * (size_t)(x >> 6), sizeof cb);
+                    voxdagi_box_transform(c, cb, x & 63, half);
+                    for (a = 0; a < 3; a++)
+                        if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
+                }
+                for (a = 0; a < 3; a++) {
+                    if (cb[a] < o[a]) o[a] = cb[a];
+                    if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
+                }
+            }
+        }
+        voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+        below = cur, below_n = s->n;
+    }
+    memcpy(box, below + 6 * (size_t)(r->root >> 6), 6 * sizeof *box);
+    voxdagi_box_transform(c, box, r->root & 63, 1u << r->levels);
+    voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+    return 1;
+}
+
 static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, voxdag_error *err) {
     const voxdagi_reducer *r = &b->red[0];
     voxdagi_encoder e;
     voxdagi_layout lay;
+    voxdagi_scene sc;
     uint32_t B = b->levels - 2, l;
     uint64_t node_bytes = 0;
     uint8_t *img;
@@ -2887,14 +3428,24 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     memset(&e, 0, sizeof e);
     e.mem = &b->mem;
     e.r = r;
+    e.cube = &b->group[0].cube;
     e.levels = b->levels;
     for (l = 0; l < B; l++) { /* what an empty scene's level table says */
-        e.ptr_bytes[l][1] = 2;
-        e.ptr_bytes[l][2] = 3;
-        e.ptr_bytes[l][3] = 4;
-        e.count_bytes[l] = l + 1 < B;
+        unsigned t;
+        for (t = 1; t <= 3; t++) e.cls[l].O[t] = (unsigned char)(8 * t);
+        e.count_bits[l] = l + 1 < B;
+        e.table_len[l] = 1;
     }
     if (r->root != VOXDAGI_NONE && !voxdagi_encoder_plan(&e)) {
+        voxdagi_encoder_free(&e);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
+    }
+    memset(&sc, 0, sizeof sc);
+    sc.levels = b->levels;
+    sc.root_transform = e.root_transform;
+    sc.symmetry = b->symmetry;
+    sc.voxels = b->voxels;
+    if (!voxdagi_voxel_box(&b->mem, r, e.cube, sc.voxel_box)) {
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
@@ -2921,8 +3472,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     if (b->opts.colors && !b->opts.color_sink && b->voxels)
         memcpy(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_COLORS_RGB8), b->colors, 3 * (size_t)b->voxels);
     if (b->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), b->bounds);
-    voxdagi_layout_seal(img, &lay, b->opts.no_symmetry ? 0 : VOXDAG_FILE_FLAG_SYMMETRIC, b->levels,
-                        r->root == VOXDAGI_NONE ? 0 : r->root & 7, b->voxels);
+    voxdagi_layout_seal(img, &lay, &sc);
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &b->mem, err);
@@ -2969,9 +3519,13 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
         for (l = 0; l + 1 < b->levels; l++) {
             stats->nodes[l] = b->red[0].store[l].n;
             stats->svo_nodes[l] = b->red[0].store[l].svo;
-            if (b->red_count == 2) {
-                stats->ssvdag_nodes[l] = b->red[b->opts.no_symmetry].store[l].n;
-                stats->svdag_nodes[l] = b->red[!b->opts.no_symmetry].store[l].n;
+            for (k = 0; k < b->red_count; k++) {
+                uint64_t n = b->red[k].store[l].n;
+                switch (b->red[k].group->count) {
+                case 1: stats->svdag_nodes[l] = n; break;
+                case 8: stats->reflect_nodes[l] = n; break;
+                default: stats->full_nodes[l] = n; break;
+                }
             }
         }
     }
@@ -3058,7 +3612,15 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
         if (sizes[i]) memcpy(img + lay.offset[i], parts[i], (size_t)sizes[i]);
     if (kind != VOXDAG_COLORS_NONE && size) memcpy(img + lay.offset[3], payload, size);
     if (src->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), src->bounds);
-    voxdagi_layout_seal(img, &lay, src->flags, src->levels, src->root_mirror, src->voxels);
+    {
+        voxdagi_scene sc;
+        sc.levels = src->levels;
+        sc.root_transform = src->root_transform;
+        sc.symmetry = src->symmetry;
+        sc.voxels = src->voxels;
+        memcpy(sc.voxel_box, src->voxel_box, sizeof sc.voxel_box);
+        voxdagi_layout_seal(img, &lay, &sc);
+    }
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &m, err);
@@ -3077,8 +3639,9 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
     uint32_t l, B = dag->levels - 2;
     memset(info, 0, sizeof *info);
     info->levels = dag->levels;
-    info->symmetric = (dag->flags & VOXDAG_FILE_FLAG_SYMMETRIC) != 0;
+    info->symmetry = dag->symmetry;
     info->voxels = dag->voxels;
+    memcpy(info->voxel_box, dag->voxel_box, sizeof info->voxel_box);
     for (l = 0; l < B; l++) {
         info->nodes[l] = dag->level[l].nodes;
         info->level_bytes[l] = dag->level[l].size;
@@ -3094,38 +3657,50 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
     memcpy(info->bounds, dag->bounds, sizeof info->bounds);
 }
 
-/* Voxel index during descent (DESIGN 3.5): at a node reached with mirror M,
-   world octant w is stored in octant w ^ M; the stored children j with
-   (j ^ M) < w precede it in world order, so their counts are added. */
+/* Traversals carry MI, the transform from world to stored frame (the inverse
+   of the transforms accumulated from the root): world octant w of a node is
+   its stored octant MI(w), world brick position p is stored position MI(p),
+   and a child reached through a pointer with transform t has MI' = t^-1 o MI.
+   The voxel index (counts of the preceding siblings in world order) adds the
+   stored children j with MI^-1(j) < w, and in a brick the voxels of the mask
+   transformed to world order below the voxel. */
+static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned MI,
+                                  unsigned w) {
+    const uint8_t *to_world = d->cube.act[d->cube.inv[MI]];
+    uint64_t idx = 0;
+    unsigned j;
+    for (j = 0; j < 8; j++)
+        if ((header >> (2 * j) & 3) && to_world[j] < w)
+            idx += voxdagi_node_count(d, l + 1, voxdagi_child_ref(&d->level[l], rec, header, j, 0) >> 6);
+    return idx;
+}
+
+static uint64_t voxdagi_brick_preceding(const voxdag *d, uint64_t mask, unsigned MI, unsigned p) {
+    return (uint64_t)voxdagi_popcount64(voxdagi_brick_to_world(d, mask, MI) & ((1ull << p) - 1));
+}
+
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z, uint64_t *index) {
     uint32_t L = dag->levels, B = L - 2, l;
-    unsigned M = dag->root_mirror, p, sp;
+    unsigned MI = dag->cube.inv[dag->root_transform], p;
     uint64_t at = 0, idx = 0, mask;
     if (!dag->voxels || (x | y | z) >> L) return 0;
     for (l = 0; l < B; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
-        unsigned header = (unsigned)voxdagi_le(rec, 2), sh = L - 1 - l, j, v;
+        unsigned header = (unsigned)voxdagi_le(rec, 2), sh = L - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
-        uint64_t ptr;
-        if (index)
-            for (j = 0; j < 8; j++)
-                if ((header >> (2 * j) & 3) && (j ^ M) < w)
-                    idx += voxdagi_node_count(dag, l + 1, voxdagi_child(lv, rec, header, j) >> 3);
-        v = w ^ M;
+        uint64_t ref;
+        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w);
+        v = dag->cube.act[MI][w];
         if (!(header >> (2 * v) & 3)) return 0;
-        ptr = voxdagi_child(lv, rec, header, v);
-        M ^= (unsigned)(ptr & 7);
-        at = ptr >> 3;
+        ref = voxdagi_child_ref(lv, rec, header, v, 1);
+        MI = dag->cube.comp[ref & 63][MI];
+        at = ref >> 6;
     }
     mask = voxdagi_brick(dag, at);
     p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
-    sp = p ^ (M | M << 3);
-    if (!(mask >> sp & 1)) return 0;
-    if (index) {
-        mask = voxdagi_reflect_brick(mask, M);
-        *index = idx + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
-    }
+    if (!(mask >> voxdagi_transform_pos(&dag->cube, p, MI) & 1)) return 0;
+    if (index) *index = idx + voxdagi_brick_preceding(dag, mask, MI, p);
     return 1;
 }
 
@@ -3134,7 +3709,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
     struct frame {
         uint64_t at;
         uint32_t x, y, z;
-        unsigned mirror, next;
+        unsigned MI, next;
     } stack[VOXDAG_MAX_LEVELS];
     uint32_t L = dag->levels, B = L - 2;
     uint64_t index = 0;
@@ -3142,12 +3717,12 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
     if (!dag->voxels) return 0;
     stack[0].at = 0;
     stack[0].x = stack[0].y = stack[0].z = 0;
-    stack[0].mirror = dag->root_mirror;
+    stack[0].MI = dag->cube.inv[dag->root_transform];
     stack[0].next = 0;
     while (depth >= 0) {
         struct frame *f = &stack[depth];
-        if ((uint32_t)depth == B) { /* a brick */
-            uint64_t mask = voxdagi_reflect_brick(voxdagi_brick(dag, f->at), f->mirror);
+        if ((uint32_t)depth == B) { /* a brick, in world order */
+            uint64_t mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, f->at), f->MI);
             while (mask) {
                 unsigned p = (unsigned)voxdagi_popcount64((mask & (0 - mask)) - 1);
                 uint32_t bx, by, bz;
@@ -3162,19 +3737,21 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         {
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
+            const uint8_t *to_stored = dag->cube.act[f->MI];
             unsigned header = (unsigned)voxdagi_le(rec, 2);
             uint32_t half = 1u << (L - 1 - (uint32_t)depth);
-            while (f->next < 8 && !(header >> (2 * (f->next ^ f->mirror)) & 3)) f->next++;
+            unsigned occ = dag->occupancy[f->MI][voxdagi_presence(header)];
+            while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
             if (f->next == 8) {
                 depth--;
                 continue;
             }
             {
                 unsigned w = f->next++;
-                uint64_t ptr = voxdagi_child(lv, rec, header, w ^ f->mirror);
+                uint64_t ref = voxdagi_child_ref(lv, rec, header, to_stored[w], 1);
                 struct frame *c = &stack[depth + 1];
-                c->at = ptr >> 3;
-                c->mirror = f->mirror ^ (unsigned)(ptr & 7);
+                c->at = ref >> 6;
+                c->MI = dag->cube.comp[ref & 63][f->MI];
                 c->x = f->x + (w & 1 ? half : 0);
                 c->y = f->y + (w & 2 ? half : 0);
                 c->z = f->z + (w & 4 ? half : 0);
@@ -3189,9 +3766,11 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 // -- Ray casting
 #ifndef VOXDAG_NO_RAYTRACE
 //
-// A hierarchical integer DDA over the encoded DAG (SSVDAG Listing 1), with
-// the geometry mirrored by the accumulated mask: cell w of a node reached
-// with mirror M is stored octant w ^ M, or brick bit p ^ (M | M << 3).
+// A hierarchical integer DDA over the encoded DAG (SSVDAG Listing 1), in
+// world space: cell w of a node reached with world-to-stored transform MI is
+// its stored octant MI(w); entering a node maps its children's presence to
+// world octants (one table lookup), entering a brick transforms its mask to
+// world order, so the ray itself is never transformed and every t is exact.
 // State: the current cell's integer coordinates c at cell level q (2^q cells
 // per axis) and the event (te, ae) at which the ray entered it (ae = 3 for
 // the start). Every t comes from a plane as (plane - origin) * (1 / dir), so
@@ -3200,7 +3779,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 // the mid planes the ray has crossed by (te, ae). After a step, the highest
 // bit that changed in c names the ancestor whose child changed (a carry), so
 // the walk jumps straight there, like the paper's conditional push but with
-// no push: per node level it keeps only the record, header and mirror to
+// no push: per node level it keeps only the record, header and transform to
 // return to, which also give the voxel index at the hit in one pass.
 // A brick is walked as 4^3 voxels in one level, or, when level of detail can
 // stop inside it, as 2^3 cells (a byte of the mask each) and then voxels.
@@ -3209,7 +3788,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 
 typedef struct voxdagi_frame {
     const uint8_t *rec;
-    unsigned header, mirror;
+    unsigned header, MI, occ; /* occ: which world octants hold a child */
 } voxdagi_frame;
 
 static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
@@ -3235,18 +3814,14 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
     uint32_t B = d->levels - 2, top = q < B ? q : B, k;
     uint64_t idx = 0;
     for (k = 0; k < top; k++) {
-        unsigned sh = q - 1 - k, j;
+        unsigned sh = q - 1 - k;
         unsigned w = (c[0] >> sh & 1) | (c[1] >> sh & 1) << 1 | (c[2] >> sh & 1) << 2;
-        for (j = 0; j < 8; j++)
-            if ((f[k].header >> (2 * j) & 3) && (j ^ f[k].mirror) < w)
-                idx += voxdagi_node_count(d, k + 1, voxdagi_child(&d->level[k], f[k].rec, f[k].header, j) >> 3);
+        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w);
     }
     if (q > B) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
         uint32_t v[3];
-        unsigned p;
         for (k = 0; k < 3; k++) v[k] = c[k] << (d->levels - q);
-        p = voxdagi_brick_pos(v);
-        idx += (uint64_t)voxdagi_popcount64(voxdagi_reflect_brick(mask, f[B].mirror) & ((1ull << p) - 1));
+        idx += (uint64_t)voxdagi_popcount64(mask & ((1ull << voxdagi_brick_pos(v)) - 1)); /* MASK: world order */
     }
     return idx;
 }
@@ -3259,7 +3834,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     double ox[3], ix[3], te = -HUGE_VAL, tx = HUGE_VAL, t_stop;
     uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
     int sgn[3];
-    unsigned ae = 0, ax = 0, a, M = d->root_mirror, header = 0;
+    unsigned ae = 0, ax = 0, a, MI = d->cube.inv[d->root_transform], header = 0, occ = 0;
     int split;
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
@@ -3294,15 +3869,17 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
         if (l < B) {
             rec = d->level[l].data + at;
             header = (unsigned)voxdagi_le(rec, 2);
+            occ = d->occupancy[MI][voxdagi_presence(header)];
             f[l].rec = rec;
             f[l].header = header;
-        } else if (l == B) {
-            mask = voxdagi_brick(d, at);
+            f[l].occ = occ;
+        } else if (l == B) { /* the brick in world order */
+            mask = voxdagi_brick_to_world(d, voxdagi_brick(d, at), MI);
             f[l].rec = NULL;
-            f[l].header = 0;
+            f[l].header = f[l].occ = 0;
             halves = split ? 1 : 2;
         } /* else l == B + 1: a 2^3 cell of the same brick */
-        f[l].mirror = M;
+        f[l].MI = MI;
         while (halves--) { /* the child cell: which mid planes are crossed by (te, ae) */
             uint32_t sh = L - q - 1;
             for (b = 0; b < 3; b++) {
@@ -3325,10 +3902,10 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             uint32_t old, sh;
             int k;
             if (l < B) {
-                if (header >> (2 * (((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M)) & 3) break;
+                if (occ >> ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 1) break;
             } else if (q == L) {
-                if (mask >> (voxdagi_brick_pos(c) ^ (M | M << 3)) & 1) break;
-            } else if (mask >> 8 * (((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M) & 0xFF) {
+                if (mask >> voxdagi_brick_pos(c) & 1) break;
+            } else if (mask >> 8 * ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 0xFF) {
                 break; /* a 2^3 cell: one byte of the brick, any bit */
             }
             sh = L - q;
@@ -3348,7 +3925,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 if (k < 0) return 0; /* left the grid */
                 c[0] >>= sh, c[1] >>= sh, c[2] >>= sh;
                 q -= sh, l = (uint32_t)k;
-                rec = f[l].rec, header = f[l].header, M = f[l].mirror;
+                rec = f[l].rec, header = f[l].header, MI = f[l].MI, occ = f[l].occ;
             }
         }
         /* Cell c of level q is full: a hit, or go down into it. */
@@ -3364,10 +3941,10 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             return 1;
         }
         if (l < B) {
-            uint64_t ptr = voxdagi_child(&d->level[l], rec, header,
-                                         ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) ^ M);
-            M ^= (unsigned)(ptr & 7);
-            at = ptr >> 3;
+            uint64_t ref = voxdagi_child_ref(&d->level[l], rec, header,
+                                             d->cube.act[MI][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
+            MI = d->cube.comp[ref & 63][MI];
+            at = ref >> 6;
         }
         l++;
     }

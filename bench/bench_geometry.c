@@ -78,7 +78,7 @@ static void graph_from_dag(const voxdag *d, graph *g) {
         while (at < lv->size) {
             unsigned header = (unsigned)voxdagi_le(lv->data + at, 2);
             off[l][i++] = at;
-            at += voxdagi_record_size(lv, header);
+            at += (voxdagi_record_bits(lv, header) + 7) / 8;
         }
         g->lv[l].n = i;
     }
@@ -97,10 +97,10 @@ static void graph_from_dag(const voxdag *d, graph *g) {
             for (s = 0; s < 8; s++) {
                 uint64_t p, t;
                 if (!(header >> (2 * s) & 3)) continue;
-                p = voxdagi_child(lv, rec, header, s);
-                t = p >> 3;
+                p = voxdagi_child_ref(lv, rec, header, s, 0);
+                t = p >> 6;
                 if (l + 1 < B) t = find_offset(off[l + 1], g->lv[l + 1].n, t);
-                gl->kid[k++] = t << 3 | (p & 7);
+                gl->kid[k++] = t << 6 | (p & 63);
             }
         }
         gl->first[gl->n] = k;
@@ -173,7 +173,7 @@ static uint64_t size_paper(const graph *g, int with_counts, double *short_out) {
     }
     refs[0][0] = 1;
     for (l = 0; l < B; l++)
-        for (i = 0; i < g->lv[l].first[g->lv[l].n]; i++) refs[l + 1][g->lv[l].kid[i] >> 3]++;
+        for (i = 0; i < g->lv[l].first[g->lv[l].n]; i++) refs[l + 1][g->lv[l].kid[i] >> 6]++;
     for (l = B + 1; l-- > 0;) {
         rankrec *r;
         uint64_t at = 0, maxc = 0;
@@ -196,7 +196,7 @@ static uint64_t size_paper(const graph *g, int with_counts, double *short_out) {
             pos[l][id] = at / 2; /* in 2-byte words */
             at += 2 + cw;
             for (k = g->lv[l].first[id]; k < g->lv[l].first[id + 1]; k++) {
-                int s = pos[l + 1][g->lv[l].kid[k] >> 3] < (1u << 13);
+                int s = pos[l + 1][g->lv[l].kid[k] >> 6] < (1u << 13);
                 at += s ? 2 : 4;
                 shorts += (uint64_t)s;
                 ptrs++;
@@ -213,14 +213,14 @@ static uint64_t size_paper(const graph *g, int with_counts, double *short_out) {
     return total;
 }
 
-static voxdag *build(const bscene *s, int no_symmetry) {
+static voxdag *build(const bscene *s, voxdag_symmetry symmetry) {
     voxdag_build_opts o;
     voxdag_builder *b;
     voxdag *d = NULL;
     voxdag_error e;
     memset(&o, 0, sizeof o);
     o.levels = s->levels;
-    o.no_symmetry = no_symmetry;
+    o.symmetry = symmetry;
     o.threads = 2;
     if (voxdag_builder_create(&o, &b, &e) != VOXDAG_OK || voxdag_builder_add(b, s->xyz, NULL, s->n, &e) != VOXDAG_OK ||
         voxdag_builder_finish(b, &d, NULL, &e) != VOXDAG_OK) {
@@ -233,13 +233,40 @@ static voxdag *build(const bscene *s, int no_symmetry) {
 static uint64_t count_bytes(const voxdag *d) {
     uint64_t c = 0;
     uint32_t l;
-    for (l = 0; l + 2 < d->levels; l++) c += d->level[l].nodes * d->level[l].count_bytes;
-    return c;
+    for (l = 0; l + 2 < d->levels; l++) c += d->level[l].nodes * d->level[l].count_bits;
+    return c / 8;
 }
+
+/* Bits of the encoded inner levels of D by component: [0] headers, [1]
+   counts, [2] pointer targets, [3] transform codes, [4] record padding. */
+static void components(const voxdag *d, uint64_t bits[5]) {
+    uint32_t l;
+    memset(bits, 0, 5 * sizeof *bits);
+    for (l = 0; l + 2 < d->levels; l++) {
+        const voxdagi_level *lv = &d->level[l];
+        uint64_t at = 0;
+        while (at < lv->size) {
+            unsigned header = (unsigned)voxdagi_le(lv->data + at, 2), s;
+            uint64_t rec = voxdagi_record_bits(lv, header);
+            bits[0] += 16;
+            bits[1] += lv->count_bits;
+            for (s = 0; s < 8; s++) {
+                unsigned t = header >> (2 * s) & 3;
+                bits[2] += (unsigned)lv->width[t] - lv->code_bits[t];
+                bits[3] += lv->code_bits[t];
+            }
+            bits[4] += 8 * ((rec + 7) / 8) - rec;
+            at += (rec + 7) / 8;
+        }
+    }
+}
+
+uint64_t bench_v2_geometry_bytes(const uint32_t *xyz, size_t n, uint32_t levels); /* bench/v2_size.c */
 
 typedef struct row {
     const bscene *s;
-    uint64_t svo_nodes, svdag_nodes, ssvdag_nodes, svdag_ptrs, ssvdag_ptrs;
+    uint64_t svo_nodes, svdag_nodes, ssvdag_nodes, full_nodes, svdag_ptrs, ssvdag_ptrs, v2;
+    uint64_t comp[5], tables;
     uint64_t svo, kampe_svdag, kampe_ssvdag, paper_svdag, paper_ssvdag, paper_ssvdag_counts;
     uint64_t ours, ours_nocount, ours_svdag, file;
     double short_frac;
@@ -272,7 +299,7 @@ int main(int argc, char **argv) {
 
     for (k = 0; k < ns; k++) {
         const bscene *s = &scenes[k];
-        voxdag *sym, *plain;
+        voxdag *sym, *plain, *full;
         voxdag_info info;
         graph gs, gp;
         row *r = &rows[k];
@@ -282,14 +309,19 @@ int main(int argc, char **argv) {
         memset(r, 0, sizeof *r);
         memset(&o, 0, sizeof o);
         r->s = s;
-        sym = build(s, 0);
-        plain = build(s, 1);
+        full = build(s, VOXDAG_SYMMETRY_FULL);
+        sym = build(s, VOXDAG_SYMMETRY_REFLECT);
+        plain = build(s, VOXDAG_SYMMETRY_NONE);
         graph_from_dag(sym, &gs);
         graph_from_dag(plain, &gp);
-        voxdag_get_info(sym, &info);
+        voxdag_get_info(full, &info);
         r->ours = info.node_bytes + info.brick_bytes;
-        r->ours_nocount = r->ours - count_bytes(sym);
+        r->ours_nocount = r->ours - count_bytes(full);
         r->file = info.file_bytes;
+        r->tables = (uint64_t)(s->levels - 2) * VOXDAG_FILE_LEVEL_ENTRY_SIZE + VOXDAG_FILE_HEADER_SIZE;
+        for (l = 0; l + 1 < s->levels; l++) r->full_nodes += info.nodes[l];
+        components(full, r->comp);
+        r->v2 = bench_v2_geometry_bytes(s->xyz, s->n, s->levels);
         voxdag_get_info(plain, &info);
         r->ours_svdag = info.node_bytes + info.brick_bytes;
         r->ssvdag_nodes = graph_nodes(&gs);
@@ -318,8 +350,29 @@ int main(int argc, char **argv) {
         graph_free(&gp);
         voxdag_free(sym);
         voxdag_free(plain);
+        voxdag_free(full);
     }
 
+    printf("### Format version 3 against version 2 (same voxels)\n\n");
+    printf("Geometry bytes (node records + bricks) of the default build, next to the version-2 writer (the last "
+           "version-2 `voxdag.h`, built into this program) on the same voxels, and where version 3's bytes go. "
+           "Nodes: all levels, 4^3 bricks included; reflect = the 8 reflections (version 2's group), full = all 48 cube "
+           "symmetries (version 3's default).\n\n");
+    printf("| scene | L | nodes, reflect | nodes, full | version 2 | **version 3** | v3 / v2 | v3 / paper layout | headers | counts | pointer targets | transform codes | padding | bricks | header + level table |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (k = 0; k < ns; k++) {
+        const row *r = &rows[k];
+        printf("| %s | %u | %llu | %llu | %llu | **%llu** | %.3f | %.3f | %llu | %llu | %llu | %llu | %llu | %llu | %llu |\n",
+               r->s->name, r->s->levels, (unsigned long long)r->ssvdag_nodes, (unsigned long long)r->full_nodes,
+               (unsigned long long)r->v2, (unsigned long long)r->ours, r->v2 ? (double)r->ours / (double)r->v2 : 0.0,
+               (double)r->ours / (double)r->paper_ssvdag, (unsigned long long)(r->comp[0] / 8),
+               (unsigned long long)(r->comp[1] / 8), (unsigned long long)(r->comp[2] / 8),
+               (unsigned long long)(r->comp[3] / 8), (unsigned long long)(r->comp[4] / 8),
+               (unsigned long long)(r->ours - (r->comp[0] + r->comp[1] + r->comp[2] + r->comp[3] + r->comp[4]) / 8),
+               (unsigned long long)r->tables);
+    }
+    printf("\nComponents in bytes (bits / 8, rounded down). The version-2 column is 0 when the program was built "
+           "without that header (no git history).\n\n");
     printf("### Geometry size (SSVDAG Table 2 shape)\n\n");
     printf("Bytes of geometry for the same voxels (colours excluded). Nodes: total nodes of all levels "
            "(SVO: levels 0..L-1; DAGs: inner levels 0..L-3 plus 4^3 bricks). Layouts as described below the table.\n\n");

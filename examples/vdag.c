@@ -111,10 +111,16 @@ static int parse_double(const char *s, double *out) {
 
 // -- vdag build
 
+/* The --symmetry and info name of a group. */
+static const char *symmetry_name(voxdag_symmetry s) {
+    return s == VOXDAG_SYMMETRY_NONE ? "none" : s == VOXDAG_SYMMETRY_REFLECT ? "reflect" : "full";
+}
+
 typedef struct build_args {
     const char *in, *out;
     uint32_t levels, threads;
-    int no_symmetry, no_colors, stats, compress;
+    voxdag_symmetry symmetry;
+    int no_colors, stats, compress;
     double color_error;
     uint32_t color_bits; /* 0: auto */
     struct color_spill *spill;
@@ -254,13 +260,14 @@ static void print_build_summary(const voxdag *dag, const voxdag_build_stats *st,
     voxdag_get_info(dag, &info);
     fprintf(stderr, "vdag: %llu voxels, L=%u, %.2f s, peak %.1f MiB\n", (unsigned long long)info.voxels,
             info.levels, seconds, st->peak_memory / 1048576.0);
-    fprintf(stderr, "vdag: level      nodes        svo%s\n", st->svdag_nodes[0] ? "      svdag     ssvdag" : "");
+    int all = st->svdag_nodes[0] && st->reflect_nodes[0] && st->full_nodes[0];
+    fprintf(stderr, "vdag: level      nodes        svo%s\n", all ? "      svdag    reflect       full" : "");
     for (l = 0; l + 1 < info.levels; l++) {
         fprintf(stderr, "vdag: %5u %10llu %10llu", l, (unsigned long long)st->nodes[l],
                 (unsigned long long)st->svo_nodes[l]);
-        if (st->svdag_nodes[0])
-            fprintf(stderr, " %10llu %10llu", (unsigned long long)st->svdag_nodes[l],
-                    (unsigned long long)st->ssvdag_nodes[l]);
+        if (all)
+            fprintf(stderr, " %10llu %10llu %10llu", (unsigned long long)st->svdag_nodes[l],
+                    (unsigned long long)st->reflect_nodes[l], (unsigned long long)st->full_nodes[l]);
         fputc('\n', stderr);
     }
     fprintf(stderr, "vdag: geometry %llu bytes (%.3f bits/voxel), colours %llu bytes, file %llu bytes\n",
@@ -371,7 +378,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
 static int build_opts(build_args *a, int colors, const double *bounds, voxdag_build_opts *o) {
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
-    o->no_symmetry = a->no_symmetry;
+    o->symmetry = a->symmetry;
     o->colors = colors;
     o->compare_structures = a->stats;
     o->threads = a->threads;
@@ -452,7 +459,13 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
-            a.no_symmetry = 1;
+            a.symmetry = VOXDAG_SYMMETRY_NONE;
+        } else if (!strcmp(argv[k], "--symmetry") && k + 1 < argc) {
+            k++;
+            for (a.symmetry = VOXDAG_SYMMETRY_NONE; a.symmetry <= VOXDAG_SYMMETRY_FULL;
+                 a.symmetry = (voxdag_symmetry)(a.symmetry + 1))
+                if (!strcmp(argv[k], symmetry_name(a.symmetry))) break;
+            if (a.symmetry > VOXDAG_SYMMETRY_FULL) return vdag_fail("build: --symmetry takes none, reflect or full");
         } else if (!strcmp(argv[k], "--stats")) {
             a.stats = 1;
         } else if (!strcmp(argv[k], "--color-error") && k + 1 < argc) {
@@ -543,8 +556,10 @@ static int cmd_info(int argc, char **argv) {
     voxdag_get_info(f.dag, &in);
     geo_bits = in.voxels ? 8.0 * (double)(in.node_bytes + in.brick_bytes) / (double)in.voxels : 0.0;
     if (json) {
-        printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"nodes_per_level\": [", in.levels,
-               (unsigned long long)in.voxels, in.symmetric ? "true" : "false");
+        printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"symmetry\": \"%s\", \"voxel_box\": [%u, %u, %u, %u, %u, %u], \"nodes_per_level\": [",
+               in.levels, (unsigned long long)in.voxels, in.symmetry != VOXDAG_SYMMETRY_NONE ? "true" : "false",
+               symmetry_name(in.symmetry), in.voxel_box[0], in.voxel_box[1],
+               in.voxel_box[2], in.voxel_box[3], in.voxel_box[4], in.voxel_box[5]);
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.nodes[l]);
         printf("], \"bytes_per_level\": [");
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.level_bytes[l]);
@@ -560,7 +575,9 @@ static int cmd_info(int argc, char **argv) {
     } else {
         printf("levels      %u (grid %u^3)\n", in.levels, 1u << in.levels);
         printf("voxels      %llu\n", (unsigned long long)in.voxels);
-        printf("symmetric   %s\n", in.symmetric ? "yes" : "no");
+        printf("symmetry    %s\n", symmetry_name(in.symmetry));
+        printf("voxel box   %u %u %u .. %u %u %u (occupied voxels, grid units)\n", in.voxel_box[0], in.voxel_box[1],
+               in.voxel_box[2], in.voxel_box[3], in.voxel_box[4], in.voxel_box[5]);
         printf("level       nodes        bytes\n");
         for (l = 0; l + 1 < in.levels; l++)
             printf("%5u %11llu %12llu%s\n", l, (unsigned long long)in.nodes[l],

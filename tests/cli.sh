@@ -68,7 +68,17 @@ import json, sys
 d = json.load(open('$T/info.json'))
 assert d['levels'] == 5 and d['voxels'] == int(open('$T/count').read())
 assert len(d['nodes_per_level']) == 4 and d['nodes_per_level'][0] == 1
+assert d['symmetry'] == 'full' and d['symmetric'] is True
+v = [list(map(int, l.split()[:3])) for l in open('$T/expected_export')]
+box = [min(p[a] for p in v) for a in range(3)] + [max(p[a] for p in v) + 1 for a in range(3)]
+assert d['voxel_box'] == box, (d['voxel_box'], box)
 "
+for g in none reflect full; do
+    check "build --symmetry $g keeps the voxels and says so" sh -c "'$VDAG' build '$T/in.xyz' '$T/s_$g.vdag' --levels 5 --symmetry $g 2>/dev/null &&
+        '$VDAG' export-voxels '$T/s_$g.vdag' 2>/dev/null | cmp -s - '$T/expected_export' &&
+        '$VDAG' info '$T/s_$g.vdag' --json | grep -q '\"symmetry\": \"$g\"'"
+done
+check "--symmetry with a bad name fails with one line" sh -c "! '$VDAG' build '$T/in.xyz' '$T/bad.vdag' --symmetry all 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
 
 # -- lossy colours stay within the bound; lossless colours are exact
 check "build with --color-error" "$VDAG" build "$T/in.xyz" "$T/c.vdag" --levels 5 --color-error 0.05 2>/dev/null

@@ -1,7 +1,8 @@
 /* Fuzz target for the build -> save -> load round trip. The input is a small
    voxel scene with its options:
      byte 0    bits 0-4  levels: 2 + value % 20 (2..21)
-               bit 5     no_symmetry
+               bit 5     symmetry none; else reflections when bits 0-4
+                         are >= 20, all 48 symmetries below
                bit 6     colours (RGB8 per voxel)
                bit 7     two threads (and the result must equal a one-thread
                          build byte for byte)
@@ -56,7 +57,8 @@ typedef struct voxel {
 
 typedef struct scene {
     uint32_t levels;
-    int colors, threads, no_symmetry;
+    int colors, threads;
+    voxdag_symmetry symmetry;
     unsigned bound, adding, fail, limit, p;
     size_t n;         /* voxels as added, in input order */
     uint32_t *xyz;
@@ -76,7 +78,8 @@ static void scene_read(scene *s, const uint8_t *data, size_t size) {
     uint32_t mask;
     memset(s, 0, sizeof *s);
     s->levels = 2 + (data[0] & 31) % 20;
-    s->no_symmetry = data[0] >> 5 & 1;
+    s->symmetry = data[0] >> 5 & 1 ? VOXDAG_SYMMETRY_NONE
+                  : (data[0] & 31) >= 20 ? VOXDAG_SYMMETRY_REFLECT : VOXDAG_SYMMETRY_FULL;
     s->colors = data[0] >> 6 & 1;
     s->threads = data[0] >> 7 ? 2 : 1;
     s->bound = data[1] & 7;
@@ -173,7 +176,7 @@ static voxdag_status build(const scene *s, unsigned threads, const voxdag_alloca
     voxdag_status st;
     memset(&o, 0, sizeof o);
     o.levels = s->levels;
-    o.no_symmetry = s->no_symmetry;
+    o.symmetry = s->symmetry == VOXDAG_SYMMETRY_FULL ? VOXDAG_SYMMETRY_DEFAULT : s->symmetry;
     o.colors = s->colors;
     o.threads = threads;
     o.allocator = *a;
@@ -238,7 +241,18 @@ static void check(const scene *s, const voxdag *d, double bound) {
     walk w;
     voxdag_get_info(d, &info);
     require(info.levels == s->levels && info.voxels == s->distinct, "levels or voxel count");
-    require(info.symmetric == !s->no_symmetry, "symmetry flag");
+    require(info.symmetry == s->symmetry, "symmetry group");
+    { /* the occupied box, from the voxels */
+        uint32_t box[6] = {0, 0, 0, 0, 0, 0}, c[3], k;
+        for (i = 0; i < s->distinct; i++) {
+            voxdag_morton_decode(s->sorted[i].morton, c, c + 1, c + 2);
+            for (k = 0; k < 3; k++) {
+                if (!i || c[k] < box[k]) box[k] = c[k];
+                if (!i || c[k] + 1 > box[k + 3]) box[k + 3] = c[k] + 1;
+            }
+        }
+        require(!memcmp(box, info.voxel_box, sizeof box), "voxel box");
+    }
     require(kind == (!s->colors ? VOXDAG_COLORS_NONE : s->bound ? VOXDAG_COLORS_VOXCOLOR : VOXDAG_COLORS_RGB8),
             "colour kind");
     if (kind == VOXDAG_COLORS_VOXCOLOR) {

@@ -25,13 +25,15 @@
 #define GOLDEN_OFF_FILE_SIZE 24
 #define GOLDEN_OFF_VOXELS 32
 #define GOLDEN_OFF_LEVELS 40
-#define GOLDEN_OFF_ROOT_MIRROR 41
+#define GOLDEN_OFF_ROOT_TRANSFORM 41
+#define GOLDEN_OFF_SYMMETRY 42
 #define GOLDEN_OFF_SECTION_COUNT 44
 #define GOLDEN_OFF_TABLE_CRC 48
 #define GOLDEN_OFF_HEADER_CRC 52
-#define GOLDEN_HEADER_SIZE 64
+#define GOLDEN_OFF_VOXEL_BOX 56
+#define GOLDEN_HEADER_SIZE 96
 #define GOLDEN_SECTION_ENTRY_SIZE 32
-#define GOLDEN_LEVEL_ENTRY_SIZE 24
+#define GOLDEN_LEVEL_ENTRY_SIZE 80
 
 static inline uint64_t golden_le(const uint8_t *p, unsigned n) {
     uint64_t v = 0;
@@ -159,7 +161,7 @@ static inline voxdag_status golden_build(int kind, const voxdag_allocator *alloc
         break;
     case GOLDEN_SVDAG: /* a terrain with repeated columns, no reflections */
         o.levels = 5;
-        o.no_symmetry = 1;
+        o.symmetry = VOXDAG_SYMMETRY_NONE;
         for (y = 0; y < 32; y++)
             for (x = 0; x < 32; x++) {
                 uint32_t h = 2 + (x / 4 * 3 + y / 4 * 5) % 5;

@@ -35,9 +35,24 @@ static void scene_free(scene *s) {
 }
 
 enum { SC_EMPTY, SC_ONE, SC_FULL, SC_NOISE_SPARSE, SC_NOISE_DENSE, SC_SPHERE, SC_PLANE,
-       SC_HEIGHT, SC_MIRRORED_BLOB, SC_CORNERS, SC_COUNT };
+       SC_HEIGHT, SC_MIRRORED_BLOB, SC_CORNERS, SC_TRANSFORMED_BLOB, SC_COUNT };
 static const char *const scene_names[SC_COUNT] = {"empty", "one voxel", "full", "sparse noise",
-    "dense noise", "sphere", "tilted plane", "heightfield", "mirrored blob", "corners"};
+    "dense noise", "sphere", "tilted plane", "heightfield", "mirrored blob", "corners", "transformed blob"};
+
+/* The 48 symmetries of a cube of side SIZE applied to point V: axis a moves
+   to axis perm[a] (the permutations enumerated here), then axes in M flip. */
+static void cube_image(uint32_t size, unsigned t, const uint32_t v[3], uint32_t out[3]) {
+    static unsigned perm[6][3], n = 0;
+    unsigned a, b, c;
+    if (!n) /* the permutations in lexicographic order, once */
+        for (a = 0; a < 3; a++)
+            for (b = 0; b < 3; b++)
+                for (c = 0; c < 3; c++)
+                    if (a != b && b != c && a != c) perm[n][0] = a, perm[n][1] = b, perm[n][2] = c, n++;
+    for (a = 0; a < 3; a++) out[perm[t / 8][a]] = v[a];
+    for (a = 0; a < 3; a++)
+        if (t >> a & 1) out[a] = size - 1 - out[a];
+}
 
 static scene make_scene(int kind, uint32_t levels, uint64_t seed) {
     scene s = scene_new(levels, seed);
@@ -80,7 +95,7 @@ static scene make_scene(int kind, uint32_t levels, uint64_t seed) {
     case SC_MIRRORED_BLOB: {
         /* a random blob in the lower octant, reflected into all 8 octants */
         uint32_t h = n / 2, m;
-        for (i = 0; i < (size_t)h * h * h / 3 + 1; i++) {
+        for (i = 0; i < (size_t)h * h * h / 12 + 1; i++) {
             uint32_t bx = test_rand_below(&r, h), by = test_rand_below(&r, h), bz = test_rand_below(&r, h);
             for (m = 0; m < 8; m++)
                 s.full[cell(&s, m & 1 ? n - 1 - bx : bx, m & 2 ? n - 1 - by : by, m & 4 ? n - 1 - bz : bz)] = 1;
@@ -90,6 +105,21 @@ static scene make_scene(int kind, uint32_t levels, uint64_t seed) {
     case SC_CORNERS:
         for (i = 0; i < 8; i++) s.full[cell(&s, i & 1 ? n - 1 : 0, i & 2 ? n - 1 : 0, i & 4 ? n - 1 : 0)] = 1;
         break;
+    case SC_TRANSFORMED_BLOB: {
+        /* a random blob copied into 48 of the 64 cells of side n/4, each under
+           another of the 48 cube symmetries */
+        uint32_t q = n / 4, v[3], w[3];
+        unsigned t;
+        if (!q) break;
+        for (i = 0; i < (size_t)q * q * q / 16 + 1; i++) {
+            v[0] = test_rand_below(&r, q), v[1] = test_rand_below(&r, q), v[2] = test_rand_below(&r, q);
+            for (t = 0; t < 48; t++) {
+                cube_image(q, t, v, w);
+                s.full[cell(&s, (t & 3) * q + w[0], (t >> 2 & 3) * q + w[1], (t >> 4) * q + w[2])] = 1;
+            }
+        }
+        break;
+    }
     }
     return s;
 }
@@ -120,64 +150,78 @@ static size_t scene_voxels(const scene *s, uint32_t **xyz, uint8_t **rgb) {
 static size_t key_bytes_global;
 static int key_cmp(const void *a, const void *b) { return memcmp(a, b, key_bytes_global); }
 
-/* Content of the cell of size SIZE at (cx,cy,cz) seen through reflection M,
-   as raster-order bits. Returns 1 when the cell is not empty. */
-static int cell_key(const scene *s, uint32_t size, uint32_t cx, uint32_t cy, uint32_t cz, unsigned m, uint8_t *key) {
-    uint32_t x, y, z, bit = 0;
-    int any = 0;
-    memset(key, 0, (size_t)size * size * size / 8);
+/* The full voxels of the cell of size SIZE at (cx,cy,cz), relative to the
+   cell, 3 coordinates each. Returns their number. */
+static size_t cell_voxels(const scene *s, uint32_t size, uint32_t cx, uint32_t cy, uint32_t cz, uint32_t *v) {
+    uint32_t x, y, z;
+    size_t n = 0;
     for (z = 0; z < size; z++)
         for (y = 0; y < size; y++)
-            for (x = 0; x < size; x++, bit++) {
-                uint32_t sx = m & 1 ? size - 1 - x : x, sy = m & 2 ? size - 1 - y : y, sz = m & 4 ? size - 1 - z : z;
-                if (s->full[cell(s, cx * size + sx, cy * size + sy, cz * size + sz)]) {
-                    key[bit >> 3] |= (uint8_t)(1u << (bit & 7));
-                    any = 1;
-                }
-            }
-    return any;
+            for (x = 0; x < size; x++)
+                if (s->full[cell(s, cx * size + x, cy * size + y, cz * size + z)])
+                    v[3 * n] = x, v[3 * n + 1] = y, v[3 * n + 2] = z, n++;
+    return n;
 }
 
-/* Counts per level 0..L-2 of: nonempty cells (SVO), distinct contents (SVDAG),
-   and distinct contents up to the 8 reflections (SSVDAG). */
-static void brute_counts(const scene *s, uint64_t *svo, uint64_t *svdag, uint64_t *ssvdag) {
+/* The image of N voxels V of a cube of side SIZE under symmetry T
+   (cube_image), as raster-order bits: its sorted voxel list as a bit set. */
+static void cell_key(uint32_t size, const uint32_t *v, size_t n, unsigned t, uint8_t *key) {
+    size_t i;
+    memset(key, 0, (size_t)size * size * size / 8);
+    for (i = 0; i < n; i++) {
+        uint32_t w[3];
+        size_t bit;
+        cube_image(size, t, v + 3 * i, w);
+        bit = (size_t)w[0] + (size_t)size * ((size_t)w[1] + (size_t)size * w[2]);
+        key[bit >> 3] |= (uint8_t)(1u << (bit & 7));
+    }
+}
+
+/* Counts per level 0..L-2 of: nonempty cells (SVO) and distinct contents up
+   to each group (index G: 0 none, 1 the 8 reflections, 2 all 48 symmetries):
+   a cell's class is the smallest key over the group's images. */
+static void brute_counts(const scene *s, uint64_t *svo, uint64_t groups[3][VOXDAG_LEVEL_CAPACITY]) {
     uint32_t l;
+    unsigned g;
     for (l = 0; l + 1 < s->levels; l++) {
         uint32_t size = s->n >> l, cells = 1u << l, cx, cy, cz;
         size_t kb = (size_t)size * size * size / 8, count = 0, i;
-        uint8_t *keys = (uint8_t *)malloc(kb * (size_t)cells * cells * cells);
-        uint8_t *sym = (uint8_t *)malloc(kb * (size_t)cells * cells * cells);
-        uint8_t *tmp = (uint8_t *)malloc(kb);
+        uint8_t *keys[3], *tmp = (uint8_t *)malloc(kb);
+        uint32_t *v = (uint32_t *)malloc(3 * sizeof *v * (size_t)size * size * size);
+        for (g = 0; g < 3; g++) keys[g] = (uint8_t *)malloc(kb * (size_t)cells * cells * cells);
         for (cz = 0; cz < cells; cz++)
             for (cy = 0; cy < cells; cy++)
                 for (cx = 0; cx < cells; cx++) {
-                    unsigned m;
-                    if (!cell_key(s, size, cx, cy, cz, 0, keys + count * kb)) continue;
-                    memcpy(sym + count * kb, keys + count * kb, kb);
-                    for (m = 1; m < 8; m++) {
-                        cell_key(s, size, cx, cy, cz, m, tmp);
-                        if (memcmp(tmp, sym + count * kb, kb) < 0) memcpy(sym + count * kb, tmp, kb);
+                    size_t nv = cell_voxels(s, size, cx, cy, cz, v);
+                    unsigned t;
+                    if (!nv) continue;
+                    cell_key(size, v, nv, 0, keys[0] + count * kb);
+                    memcpy(keys[1] + count * kb, keys[0] + count * kb, kb);
+                    for (t = 1; t < 48; t++) {
+                        uint8_t *best = keys[t < 8 ? 1 : 2] + count * kb;
+                        if (t == 8) memcpy(keys[2] + count * kb, keys[1] + count * kb, kb);
+                        cell_key(size, v, nv, t, tmp);
+                        if (memcmp(tmp, best, kb) < 0) memcpy(best, tmp, kb);
                     }
                     count++;
                 }
         key_bytes_global = kb;
-        qsort(keys, count, kb, key_cmp);
-        qsort(sym, count, kb, key_cmp);
         svo[l] = count;
-        svdag[l] = ssvdag[l] = 0;
-        for (i = 0; i < count; i++) {
-            if (i == 0 || memcmp(keys + i * kb, keys + (i - 1) * kb, kb)) svdag[l]++;
-            if (i == 0 || memcmp(sym + i * kb, sym + (i - 1) * kb, kb)) ssvdag[l]++;
+        for (g = 0; g < 3; g++) {
+            qsort(keys[g], count, kb, key_cmp);
+            groups[g][l] = 0;
+            for (i = 0; i < count; i++)
+                if (i == 0 || memcmp(keys[g] + i * kb, keys[g] + (i - 1) * kb, kb)) groups[g][l]++;
+            free(keys[g]);
         }
-        free(keys);
-        free(sym);
+        free(v);
         free(tmp);
     }
 }
 
 // -- Building helpers
 
-static voxdag *build(const scene *s, int symmetric, uint32_t threads, int compare, voxdag_build_stats *stats) {
+static voxdag *build(const scene *s, voxdag_symmetry symmetry, uint32_t threads, int compare, voxdag_build_stats *stats) {
     voxdag_build_opts o;
     voxdag_builder *b;
     voxdag *d = NULL;
@@ -186,7 +230,7 @@ static voxdag *build(const scene *s, int symmetric, uint32_t threads, int compar
     size_t n = scene_voxels(s, &xyz, &rgb);
     memset(&o, 0, sizeof o);
     o.levels = s->levels;
-    o.no_symmetry = !symmetric;
+    o.symmetry = symmetry;
     o.colors = 1;
     o.threads = threads;
     o.compare_structures = compare;
@@ -298,17 +342,20 @@ static void check_queries(const scene *s, const voxdag *d, const char *what) {
     free(sorted);
 }
 
-static void check_counts(const scene *s, const voxdag_build_stats *st, int symmetric, const uint64_t *svo,
-                         const uint64_t *svdag, const uint64_t *ssvdag, const char *what) {
+/* G: the build's group (0 none, 1 reflections, 2 full). */
+static void check_counts(const scene *s, const voxdag_build_stats *st, unsigned g, const uint64_t *svo,
+                         uint64_t groups[3][VOXDAG_LEVEL_CAPACITY], const char *what) {
     uint32_t l;
     for (l = 0; l + 1 < s->levels; l++) {
-        uint64_t want = symmetric ? ssvdag[l] : svdag[l];
-        CHECK_MSG(st->nodes[l] == want, "%s level %u: %llu nodes, brute force %llu", what, l,
-                  (unsigned long long)st->nodes[l], (unsigned long long)want);
+        CHECK_MSG(st->nodes[l] == groups[g][l], "%s level %u: %llu nodes, brute force %llu", what, l,
+                  (unsigned long long)st->nodes[l], (unsigned long long)groups[g][l]);
         CHECK_MSG(st->svo_nodes[l] == svo[l], "%s level %u: %llu SVO nodes, brute force %llu", what, l,
                   (unsigned long long)st->svo_nodes[l], (unsigned long long)svo[l]);
-        CHECK(st->svdag_nodes[l] == svdag[l]);
-        CHECK(st->ssvdag_nodes[l] == ssvdag[l]);
+        CHECK(st->svdag_nodes[l] == groups[0][l]);
+        CHECK_MSG(st->reflect_nodes[l] == groups[1][l], "%s level %u: %llu reflection nodes, brute force %llu", what,
+                  l, (unsigned long long)st->reflect_nodes[l], (unsigned long long)groups[1][l]);
+        CHECK_MSG(st->full_nodes[l] == groups[2][l], "%s level %u: %llu full-group nodes, brute force %llu", what, l,
+                  (unsigned long long)st->full_nodes[l], (unsigned long long)groups[2][l]);
     }
 }
 
@@ -319,8 +366,10 @@ static void check_counts(const scene *s, const voxdag_build_stats *st, int symme
    every query agrees with the grid. */
 static int oracle_wanted(int kind, uint32_t levels) {
     if (levels <= 6) return 1;
-    if (levels == 7) return kind == SC_SPHERE || kind == SC_MIRRORED_BLOB || kind == SC_HEIGHT || kind == SC_NOISE_SPARSE;
-    return kind == SC_SPHERE || kind == SC_MIRRORED_BLOB;
+    if (levels == 7)
+        return kind == SC_SPHERE || kind == SC_MIRRORED_BLOB || kind == SC_HEIGHT || kind == SC_NOISE_SPARSE ||
+               kind == SC_TRANSFORMED_BLOB;
+    return kind == SC_MIRRORED_BLOB || kind == SC_TRANSFORMED_BLOB;
 }
 
 static void test_oracle_scenes(void) {
@@ -328,19 +377,20 @@ static void test_oracle_scenes(void) {
     int kind;
     for (levels = 2; levels <= 8; levels++)
         for (kind = 0; kind < SC_COUNT; kind++) {
-            uint64_t svo[VOXDAG_MAX_LEVELS], svdag[VOXDAG_MAX_LEVELS], ssvdag[VOXDAG_MAX_LEVELS];
+            static const char *const group_names[3] = {"none", "reflect", "full"};
+            uint64_t svo[VOXDAG_LEVEL_CAPACITY], groups[3][VOXDAG_LEVEL_CAPACITY];
             scene s;
-            int sym;
+            unsigned g;
             if (!oracle_wanted(kind, levels)) continue;
             s = make_scene(kind, levels, 1000 + levels * 31 + (uint64_t)kind);
-            brute_counts(&s, svo, svdag, ssvdag);
-            for (sym = 0; sym < 2; sym++) {
+            brute_counts(&s, svo, groups);
+            for (g = 0; g < 3; g++) {
                 voxdag_build_stats st;
                 char what[96];
-                voxdag *d = build(&s, sym, 1 + (levels & 1), 1, &st);
-                snprintf(what, sizeof what, "%s L=%u %s", scene_names[kind], levels, sym ? "symmetric" : "plain");
+                voxdag *d = build(&s, (voxdag_symmetry)(VOXDAG_SYMMETRY_NONE + g), 1 + (levels & 1), 1, &st);
+                snprintf(what, sizeof what, "%s L=%u %s", scene_names[kind], levels, group_names[g]);
                 if (!d) continue;
-                check_counts(&s, &st, sym, svo, svdag, ssvdag, what);
+                check_counts(&s, &st, g, svo, groups, what);
                 check_queries(&s, d, what);
                 voxdag_free(d);
             }
@@ -353,7 +403,7 @@ static void test_oracle_scenes(void) {
 static void test_mirrored_blob_merges(void) {
     scene s = make_scene(SC_MIRRORED_BLOB, 6, 77);
     voxdag_build_stats st;
-    voxdag *d = build(&s, 1, 1, 1, &st);
+    voxdag *d = build(&s, VOXDAG_SYMMETRY_REFLECT, 1, 1, &st);
     CHECK(st.nodes[1] == 1);
     CHECK(st.svdag_nodes[1] == 8);
     voxdag_free(d);
@@ -369,7 +419,7 @@ static void test_determinism(void) {
         uint32_t *xyz;
         uint8_t *rgb;
         size_t n = scene_voxels(&s, &xyz, &rgb), i, size0, size1;
-        voxdag *ref = build(&s, 1, 1, 0, NULL);
+        voxdag *ref = build(&s, VOXDAG_SYMMETRY_DEFAULT, 1, 0, NULL);
         const void *img0 = voxdag_image(ref, &size0);
         uint32_t threads;
         uint64_t seed = 99;
@@ -420,7 +470,7 @@ static void test_streaming_chunks(void) {
     scene s = make_scene(SC_SPHERE, 7, 5);
     morton_voxel *sorted;
     size_t count = sorted_voxels(&s, &sorted), i, size0, size1;
-    voxdag *ref = build(&s, 1, 2, 0, NULL), *d = NULL;
+    voxdag *ref = build(&s, VOXDAG_SYMMETRY_DEFAULT, 2, 0, NULL), *d = NULL;
     voxdag_build_opts o;
     voxdag_builder *b;
     uint32_t xyz[3];
@@ -534,7 +584,7 @@ static void test_load_roundtrip(void) {
     int kind;
     for (kind = 0; kind < SC_COUNT; kind++) {
         scene s = make_scene(kind, 6, 300 + (uint64_t)kind);
-        voxdag *d = build(&s, 1, 1, 0, NULL), *e = NULL;
+        voxdag *d = build(&s, VOXDAG_SYMMETRY_DEFAULT, 1, 0, NULL), *e = NULL;
         size_t size;
         const void *img = voxdag_image(d, &size);
         voxdag_error err;
@@ -690,7 +740,7 @@ static void test_build_limits(void) {
    truncation is rejected. */
 static void test_mutations_rejected(void) {
     scene s = make_scene(SC_MIRRORED_BLOB, 5, 21);
-    voxdag *d = build(&s, 1, 1, 0, NULL);
+    voxdag *d = build(&s, VOXDAG_SYMMETRY_DEFAULT, 1, 0, NULL);
     size_t size, i;
     const uint8_t *img = (const uint8_t *)voxdag_image(d, &size);
     uint8_t *copy = (uint8_t *)malloc(size);

@@ -132,17 +132,18 @@ static void test_offsets_documented(void) {
     /* FORMAT.md's header table */
     CHECK(VOXDAG_FILE_OFF_MAGIC == 0 && VOXDAG_FILE_OFF_VERSION == 8 && VOXDAG_FILE_OFF_ENDIAN == 12);
     CHECK(VOXDAG_FILE_OFF_HEADER_SIZE == 16 && VOXDAG_FILE_OFF_FLAGS == 20 && VOXDAG_FILE_OFF_FILE_SIZE == 24);
-    CHECK(VOXDAG_FILE_OFF_VOXELS == 32 && VOXDAG_FILE_OFF_LEVELS == 40 && VOXDAG_FILE_OFF_ROOT_MIRROR == 41);
+    CHECK(VOXDAG_FILE_OFF_VOXELS == 32 && VOXDAG_FILE_OFF_LEVELS == 40 && VOXDAG_FILE_OFF_ROOT_TRANSFORM == 41);
+    CHECK(VOXDAG_FILE_OFF_SYMMETRY == 42 && VOXDAG_FILE_OFF_VOXEL_BOX == 56 && VOXDAG_FILE_OFF_RESERVED == 80);
     CHECK(VOXDAG_FILE_OFF_SECTION_COUNT == 44 && VOXDAG_FILE_OFF_TABLE_CRC == 48);
-    CHECK(VOXDAG_FILE_OFF_HEADER_CRC == 52 && VOXDAG_FILE_HEADER_SIZE == 64);
-    CHECK(VOXDAG_FILE_SECTION_ENTRY_SIZE == 32 && VOXDAG_FILE_LEVEL_ENTRY_SIZE == 24);
-    CHECK(VOXDAG_FILE_NODE_PADDING == 8 && VOXDAG_FILE_MAX_SECTIONS == 16);
-    CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 2);
+    CHECK(VOXDAG_FILE_OFF_HEADER_CRC == 52 && VOXDAG_FILE_HEADER_SIZE == 96);
+    CHECK(VOXDAG_FILE_SECTION_ENTRY_SIZE == 32 && VOXDAG_FILE_LEVEL_ENTRY_SIZE == 80);
+    CHECK(VOXDAG_FILE_NODE_PADDING == 16 && VOXDAG_FILE_MAX_SECTIONS == 16);
+    CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 3);
     /* the helpers of golden.h use the same numbers */
     CHECK(GOLDEN_OFF_SECTION_COUNT == VOXDAG_FILE_OFF_SECTION_COUNT && GOLDEN_OFF_TABLE_CRC == VOXDAG_FILE_OFF_TABLE_CRC);
     CHECK(GOLDEN_OFF_HEADER_CRC == VOXDAG_FILE_OFF_HEADER_CRC && GOLDEN_HEADER_SIZE == VOXDAG_FILE_HEADER_SIZE);
     CHECK(GOLDEN_SECTION_ENTRY_SIZE == VOXDAG_FILE_SECTION_ENTRY_SIZE);
-    CHECK(GOLDEN_LEVEL_ENTRY_SIZE == VOXDAG_FILE_LEVEL_ENTRY_SIZE);
+    CHECK(GOLDEN_LEVEL_ENTRY_SIZE == VOXDAG_FILE_LEVEL_ENTRY_SIZE && GOLDEN_OFF_VOXEL_BOX == VOXDAG_FILE_OFF_VOXEL_BOX);
     CHECK(golden_crc32c((const uint8_t *)"123456789", 9) == 0xE3069283u); /* the CRC-32C check value */
 }
 
@@ -170,27 +171,29 @@ static void test_header_fields(void) {
         CHECK(!memcmp(f + VOXDAG_FILE_OFF_MAGIC, magic, 8));
         CHECK(golden_le(f + VOXDAG_FILE_OFF_VERSION, 4) == VOXDAG_FORMAT_VERSION);
         CHECK(!memcmp(f + VOXDAG_FILE_OFF_ENDIAN, "\x0D\x0C\x0B\x0A", 4));
-        CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_SIZE, 4) == 64);
-        CHECK(golden_le(f + VOXDAG_FILE_OFF_FLAGS, 4) == info.symmetric);
-        CHECK(info.symmetric == (kind != GOLDEN_SVDAG));
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_SIZE, 4) == 96);
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_FLAGS, 4) == 0);
+        CHECK(f[VOXDAG_FILE_OFF_SYMMETRY] == (unsigned)info.symmetry);
+        CHECK(info.symmetry == (kind != GOLDEN_SVDAG ? VOXDAG_SYMMETRY_FULL : VOXDAG_SYMMETRY_NONE));
         CHECK(golden_le(f + VOXDAG_FILE_OFF_FILE_SIZE, 8) == size && info.file_bytes == size);
         CHECK(golden_le(f + VOXDAG_FILE_OFF_VOXELS, 8) == info.voxels);
         CHECK(!voxels[kind] || info.voxels == voxels[kind]);
         CHECK((info.voxels == 0) == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_EMPTY_L5));
         CHECK(f[VOXDAG_FILE_OFF_LEVELS] == info.levels);
         CHECK(info.levels == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_BRICK_ROOT_L2 ? 2u : 5u));
-        CHECK(f[VOXDAG_FILE_OFF_ROOT_MIRROR] < 8 && !f[42] && !f[43]);
-        CHECK(golden_le(f + 56, 8) == 0);
+        CHECK(f[VOXDAG_FILE_OFF_ROOT_TRANSFORM] < 48 && !f[43]);
+        for (i = 0; i < 6; i++) CHECK(golden_le(f + VOXDAG_FILE_OFF_VOXEL_BOX + 4 * i, 4) == info.voxel_box[i]);
+        for (i = VOXDAG_FILE_OFF_RESERVED; i < VOXDAG_FILE_HEADER_SIZE; i++) CHECK(f[i] == 0);
         memcpy(h, f, sizeof h);
         golden_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
         CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_CRC, 4) == golden_crc32c(h, sizeof h));
         count = (uint32_t)golden_le(f + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
         CHECK(count == 3u + (kind == GOLDEN_MIRRORED_BLOB ? 2u : 0u));
-        CHECK(64 + (size_t)count * 32 <= size);
-        if (64 + (size_t)count * 32 > size) count = 0;
-        CHECK(golden_le(f + VOXDAG_FILE_OFF_TABLE_CRC, 4) == golden_crc32c(f + 64, (size_t)count * 32));
+        CHECK(96 + (size_t)count * 32 <= size);
+        if (96 + (size_t)count * 32 > size) count = 0;
+        CHECK(golden_le(f + VOXDAG_FILE_OFF_TABLE_CRC, 4) == golden_crc32c(f + 96, (size_t)count * 32));
         for (i = 0; i < count; i++) {
-            const uint8_t *e = f + 64 + 32 * i;
+            const uint8_t *e = f + 96 + 32 * i;
             uint32_t type = (uint32_t)golden_le(e, 4);
             uint64_t off = golden_le(e + 8, 8), sz = golden_le(e + 16, 8);
             CHECK(golden_le(e + 4, 4) == 0 && golden_le(e + 28, 4) == 0 && off % 8 == 0);
@@ -203,20 +206,25 @@ static void test_header_fields(void) {
             case VOXDAG_SECTION_LEVELS: {
                 uint32_t l;
                 uint64_t at = 0;
-                CHECK(sz == 24 * (uint64_t)(info.levels - 2));
-                for (l = 0; l + 2 < info.levels && 24 * (l + 1) <= sz; l++) {
-                    const uint8_t *le = f + off + 24 * l;
+                CHECK(sz == 80 * (uint64_t)(info.levels - 2));
+                for (l = 0; l + 2 < info.levels && 80 * (l + 1) <= sz; l++) {
+                    const uint8_t *le = f + off + 80 * l;
+                    unsigned t, k;
                     CHECK(golden_le(le, 8) == at);
                     CHECK(golden_le(le + 8, 8) == info.level_bytes[l]);
                     CHECK(golden_le(le + 16, 4) == info.nodes[l]);
-                    CHECK(le[20] == (l + 3 < info.levels ? (info.voxels ? le[20] : 1) : 0));
-                    CHECK(le[21] >= 1 && le[21] < le[22] && le[22] < le[23] && le[23] <= 8);
+                    CHECK(le[20] == (l + 3 < info.levels ? (info.voxels ? le[20] : 1) : 0) && le[20] <= 64);
+                    CHECK(le[21] >= 1 && le[21] <= (info.symmetry == VOXDAG_SYMMETRY_NONE ? 1 : 48));
+                    for (t = 1; t <= 3; t++) CHECK(le[24 + t] <= 6 && le[21 + t] + le[24 + t] <= 57);
+                    for (k = 0; k < 48; k++) /* the transform table: used entries distinct, the rest zero */
+                        CHECK(k < le[21] ? le[32 + k] < 48 && (!k || le[32 + k] != le[31 + k]) : le[32 + k] == 0);
+                    CHECK(golden_le(le + 28, 4) == 0);
                     at += info.level_bytes[l];
                 }
                 CHECK(at == info.node_bytes);
                 break;
             }
-            case VOXDAG_SECTION_NODES: CHECK(sz == info.node_bytes + 8); break;
+            case VOXDAG_SECTION_NODES: CHECK(sz == info.node_bytes + 16); break;
             case VOXDAG_SECTION_BRICKS:
                 CHECK(sz == info.brick_bytes && sz == 8 * info.nodes[info.levels - 2]);
                 break;
@@ -434,7 +442,7 @@ static void test_limits(void) {
 /* A file taken apart into its sections, to be changed and written again with
    the layout FORMAT.md gives (8-byte aligned, zero gaps, fresh checksums). */
 typedef struct parts {
-    uint8_t header[64];
+    uint8_t header[GOLDEN_HEADER_SIZE];
     uint32_t count;
     uint32_t type[16], flags[16];
     uint8_t *data[16];
@@ -444,12 +452,12 @@ typedef struct parts {
 static int parts_read(parts *p, const uint8_t *f, size_t size) {
     uint32_t i;
     memset(p, 0, sizeof *p);
-    if (size < 64) return 0;
-    memcpy(p->header, f, 64);
+    if (size < GOLDEN_HEADER_SIZE) return 0;
+    memcpy(p->header, f, GOLDEN_HEADER_SIZE);
     p->count = (uint32_t)golden_le(f + 44, 4);
-    if (p->count > 16 || 64 + 32 * (size_t)p->count > size) return 0;
+    if (p->count > 16 || GOLDEN_HEADER_SIZE + 32 * (size_t)p->count > size) return 0;
     for (i = 0; i < p->count; i++) {
-        const uint8_t *e = f + 64 + 32 * i;
+        const uint8_t *e = f + GOLDEN_HEADER_SIZE + 32 * i;
         uint64_t off = golden_le(e + 8, 8), sz = golden_le(e + 16, 8);
         if (off > size || sz > size - off) return 0;
         p->type[i] = (uint32_t)golden_le(e, 4);
@@ -475,7 +483,7 @@ static int parts_find(const parts *p, uint32_t type) {
 
 /* Writes P as a file (resealed) of *SIZE bytes; the caller frees it. */
 static uint8_t *parts_write(const parts *p, size_t *size) {
-    size_t at = 64 + 32 * (size_t)p->count, total;
+    size_t at = GOLDEN_HEADER_SIZE + 32 * (size_t)p->count, total;
     size_t off[16];
     uint32_t i;
     uint8_t *f;
@@ -486,11 +494,11 @@ static uint8_t *parts_write(const parts *p, size_t *size) {
     }
     total = at;
     f = (uint8_t *)calloc(total, 1);
-    memcpy(f, p->header, 64);
+    memcpy(f, p->header, GOLDEN_HEADER_SIZE);
     golden_put_le(f + 24, total, 8);
     golden_put_le(f + 44, p->count, 4);
     for (i = 0; i < p->count; i++) {
-        uint8_t *e = f + 64 + 32 * i;
+        uint8_t *e = f + GOLDEN_HEADER_SIZE + 32 * i;
         golden_put_le(e, p->type[i], 4);
         golden_put_le(e + 4, p->flags[i], 4);
         golden_put_le(e + 8, off[i], 8);
@@ -503,34 +511,49 @@ static uint8_t *parts_write(const parts *p, size_t *size) {
     return f;
 }
 
-/* The records of inner level L of a parsed file: start offsets inside NODES
-   and the offset of the level. Returns the number found (at most CAP). */
+/* The records of inner level L of a parsed file (FORMAT.md, read here bit
+   by bit): start offsets inside NODES and the offset of the level. */
 typedef struct level_view {
     uint64_t offset, size;
-    unsigned count_bytes;
-    unsigned ptr_bytes[4]; /* pointer size of tags 1..3 */
+    unsigned count_bits;
+    unsigned width[4], code_bits[4]; /* pointer bits and code bits of tags 1..3 */
 } level_view;
+
+static uint64_t bits_get(const uint8_t *p, uint64_t pos, unsigned n) {
+    uint64_t v = 0;
+    unsigned k;
+    for (k = 0; k < n; k++) v |= (uint64_t)(p[(pos + k) >> 3] >> ((pos + k) & 7) & 1) << k;
+    return v;
+}
+
+static void bits_put(uint8_t *p, uint64_t pos, uint64_t v, unsigned n) {
+    unsigned k;
+    for (k = 0; k < n; k++) {
+        uint8_t bit = (uint8_t)(1u << ((pos + k) & 7));
+        if (v >> k & 1) p[(pos + k) >> 3] |= bit;
+        else p[(pos + k) >> 3] &= (uint8_t)~bit;
+    }
+}
 
 static level_view level_of(const parts *p, uint32_t l) {
     level_view v;
-    const uint8_t *e = p->data[parts_find(p, 1)] + 24 * l;
+    const uint8_t *e = p->data[parts_find(p, 1)] + GOLDEN_LEVEL_ENTRY_SIZE * l;
+    unsigned t;
     v.offset = golden_le(e, 8);
     v.size = golden_le(e + 8, 8);
-    v.count_bytes = e[20];
-    v.ptr_bytes[0] = 0;
-    v.ptr_bytes[1] = e[21];
-    v.ptr_bytes[2] = e[22];
-    v.ptr_bytes[3] = e[23];
+    v.count_bits = e[20];
+    v.width[0] = v.code_bits[0] = 0;
+    for (t = 1; t <= 3; t++) {
+        v.width[t] = (unsigned)e[21 + t] + e[24 + t];
+        v.code_bits[t] = e[24 + t];
+    }
     return v;
 }
 
 static unsigned record_size(const uint8_t *rec, const level_view *v) {
-    unsigned header = (unsigned)golden_le(rec, 2), s, n = 2 + v->count_bytes;
-    for (s = 0; s < 8; s++) {
-        unsigned tag = header >> (2 * s) & 3;
-        n += v->ptr_bytes[tag];
-    }
-    return n;
+    unsigned header = (unsigned)golden_le(rec, 2), s, n = 16 + v->count_bits;
+    for (s = 0; s < 8; s++) n += v->width[header >> (2 * s) & 3];
+    return (n + 7) / 8;
 }
 
 static size_t record_starts(const parts *p, uint32_t l, uint64_t *starts, size_t cap) {
@@ -545,16 +568,101 @@ static size_t record_starts(const parts *p, uint32_t l, uint64_t *starts, size_t
     return n;
 }
 
-/* Offset (inside NODES) and byte size of the first pointer of the record at
-   START of level L. */
-static uint64_t first_pointer(const parts *p, uint32_t l, uint64_t start, unsigned *bytes) {
+/* Writes NODES again with every pointer class EXTRA target bits wider (an
+   independent writer of FORMAT.md's records): the same DAG, with room in
+   every pointer for the hostile targets below. */
+static void parts_widen(parts *p, unsigned extra) {
+    int li = parts_find(p, 1), ni = parts_find(p, 2);
+    uint32_t B = p->header[GOLDEN_OFF_LEVELS] - 2, l;
+    uint64_t *starts[32], *moved[32], at = 0;
+    size_t n[32], total = 0, k;
+    uint8_t *out;
+    level_view old[32];
+    for (l = 0; l < B; l++) {
+        old[l] = level_of(p, l);
+        starts[l] = (uint64_t *)malloc(4096 * sizeof(uint64_t));
+        moved[l] = (uint64_t *)malloc(4096 * sizeof(uint64_t));
+        n[l] = record_starts(p, l, starts[l], 4096);
+    }
+    for (l = 0; l < B; l++) { /* the new classes, record offsets and sizes */
+        uint8_t *e = p->data[li] + GOLDEN_LEVEL_ENTRY_SIZE * l;
+        unsigned t;
+        for (t = 1; t <= 3; t++) e[21 + t] = (uint8_t)(e[21 + t] + extra > 57u - e[24 + t] ? 57u - e[24 + t] : e[21 + t] + extra);
+        {
+            level_view v = level_of(p, l);
+            uint64_t size = 0;
+            for (k = 0; k < n[l]; k++) {
+                moved[l][k] = size;
+                size += record_size(p->data[ni] + old[l].offset + starts[l][k], &v);
+            }
+            golden_put_le(e, at, 8);
+            golden_put_le(e + 8, size, 8);
+            at += size;
+        }
+    }
+    total = (size_t)at + 16;
+    out = (uint8_t *)calloc(total + 64, 1);
+    for (l = 0; l < B; l++) {
+        level_view v = level_of(p, l);
+        for (k = 0; k < n[l]; k++) {
+            const uint8_t *rec = p->data[ni] + old[l].offset + starts[l][k];
+            uint8_t *w = out + v.offset + moved[l][k];
+            unsigned header = (unsigned)golden_le(rec, 2), s;
+            uint64_t from = 16 + old[l].count_bits, to = 16 + v.count_bits;
+            memcpy(w, rec, 2);
+            bits_put(w, 16, bits_get(rec, 16, v.count_bits), v.count_bits);
+            for (s = 0; s < 8; s++) {
+                unsigned t = header >> (2 * s) & 3, kb = v.code_bits[t];
+                uint64_t val, target;
+                size_t j;
+                if (!t) continue;
+                val = bits_get(rec, from, old[l].width[t]);
+                target = val >> kb;
+                if (l + 1 < B) /* a record offset of the next level moves with it */
+                    for (j = 0; j < n[l + 1]; j++)
+                        if (starts[l + 1][j] == target) target = moved[l + 1][j], j = n[l + 1];
+                bits_put(w, to, target << kb | (val & ((1ull << kb) - 1)), v.width[t]);
+                from += old[l].width[t], to += v.width[t];
+            }
+        }
+    }
+    for (l = 0; l < B; l++) free(starts[l]), free(moved[l]);
+    free(p->data[ni]);
+    p->data[ni] = out;
+    p->size[ni] = total;
+}
+
+/* Sets the target of a pointer of the record at START of level L (keeping
+   its transform code) to TARGET, or to its own target + 1 when PLUS_ONE:
+   the first pointer of the record whose class holds the new target. Returns
+   0 (changing nothing) when none does. */
+static int set_target(parts *p, uint32_t l, uint64_t start, int plus_one, uint64_t target) {
     level_view v = level_of(p, l);
-    const uint8_t *rec = p->data[parts_find(p, 2)] + v.offset + start;
-    unsigned header = (unsigned)golden_le(rec, 2), s = 0, tag;
-    while (!(header >> (2 * s) & 3)) s++;
-    tag = header >> (2 * s) & 3;
-    *bytes = v.ptr_bytes[tag];
-    return v.offset + start + 2 + v.count_bytes;
+    uint8_t *nodes = p->data[parts_find(p, 2)];
+    unsigned header = (unsigned)golden_le(nodes + v.offset + start, 2), s;
+    uint64_t at = 8 * (v.offset + start) + 16 + v.count_bits;
+    for (s = 0; s < 8; s++) {
+        unsigned t = header >> (2 * s) & 3, o = v.width[t] - v.code_bits[t];
+        uint64_t cur, want;
+        if (!t) continue;
+        cur = bits_get(nodes, at, v.width[t]);
+        want = plus_one ? (cur >> v.code_bits[t]) + 1 : target;
+        if (!(want >> o)) {
+            bits_put(nodes, at, want << v.code_bits[t] | (cur & ((1ull << v.code_bits[t]) - 1)), v.width[t]);
+            return 1;
+        }
+        at += v.width[t];
+    }
+    return 0;
+}
+
+/* The same on any record of level L: the first that has such a pointer. */
+static int set_any_target(parts *p, uint32_t l, int plus_one, uint64_t target) {
+    uint64_t starts[512];
+    size_t n = record_starts(p, l, starts, 512), k;
+    for (k = 0; k < n; k++)
+        if (set_target(p, l, starts[k], plus_one, target)) return 1;
+    return 0;
 }
 
 static void expect(const parts *p, voxdag_status want, const char *what, const voxdag *original) {
@@ -578,8 +686,7 @@ static void test_hostile_files(void) {
     uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size), *w;
     parts p;
     voxdag *orig = NULL;
-    uint64_t starts1[512], starts2[512], ptr_at;
-    unsigned bytes;
+    uint64_t starts1[512], starts2[512];
     int nodes, bricks;
     if (!f || !parts_read(&p, f, size)) {
         CHECK_MSG(0, "mirrored blob golden missing or unreadable");
@@ -602,25 +709,22 @@ static void test_hostile_files(void) {
     { /* a pointer to a byte inside a record of the next level */
         parts q;
         parts_read(&q, f, size);
-        ptr_at = first_pointer(&q, 0, 0, &bytes);
-        {
-            uint64_t v = golden_le(q.data[nodes] + ptr_at, bytes), t = v >> 3;
-            CHECK(t == starts1[0] || t < level_of(&q, 1).size);
-            golden_put_le(q.data[nodes] + ptr_at, (t + 1) << 3 | (v & 7), bytes);
-        }
+        parts_widen(&q, 8);
+        expect(&q, VOXDAG_OK, "the same DAG with wider pointers", orig);
+        CHECK(set_any_target(&q, 0, 1, 0));
         expect(&q, VOXDAG_ERR_CORRUPT, "pointer to a non-start byte", NULL);
         parts_free(&q);
     }
     { /* a pointer past the end of the next level; and a brick index past the bricks */
         parts q;
         parts_read(&q, f, size);
-        ptr_at = first_pointer(&q, 1, starts1[n1 - 1], &bytes);
-        golden_put_le(q.data[nodes] + ptr_at, level_of(&q, 2).size << 3, bytes);
+        parts_widen(&q, 8);
+        CHECK(set_any_target(&q, 1, 0, level_of(&q, 2).size));
         expect(&q, VOXDAG_ERR_CORRUPT, "pointer past the level", NULL);
         parts_free(&q);
         parts_read(&q, f, size);
-        ptr_at = first_pointer(&q, 2, starts2[0], &bytes);
-        golden_put_le(q.data[nodes] + ptr_at, (uint64_t)(q.size[bricks] / 8) << 3, bytes);
+        parts_widen(&q, 8);
+        CHECK(set_any_target(&q, 2, 0, (uint64_t)(q.size[bricks] / 8)));
         expect(&q, VOXDAG_ERR_CORRUPT, "brick index past the bricks", NULL);
         parts_free(&q);
     }
@@ -629,14 +733,14 @@ static void test_hostile_files(void) {
         level_view v;
         parts_read(&q, f, size);
         v = level_of(&q, 1);
-        CHECK(v.count_bytes >= 1);
+        CHECK(v.count_bits >= 1);
         q.data[nodes][v.offset + starts1[0] + 2] ^= 1;
         expect(&q, VOXDAG_ERR_CORRUPT, "count differs from the children's sum", NULL);
         parts_free(&q);
         /* the root's count and the header's voxel count both one higher */
         parts_read(&q, f, size);
         v = level_of(&q, 0);
-        golden_put_le(q.data[nodes] + 2, golden_le(q.data[nodes] + 2, v.count_bytes) + 1, v.count_bytes);
+        bits_put(q.data[nodes], 16, bits_get(q.data[nodes], 16, v.count_bits) + 1, v.count_bits);
         golden_put_le(q.header + 32, golden_le(q.header + 32, 8) + 1, 8);
         q.size[parts_find(&q, 4)] += 3; /* one more colour (zero), so that only the counts disagree */
         memset(q.data[parts_find(&q, 4)] + q.size[parts_find(&q, 4)] - 3, 0, 3);
@@ -645,7 +749,7 @@ static void test_hostile_files(void) {
         /* level 1 without counts above level 2 (L-3), which has none either:
            a derived count must sum stored ones */
         parts_read(&q, f, size);
-        q.data[parts_find(&q, 1)][24 + 20] = 0;
+        q.data[parts_find(&q, 1)][GOLDEN_LEVEL_ENTRY_SIZE + 20] = 0;
         expect(&q, VOXDAG_ERR_CORRUPT, "two levels in a row without counts", NULL);
         parts_free(&q);
         /* only the header's voxel count */
@@ -656,33 +760,37 @@ static void test_hostile_files(void) {
         parts_free(&q);
     }
     { /* cycle-like: a node whose pointer holds its own offset (a pointer only
-         reaches the next level, so this lands elsewhere, never on itself) */
+         reaches the next level, so this lands elsewhere, never on itself);
+         on the widened file, where every such target fits */
         int tried = 0;
         for (i = 0; i < n1 + n2; i++) {
             parts q;
-            size_t k;
+            size_t k, m1, m2;
+            uint64_t w1[512], w2[512], own;
             uint32_t l = i < n1 ? 1 : 2;
-            uint64_t own = i < n1 ? starts1[i] : starts2[i - n1];
             int lands = 0;
+            parts_read(&q, f, size);
+            parts_widen(&q, 8);
+            m1 = record_starts(&q, 1, w1, 512);
+            m2 = record_starts(&q, 2, w2, 512);
+            CHECK(m1 == n1 && m2 == n2);
+            own = i < n1 ? w1[i] : w2[i - n1];
             if (l == 1)
-                for (k = 0; k < n2; k++) lands |= starts2[k] == own;
+                for (k = 0; k < m2; k++) lands |= w2[k] == own;
             else
                 lands = own < p.size[bricks] / 8;
-            if (lands) continue; /* would be a real node of the next level */
-            parts_read(&q, f, size);
-            ptr_at = first_pointer(&q, l, own, &bytes);
-            golden_put_le(q.data[nodes] + ptr_at, own << 3, bytes);
-            expect(&q, VOXDAG_ERR_CORRUPT, "self pointer", NULL);
+            if (!lands && set_target(&q, l, own, 0, own)) { /* landing: a real node of the next level */
+                expect(&q, VOXDAG_ERR_CORRUPT, "self pointer", NULL);
+                tried++;
+            }
             parts_free(&q);
-            tried++;
         }
         CHECK(tried > 0);
         /* the root pointing at its own offset 0: the first node of level 1 */
         {
             parts q;
             parts_read(&q, f, size);
-            ptr_at = first_pointer(&q, 0, 0, &bytes);
-            golden_put_le(q.data[nodes] + ptr_at, golden_le(q.data[nodes] + ptr_at, bytes) & 7, bytes);
+            CHECK(set_target(&q, 0, 0, 0, 0));
             w = parts_write(&q, &i);
             {
                 voxdag_error err;
@@ -766,7 +874,7 @@ static void test_hostile_files(void) {
         uint8_t *e;
         parts_read(&q, f, size);
         w = parts_write(&q, &i);
-        e = w + 64 + 32 * (size_t)bricks;
+        e = w + GOLDEN_HEADER_SIZE + 32 * (size_t)bricks;
         golden_put_le(e + 8, golden_le(e + 8, 8) - 8, 8);
         golden_put_le(e + 16, golden_le(e + 16, 8) + 8, 8);
         golden_reseal(w, i);
@@ -777,7 +885,7 @@ static void test_hostile_files(void) {
         /* and the nodes section reaching into the bricks */
         free(w);
         w = parts_write(&q, &i);
-        e = w + 64 + 32 * (size_t)nodes;
+        e = w + GOLDEN_HEADER_SIZE + 32 * (size_t)nodes;
         golden_put_le(e + 16, golden_le(e + 16, 8) + 16, 8);
         golden_reseal(w, i);
         {
@@ -793,6 +901,141 @@ done:
     free(f);
 }
 
+/* Fields new in version 3, each broken in turn on the mirrored blob (built
+   with all 48 symmetries); and a version-2 file refused by its version. */
+static void test_version3_fields(void) {
+    size_t size = 0, old_size = 0, n1;
+    uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size), *old = NULL;
+    uint64_t starts1[512];
+    parts p;
+    int levels;
+    if (!f || !parts_read(&p, f, size)) {
+        CHECK_MSG(0, "mirrored blob golden missing or unreadable");
+        free(f);
+        return;
+    }
+    levels = parts_find(&p, 1);
+    n1 = record_starts(&p, 1, starts1, 512);
+    CHECK(levels >= 0 && n1 >= 1 && p.header[VOXDAG_FILE_OFF_SYMMETRY] == VOXDAG_SYMMETRY_FULL);
+    { /* the symmetry group: unknown, or too small for the transforms used */
+        parts q;
+        parts_read(&q, f, size);
+        q.header[VOXDAG_FILE_OFF_SYMMETRY] = 4;
+        expect(&q, VOXDAG_ERR_CORRUPT, "unknown symmetry group", NULL);
+        q.header[VOXDAG_FILE_OFF_SYMMETRY] = 0;
+        expect(&q, VOXDAG_ERR_CORRUPT, "symmetry group 0", NULL);
+        q.header[VOXDAG_FILE_OFF_SYMMETRY] = VOXDAG_SYMMETRY_NONE;
+        expect(&q, VOXDAG_ERR_CORRUPT, "transforms outside the group none", NULL);
+        q.header[VOXDAG_FILE_OFF_SYMMETRY] = VOXDAG_SYMMETRY_FULL;
+        q.header[VOXDAG_FILE_OFF_ROOT_TRANSFORM] = 48;
+        expect(&q, VOXDAG_ERR_CORRUPT, "root transform 48", NULL);
+        parts_free(&q);
+    }
+    { /* the voxel box: outside the grid, empty, inverted */
+        parts q;
+        parts_read(&q, f, size);
+        golden_put_le(q.header + VOXDAG_FILE_OFF_VOXEL_BOX + 12, 33, 4);
+        expect(&q, VOXDAG_ERR_CORRUPT, "voxel box past the grid", NULL);
+        golden_put_le(q.header + VOXDAG_FILE_OFF_VOXEL_BOX + 12, golden_le(q.header + VOXDAG_FILE_OFF_VOXEL_BOX, 4), 4);
+        expect(&q, VOXDAG_ERR_CORRUPT, "empty voxel box", NULL);
+        parts_free(&q);
+    }
+    { /* level entries: table length, table entries, classes, reserved bytes */
+        parts q;
+        uint8_t *e;
+        parts_read(&q, f, size);
+        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
+        CHECK(e[21] >= 1);
+        e[21] = 0;
+        expect(&q, VOXDAG_ERR_CORRUPT, "transform table length 0", NULL);
+        e[21] = 49;
+        expect(&q, VOXDAG_ERR_CORRUPT, "transform table length 49", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
+        e[32] = 48;
+        expect(&q, VOXDAG_ERR_CORRUPT, "table entry 48", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
+        e[32 + e[21]] = 1;
+        expect(&q, VOXDAG_ERR_CORRUPT, "table entry past the length", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
+        e[25] = 7;
+        expect(&q, VOXDAG_ERR_CORRUPT, "7 code bits", NULL);
+        e[25] = 6, e[22] = 52;
+        expect(&q, VOXDAG_ERR_CORRUPT, "58-bit pointer class", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        q.data[levels][29] = 1;
+        expect(&q, VOXDAG_ERR_CORRUPT, "reserved level bytes", NULL);
+        q.data[levels][29] = 0;
+        q.data[levels][20] = 65;
+        expect(&q, VOXDAG_ERR_CORRUPT, "count width 65", NULL);
+        parts_free(&q);
+    }
+    { /* a pointer code at or past the table length; a padding bit */
+        parts q;
+        level_view v;
+        unsigned width, code_bits, t, found = 0;
+        uint64_t at, k;
+        parts_read(&q, f, size);
+        v = level_of(&q, 1);
+        for (k = 0; k < n1 && !found; k++) { /* a pointer with code bits */
+            uint8_t *rec = q.data[parts_find(&q, 2)] + v.offset + starts1[k];
+            unsigned header = (unsigned)golden_le(rec, 2), s;
+            at = 8 * (v.offset + starts1[k]) + 16 + v.count_bits;
+            for (s = 0; s < 8 && !found; s++) {
+                t = header >> (2 * s) & 3;
+                if (t && v.code_bits[t]) {
+                    width = v.width[t], code_bits = v.code_bits[t], found = 1;
+                    bits_put(q.data[parts_find(&q, 2)], at, (bits_get(q.data[parts_find(&q, 2)], at, width) | ((1ull << code_bits) - 1)), width);
+                    q.data[levels][GOLDEN_LEVEL_ENTRY_SIZE + 21] = (uint8_t)((1u << code_bits) - 1);
+                    memset(q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE + 32 + ((1u << code_bits) - 1), 0, 48 - ((1u << code_bits) - 1));
+                }
+                at += v.width[t];
+            }
+        }
+        if (found) expect(&q, VOXDAG_ERR_CORRUPT, "code past the table", NULL);
+        parts_free(&q);
+        parts_read(&q, f, size);
+        for (k = 0; k < n1; k++) { /* a record with padding bits */
+            uint8_t *rec = q.data[parts_find(&q, 2)] + v.offset + starts1[k];
+            unsigned header = (unsigned)golden_le(rec, 2), s, bits = 16 + v.count_bits;
+            for (s = 0; s < 8; s++) bits += v.width[header >> (2 * s) & 3];
+            if (bits % 8) {
+                rec[bits / 8] |= (uint8_t)(0x80u);
+                expect(&q, VOXDAG_ERR_CORRUPT, "padding bit", NULL);
+                break;
+            }
+        }
+        parts_free(&q);
+    }
+    { /* a version-2 file: refused by its version, the message naming it */
+        FILE *fp = fopen("tests/data/version2/mirrored_blob_l5.vdag", "rb");
+        voxdag_error err;
+        voxdag *d = NULL;
+        CHECK(fp != NULL);
+        if (fp) {
+            old = (uint8_t *)malloc(1 << 16);
+            old_size = fread(old, 1, 1 << 16, fp);
+            fclose(fp);
+            CHECK(old_size > 64 && golden_le(old + VOXDAG_FILE_OFF_VERSION, 4) == 2);
+            CHECK(voxdag_load_memory(old, old_size, NULL, &d, &err) == VOXDAG_ERR_VERSION);
+            CHECK(err.message && strstr(err.message, "version 1 or 2") && err.byte_offset == VOXDAG_FILE_OFF_VERSION);
+            voxdag_free(d);
+            golden_put_le(old + VOXDAG_FILE_OFF_VERSION, 4, 4);
+            CHECK(voxdag_load_memory(old, old_size, NULL, &d, &err) == VOXDAG_ERR_VERSION);
+            CHECK(err.message && strstr(err.message, "newer"));
+            free(old);
+        }
+    }
+    parts_free(&p);
+    free(f);
+}
+
 const test_case test_format_cases[] = {
     {"format/golden_identical", test_golden_identical},
     {"format/offsets_documented", test_offsets_documented},
@@ -802,5 +1045,6 @@ const test_case test_format_cases[] = {
     {"format/build_allocation_failures", test_build_allocation_failures},
     {"format/limits", test_limits},
     {"format/hostile_files", test_hostile_files},
+    {"format/version3_fields", test_version3_fields},
     {NULL, NULL},
 };

@@ -49,7 +49,8 @@ static int rscene_voxel(int kind, uint32_t n, uint32_t x, uint32_t y, uint32_t z
     }
 }
 
-/* Builds a scene into a dense pyramid and a DAG (symmetric or not). */
+/* Builds a scene into a dense pyramid and a DAG under symmetry group G
+   (0 none, 1 reflections, 2 all 48). */
 static voxdag *rscene_make(rscene *s, int kind, uint32_t levels, int symmetric, uint64_t seed) {
     uint32_t n = 1u << levels, x, y, z, q, one[3];
     uint64_t r = seed, count = 0, m, cells = (uint64_t)n * n * n;
@@ -84,7 +85,7 @@ static voxdag *rscene_make(rscene *s, int kind, uint32_t levels, int symmetric, 
     }
     memset(&o, 0, sizeof o);
     o.levels = levels;
-    o.no_symmetry = !symmetric;
+    o.symmetry = (voxdag_symmetry)(VOXDAG_SYMMETRY_NONE + symmetric);
     o.colors = 1;
     CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
     CHECK(voxdag_builder_add(b, xyz, rgb, count, NULL) == VOXDAG_OK);
@@ -383,7 +384,7 @@ static void test_raytrace_oracle(void) {
     memset(&st, 0, sizeof st);
     for (levels = 2; levels <= 7; levels++)
         for (kind = 0; kind < RS_COUNT; kind++)
-            for (sym = 0; sym < 2; sym++) check_scene(kind, levels, sym, levels < 7 ? 1000 : 2000, &st);
+            for (sym = 0; sym < 3; sym++) check_scene(kind, levels, sym, levels < 7 ? 1000 : 2000, &st);
     fprintf(stderr, "  %llu rays, %llu hits (%llu through edges or corners, %llu starting inside), %llu LOD hits "
             "(%llu on 2^3 cells of bricks, %llu on bricks, %llu coarser)\n",
             (unsigned long long)st.rays, (unsigned long long)st.hits, (unsigned long long)st.edges,
