@@ -145,10 +145,10 @@ static void run_ours(result *r, const uint8_t *rgb, size_t n, const voxcolor_enc
     uint8_t *buf = (uint8_t *)malloc(cap);
     voxcolor_view v;
     double t = cpu_seconds();
-    size = voxcolor_encode(buf, cap, rgb, n, o);
+    size = voxcolor_encode(buf, cap, rgb, n, o, NULL);
     r->encode_rate = (double)n / (cpu_seconds() - t);
     r->bits = 8 * (uint64_t)size;
-    if (voxcolor_view_init(&v, buf, size) != VOXCOLOR_OK) {
+    if (voxcolor_view_init(&v, buf, size, NULL) != VOXCOLOR_OK) {
         fprintf(stderr, "bench_color: own stream rejected\n");
         exit(1);
     }

@@ -62,7 +62,7 @@ int vdag_open(const char *path, vdag_file *f) {
     case VOXDAG_COLORS_RGB8: f->has_colors = 1; break;
     case VOXDAG_COLORS_VOXCOLOR: {
         voxdag_info info;
-        voxcolor_status st = voxcolor_view_init(&f->colors, payload, size);
+        voxcolor_status st = voxcolor_view_init(&f->colors, payload, size, NULL);
         voxdag_get_info(f->dag, &info);
         if (st != VOXCOLOR_OK || f->colors.count != info.voxels) {
             vdag_close(f);
@@ -316,13 +316,13 @@ static int encode_spill(FILE *f, uint64_t n, const build_args *a, grow_buf *g) {
     memset(&o, 0, sizeof o);
     o.max_error = a->color_error;
     o.weight_bits = a->color_bits;
-    if (ok) voxcolor_encoder_init(enc, n, &o, write_grow, g);
+    if (ok) voxcolor_encoder_init(enc, n, &o, write_grow, g, NULL);
     while (ok && done < n) {
         size_t k = n - done < SLICE ? (size_t)(n - done) : SLICE;
-        ok = fread(rgb, 3, k, f) == k && voxcolor_encoder_push(enc, rgb, k);
+        ok = fread(rgb, 3, k, f) == k && voxcolor_encoder_push(enc, rgb, k) == VOXCOLOR_OK;
         done += k;
     }
-    ok = ok && voxcolor_encoder_finish(enc) == g->size;
+    ok = ok && voxcolor_encoder_finish(enc, NULL) == g->size;
     free(enc);
     free(rgb);
     return ok;
