@@ -187,8 +187,17 @@ bench-quick: bench-data $(BENCH_PROGRAMS)
 # BENCH_COLOR_FLAGS=--quick skips the slowest baseline setting. External image
 # codecs (JPEG, PNG, pngquant, ASTC, BC1, BC7) run through bench/color_peers.sh.
 .PHONY: bench-color
-$(BUILD)/bench/bench_color: bench/bench_color.c bench/color_baselines.c bench/color_baselines.h voxcolor.h
+# The previous encoder (before the parallel one), from the history, for the
+# size column of the threads-and-effort table (bench/color_previous.c).
+VOXCOLOR_PREV := 301313399728d545c08461c409f6bab15fa4aa2c
+$(BUILD)/bench/voxcolor_prev.h:
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(WARN) -O2 $(THREADS) -o $@ bench/bench_color.c bench/color_baselines.c -lm
+	@git show $(VOXCOLOR_PREV):voxcolor.h >$@ 2>/dev/null || : >$@
+COLOR_PREV_FLAGS = $(if $(shell test -s $(BUILD)/bench/voxcolor_prev.h && echo 1),-I$(BUILD)/bench,-DBENCH_NO_PREVIOUS)
+$(BUILD)/bench/bench_color: bench/bench_color.c bench/color_baselines.c bench/color_baselines.h \
+                            bench/color_previous.c bench/color_previous.h voxcolor.h $(BUILD)/bench/voxcolor_prev.h
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 $(THREADS) -c -o $(BUILD)/bench/color_previous.o $(COLOR_PREV_FLAGS) bench/color_previous.c
+	$(CC) $(CSTD) $(WARN) -O2 $(THREADS) -o $@ bench/bench_color.c bench/color_baselines.c $(BUILD)/bench/color_previous.o -lm
 bench-color: $(BUILD)/bench/bench_color
 	$(BUILD)/bench/bench_color $(BENCH_COLOR_FLAGS) --peers bench/color_peers.sh $$(sh bench/color_fetch.sh bench/data/color)
