@@ -159,6 +159,16 @@ if [ -n "$M32" ]; then
     done
 fi
 
+# voxcolor.h's Win32 thread pool: compiled by MinGW-w64 when it is installed.
+if have x86_64-w64-mingw32-gcc; then
+    for c in "" -DVOXCOLOR_NO_THREADS; do
+        job "mingw x86_64-w64-mingw32-gcc -O2 ${c:-default} voxcolor.h" ok \
+            "x86_64-w64-mingw32-gcc $C99 $CONV -O2 $c -c -o /dev/null -I. -DVOXCOLOR_IMPLEMENTATION $L/header_voxcolor.c"
+    done
+else
+    note "MinGW-w64 voxcolor.h compile skipped: x86_64-w64-mingw32-gcc not installed (gcc-mingw-w64-x86-64)"
+fi
+
 # -- Configuration errors
 cc1=$(echo $CCS | cut -d' ' -f1)
 job "error VOXDAG_MALLOC alone" "define both VOXDAG_MALLOC and VOXDAG_FREE" \
