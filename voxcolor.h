@@ -165,9 +165,10 @@ typedef enum voxcolor_effort {
     VOXCOLOR_EFFORT_SMALLEST = 0, /* the smallest stream this encoder can make */
     VOXCOLOR_EFFORT_FAST = 1,     /* one endpoint precision per stream (RGB565 or
                                      RGB888 by the bound) where the default tries
-                                     both: faster at bounds near 0.02 .. 0.04,
-                                     slightly larger there; the same stream
-                                     elsewhere (BENCHMARKS.md) */
+                                     both, i.e. for RGB bounds of about 0.012 ..
+                                     0.039: at e_t 0.025, 1.2-1.4x faster and
+                                     3-9 % larger on the bench sets; the same
+                                     stream at other bounds (BENCHMARKS.md) */
     VOXCOLOR_EFFORT_COUNT,
     VOXCOLOR_EFFORT_FORCE_32BIT = 0x7fffffff
 } voxcolor_effort;
