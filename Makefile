@@ -59,6 +59,11 @@ $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
 $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
 	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
 
+# voxcolor's option and argument checks in a release build (-DNDEBUG),
+# sanitized: they must not be asserts.
+$(BUILD)/test_voxcolor_ndebug: tests/test_voxcolor_ndebug.c voxcolor.h | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
+
 # Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):
 #   import     the scene importers (the first byte picks the format)
 #   voxcolor   colour streams decoded, and colours encoded and decoded
@@ -110,7 +115,7 @@ deps:
 check-all:
 	@sh tests/check_all.sh $(BUILD)
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
 
@@ -189,8 +194,17 @@ bench-quick: bench-data $(BENCH_PROGRAMS)
 # BENCH_COLOR_FLAGS=--quick skips the slowest baseline setting. External image
 # codecs (JPEG, PNG, pngquant, ASTC, BC1, BC7) run through bench/color_peers.sh.
 .PHONY: bench-color
-$(BUILD)/bench/bench_color: bench/bench_color.c bench/color_baselines.c bench/color_baselines.h voxcolor.h
+# The previous encoder (before the parallel one), from the history, for the
+# size column of the threads-and-effort table (bench/color_previous.c).
+VOXCOLOR_PREV := 301313399728d545c08461c409f6bab15fa4aa2c
+$(BUILD)/bench/voxcolor_prev.h:
 	@mkdir -p $(@D)
-	$(CC) $(CSTD) $(WARN) -O2 -o $@ bench/bench_color.c bench/color_baselines.c -lm
+	@git show $(VOXCOLOR_PREV):voxcolor.h >$@ 2>/dev/null || : >$@
+COLOR_PREV_FLAGS = $(if $(shell test -s $(BUILD)/bench/voxcolor_prev.h && echo 1),-I$(BUILD)/bench,-DBENCH_NO_PREVIOUS)
+$(BUILD)/bench/bench_color: bench/bench_color.c bench/color_baselines.c bench/color_baselines.h \
+                            bench/color_previous.c bench/color_previous.h voxcolor.h $(BUILD)/bench/voxcolor_prev.h
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) -O2 $(THREADS) -c -o $(BUILD)/bench/color_previous.o $(COLOR_PREV_FLAGS) bench/color_previous.c
+	$(CC) $(CSTD) $(WARN) -O2 $(THREADS) -o $@ bench/bench_color.c bench/color_baselines.c $(BUILD)/bench/color_previous.o -lm
 bench-color: $(BUILD)/bench/bench_color
 	$(BUILD)/bench/bench_color $(BENCH_COLOR_FLAGS) --peers bench/color_peers.sh $$(sh bench/color_fetch.sh bench/data/color)

@@ -24,14 +24,18 @@
        #define VOXCOLOR_IMPLEMENTATION   // in exactly one C or C++ file
        #include "voxcolor.h"
 
-       voxcolor_encode_opts opts = {0};
+       voxcolor_encode_opts opts;
+       memset(&opts, 0, sizeof opts);    // zero means default, for every field
        opts.max_error = 0.02;            // |decoded - original| / 255 <= 0.02
+       opts.threads = 4;                 // optional: the same bytes, faster
+       voxcolor_error err;
        size_t cap = voxcolor_encode_bound(count);
        uint8_t *buf = malloc(cap);
-       size_t size = voxcolor_encode(buf, cap, rgb, count, &opts);
+       size_t size = voxcolor_encode(buf, cap, rgb, count, &opts, &err);
+       if (!size) printf("%s\n", err.message);
 
        voxcolor_view view;               // validates untrusted bytes once
-       if (voxcolor_view_init(&view, buf, size) == VOXCOLOR_OK) {
+       if (voxcolor_view_init(&view, buf, size, &err) == VOXCOLOR_OK) {
            uint8_t c[3];
            voxcolor_view_get(&view, 12345, c);
        }
@@ -45,16 +49,30 @@
    The paper's settings are 0.025 .. 0.1.
 
    CONFIGURATION (define before including the implementation)
-     VOXCOLOR_ASSERT(x)   caller-contract checks (default: assert)
+     VOXCOLOR_ASSERT(x)   internal invariants and lookup preconditions
+                          (default: assert). Options, arguments and stream
+                          bytes are checked in every build and get a status.
      VOXCOLOR_STATIC      give every function internal linkage
+     VOXCOLOR_NO_THREADS  no built-in thread pool (no <pthread.h> or
+                          <windows.h>): pages are encoded on the calling
+                          thread unless the options bring a thread pool.
+                          Public types are the same in every configuration.
    The codec never allocates: the caller owns every buffer. voxcolor_encode
-   uses about 25 KiB of stack; decoding a few hundred bytes. Arrays too large
-   to hold in memory stream through voxcolor_encoder (colours in, stream
-   out, chunk by chunk).
+   uses about 35 KiB of stack, and about 16 KiB on each worker thread;
+   decoding a few hundred bytes. Arrays too large to hold in memory stream
+   through voxcolor_encoder (colours in, stream out, chunk by chunk).
+
+   ERRORS: calls that can fail return a voxcolor_status (voxcolor_encode: 0
+   bytes) and fill an optional voxcolor_error with a static message and, for
+   streams, the byte offset of the field at fault. No global error state.
 
    THREADS: no global state. A view is immutable after voxcolor_view_init: any
    number of threads may query one view at the same time. Encoding reads its
-   input and writes only the caller's buffer.
+   input and writes only the caller's buffer; any number of encodes may run
+   at once. Pages are independent, so with opts.threads > 1 an encode
+   spreads them over threads (pthreads, or Win32 threads on Windows, created
+   per call and reused for all its pages) or over the host's thread pool
+   (opts.thread_pool: run N jobs, wait), with the same bytes as one thread.
 
    STREAM FORMAT: FORMAT.md, section "Colour section (voxcolor)", documents
    every byte; the VOXCOLOR_OFF_* macros mirror it.
@@ -105,14 +123,27 @@ extern "C" {
 
 typedef enum voxcolor_status {
     VOXCOLOR_OK = 0,
-    VOXCOLOR_ERR_TRUNCATED, /* the stream ends before a part it declares */
-    VOXCOLOR_ERR_BAD_MAGIC, /* not a voxcolor stream */
-    VOXCOLOR_ERR_VERSION,   /* a format version this reader does not know */
-    VOXCOLOR_ERR_CORRUPT,   /* a field is out of range or inconsistent */
-    VOXCOLOR_ERR_TRAILING,  /* bytes follow the end of the stream */
+    VOXCOLOR_ERR_TRUNCATED,        /* the stream ends before a part it declares */
+    VOXCOLOR_ERR_BAD_MAGIC,        /* not a voxcolor stream */
+    VOXCOLOR_ERR_VERSION,          /* a format version this reader does not know */
+    VOXCOLOR_ERR_CORRUPT,          /* a field is out of range or inconsistent */
+    VOXCOLOR_ERR_TRAILING,         /* bytes follow the end of the stream */
+    VOXCOLOR_ERR_INVALID_ARGUMENT, /* a caller argument or option is out of its range */
+    VOXCOLOR_ERR_BUFFER_TOO_SMALL, /* the output buffer cannot hold the stream */
+    VOXCOLOR_ERR_WRITE,            /* the write callback failed */
+    VOXCOLOR_ERR_INCOMPLETE,       /* fewer colours were pushed than declared */
     VOXCOLOR_STATUS_COUNT,
     VOXCOLOR_STATUS_FORCE_32BIT = 0x7fffffff
 } voxcolor_status;
+
+/* What went wrong, for the calls that take a voxcolor_error* (may be NULL).
+   Filled on failure and on success (status VOXCOLOR_OK). */
+typedef struct voxcolor_error {
+    voxcolor_status status;
+    const char *message;  /* static storage, never freed: what exactly failed */
+    uint64_t byte_offset; /* offset in the stream of the field at fault (decoding),
+                             UINT64_MAX when not stream-related */
+} voxcolor_error;
 
 /* Returns a static, human-readable name of a status. Thread-safe. */
 VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status);
@@ -129,16 +160,62 @@ typedef enum voxcolor_metric {
     VOXCOLOR_METRIC_FORCE_32BIT = 0x7fffffff
 } voxcolor_metric;
 
+/* How hard the encoder searches. Every level keeps the error bound. */
+typedef enum voxcolor_effort {
+    VOXCOLOR_EFFORT_SMALLEST = 0, /* the smallest stream this encoder can make */
+    VOXCOLOR_EFFORT_FAST = 1,     /* one endpoint precision per stream (RGB565 or
+                                     RGB888 by the bound) where the default tries
+                                     both, i.e. for RGB bounds of about 0.012 ..
+                                     0.039: at e_t 0.025, 1.2-1.4x faster and
+                                     3-9 % larger on the bench sets; the same
+                                     stream at other bounds (BENCHMARKS.md) */
+    VOXCOLOR_EFFORT_COUNT,
+    VOXCOLOR_EFFORT_FORCE_32BIT = 0x7fffffff
+} voxcolor_effort;
+
+/* Most threads an encoder uses (the calling one included). */
+#define VOXCOLOR_MAX_THREADS 64
+
+/* A job of a parallel encode: run it once for each INDEX the pool is given. */
+typedef void (*voxcolor_job_fn)(void *job_user, uint32_t index);
+
+/* The host's thread pool (optional). RUN must call JOB(JOB_USER, i) once for
+   every i in [0, COUNT), on any threads (the calling one too), in any order
+   or all at once, and return when all have returned. The encoder calls RUN
+   from the thread that called it, once per batch of pages (a few hundred
+   KiB of output), never from inside a job. */
+typedef struct voxcolor_thread_pool {
+    void (*run)(void *user, voxcolor_job_fn job, void *job_user, uint32_t count);
+    void *user;
+} voxcolor_thread_pool;
+
 /* Encoder options. A NULL pointer or an all-zero struct means: lossless,
-   RGB metric, weight width chosen per block, pages of 256 colours. */
+   RGB metric, weight width chosen per block, pages of 256 colours, smallest
+   stream, the calling thread only. Every field is checked, in every build:
+   out-of-range values make the call fail with VOXCOLOR_ERR_INVALID_ARGUMENT.
+   Initialise with memset or = {0}: nonzero zero_begin / zero_end (a struct
+   left uninitialised) is rejected too. */
 typedef struct voxcolor_encode_opts {
-    double max_error;        /* error bound e_t in units of the metric; >= 0 */
+    uint32_t zero_begin;     /* must be 0 */
+    double max_error;        /* error bound e_t in units of the metric; >= 0
+                                (not NaN); +infinity accepts any colour */
     voxcolor_metric metric;
     uint32_t weight_bits;    /* 0: 0..4 bits per block (best fit); 1..4: blocks
                                 with weights all use this width (as in the
                                 paper's fixed-width format) */
     uint32_t page_shift;     /* 0: 8; else 4..10. Larger: smaller stream,
                                 slower random lookup */
+    voxcolor_effort effort;  /* 0: VOXCOLOR_EFFORT_SMALLEST */
+    uint32_t threads;        /* 0 or 1: the calling thread alone; T > 1: pages
+                                encoded on T threads (at most
+                                VOXCOLOR_MAX_THREADS) of the built-in pool, or
+                                on THREAD_POOL. The stream is the same bytes
+                                whatever the count. */
+    voxcolor_thread_pool thread_pool; /* run NULL: the built-in pool (pthreads,
+                                Win32 threads on Windows; none under
+                                VOXCOLOR_NO_THREADS, where T > 1 without a
+                                pool runs on the calling thread) */
+    uint32_t zero_end;       /* must be 0 */
 } voxcolor_encode_opts;
 
 /* Returns the largest stream voxcolor_encode can produce for COUNT colours,
@@ -147,14 +224,20 @@ typedef struct voxcolor_encode_opts {
 VOXCOLOR_API size_t voxcolor_encode_bound(size_t count);
 
 /* Encodes COUNT colours (RGB8, 3 bytes each) into DST. OPTS may be NULL.
-   Returns the stream size in bytes, or 0 when DST_SIZE is too small (a buffer
-   of voxcolor_encode_bound(count) bytes is always large enough). The caller
-   owns both buffers; no memory is allocated. Deterministic: the same input and
-   options give the same bytes, whatever the compiler, processor or
-   floating-point model (with the CIELAB metric: the same floating-point
-   model). Invalid options trip VOXCOLOR_ASSERT. */
+   Returns the stream size in bytes (at least 32), or 0 on failure, with ERR
+   (may be NULL) saying why: VOXCOLOR_ERR_BUFFER_TOO_SMALL when DST_SIZE is
+   too small (a buffer of voxcolor_encode_bound(count) bytes is always large
+   enough), VOXCOLOR_ERR_INVALID_ARGUMENT for invalid options or a NULL DST
+   or RGB8 with a nonzero size. The caller owns both buffers; no memory is
+   allocated. With threads, DST's unused end is the pages' scratch space:
+   give it voxcolor_encode_bound bytes for the full parallel speed (a smaller
+   buffer works, in smaller batches). Deterministic: the same input and
+   options (whatever the thread count and effort) give the same bytes,
+   whatever the compiler, processor or floating-point model (with the CIELAB
+   metric: the same floating-point model). Thread-safe: calls share nothing. */
 VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
-                                    size_t count, const voxcolor_encode_opts *opts);
+                                    size_t count, const voxcolor_encode_opts *opts,
+                                    voxcolor_error *err);
 
 // -- Streaming encoding
 
@@ -174,17 +257,43 @@ typedef struct voxcolori_enc {
     unsigned precisions[2], precision_count;
 } voxcolori_enc;
 
+/* The state of an encoder but its batch buffer (private). */
+typedef struct voxcolori_stream {
+    voxcolori_enc enc;
+    voxcolor_write_fn write;
+    void *user;
+    voxcolor_thread_pool pool; /* the caller's, or run NULL */
+    uint32_t threads;          /* 1: serial */
+    uint64_t count, pushed;    /* colours declared, colours received */
+    uint64_t data_offset;      /* stream offset of the block data */
+    uint64_t data_size;        /* block data bytes made (written or in out) */
+    uint64_t pages;            /* pages made */
+    uint32_t entry, held, out_used, table_used;
+    voxcolor_status status;    /* the first failure, sticky */
+    const char *message;
+    uint8_t *inplace;          /* voxcolor_encode: the destination buffer */
+    size_t inplace_size;
+    uint8_t rgb[3u << VOXCOLOR_MAX_PAGE_SHIFT]; /* the colours of the open page */
+    uint8_t out[8192];                           /* block data not yet written */
+    uint8_t table[2048];                         /* page table entries not yet written */
+} voxcolori_stream;
+
+/* Bytes of the streaming encoder's batch buffer: the output of the pages
+   encoded in parallel, before it goes to the write callback. */
+#define VOXCOLOR_ENCODER_BATCH_BYTES (256u << 10)
+
 /* A streaming encoder: takes the colours in index order, in chunks of any
    size, and hands the stream to a write callback as it goes, holding at most
-   one page of colours and a few KiB of output (about 16 KiB in all, no
-   allocation). Its fields are private. The stream is byte for byte the one
+   one page of colours and a few hundred KiB of output (about 280 KiB in all,
+   no allocation). Its fields are private. The stream is byte for byte the one
    voxcolor_encode makes from the same colours and options.
 
-       voxcolor_encoder enc;             // e.g. static or on the heap
-       voxcolor_encoder_init(&enc, count, &opts, write, file);
+       voxcolor_encoder *enc = malloc(sizeof *enc);   // or static
+       if (voxcolor_encoder_init(enc, count, &opts, write, file, &err) != VOXCOLOR_OK)
+           ...;                                        // err.message says why
        while (more colours)
-           voxcolor_encoder_push(&enc, chunk, chunk_count);
-       uint64_t size = voxcolor_encoder_finish(&enc);   // 0: failed
+           voxcolor_encoder_push(enc, chunk, chunk_count);   // stops at the first failure
+       uint64_t size = voxcolor_encoder_finish(enc, &err);  // 0: failed, see err
 
    The colour count is given up front: it fixes where the block data starts.
    WRITE receives the block data in order (offsets growing from
@@ -192,41 +301,42 @@ typedef struct voxcolori_enc {
    (in order), and the 24-byte header at offset 0 last, in finish. The pieces
    never overlap and tile [0, size) exactly, so WRITE may pwrite to a file,
    fill a buffer it grows, or keep the small header and table apart and
-   append only the block data. */
+   append only the block data. WRITE is called from the thread that called
+   push or finish. With threads, the whole pages of each chunk pushed are
+   encoded in parallel (push chunks of many pages, e.g. 2^20 colours); the
+   built-in pool's threads live for one push call. */
 typedef struct voxcolor_encoder {
-    voxcolori_enc enc;
-    voxcolor_write_fn write;
-    void *user;
-    uint64_t count, pushed;    /* colours declared, colours received */
-    uint64_t data_offset;      /* stream offset of the block data */
-    uint64_t data_size;        /* block data bytes made (written or in out) */
-    uint64_t pages;            /* pages made */
-    uint32_t entry, held, out_used, table_used;
-    int failed;
-    uint8_t rgb[3u << VOXCOLOR_MAX_PAGE_SHIFT]; /* the colours of the open page */
-    uint8_t out[8192];                           /* block data not yet written */
-    uint8_t table[2048];                         /* page table entries not yet written */
+    voxcolori_stream s;
+    uint8_t batch[VOXCOLOR_ENCODER_BATCH_BYTES];
 } voxcolor_encoder;
 
 /* Sets up ENC to encode COUNT colours with OPTS (may be NULL; as for
    voxcolor_encode) and to hand the stream to WRITE with USER. Writes
-   nothing yet. Invalid options trip VOXCOLOR_ASSERT. */
-VOXCOLOR_API void voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
-                                        const voxcolor_encode_opts *opts, voxcolor_write_fn write,
-                                        void *user);
+   nothing yet. Returns VOXCOLOR_OK, or VOXCOLOR_ERR_INVALID_ARGUMENT (ENC or
+   WRITE NULL, invalid options; details in ERR, may be NULL), after which
+   every push and finish on ENC fails. */
+VOXCOLOR_API voxcolor_status voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
+                                                   const voxcolor_encode_opts *opts,
+                                                   voxcolor_write_fn write, void *user,
+                                                   voxcolor_error *err);
 
 /* Byte offset in the stream where the block data starts (24 plus the page
-   table): known from the colour count alone. */
+   table): known from the colour count alone. 0 when ENC is NULL. */
 VOXCOLOR_API uint64_t voxcolor_encoder_data_offset(const voxcolor_encoder *enc);
 
 /* Encodes the next N colours (RGB8) in index order; at most the count given
-   to init in all. Returns 1, or 0 when a write failed (then every later call
-   fails too). RGB8 may be reused as soon as this returns. */
-VOXCOLOR_API int voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8, size_t n);
+   to init in all. Returns VOXCOLOR_OK, or the encoder's first failure (then
+   every later call fails too): VOXCOLOR_ERR_WRITE when a write failed,
+   VOXCOLOR_ERR_INVALID_ARGUMENT when RGB8 is NULL with N > 0, N is more than
+   the colours left, or init failed. RGB8 may be reused as soon as this
+   returns. */
+VOXCOLOR_API voxcolor_status voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8,
+                                                   size_t n);
 
-/* Writes the rest of the stream. Returns its size in bytes, or 0 when a write
-   failed or fewer colours than declared were pushed. */
-VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc);
+/* Writes the rest of the stream. Returns its size in bytes, or 0 when the
+   encoder failed (ERR, may be NULL, says why: also
+   VOXCOLOR_ERR_INCOMPLETE when fewer colours than declared were pushed). */
+VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc, voxcolor_error *err);
 
 // -- Decoding
 
@@ -243,10 +353,13 @@ typedef struct voxcolor_view {
 
 /* Validates SIZE bytes at SRC completely (header, version, page table, every
    block header, padding, no trailing bytes) and sets up VIEW. Returns
-   VOXCOLOR_OK, or an error and leaves VIEW zeroed. Never reads outside
-   [SRC, SRC + SIZE); runs in time linear in SIZE. Thread-safe. */
+   VOXCOLOR_OK, or an error and leaves VIEW zeroed (when not NULL); ERR (may
+   be NULL) then gives a message and the byte offset in the stream of the
+   field at fault. VOXCOLOR_ERR_INVALID_ARGUMENT: VIEW is NULL, or SRC is
+   NULL with SIZE > 0. Never reads outside [SRC, SRC + SIZE); runs in time
+   linear in SIZE. Thread-safe. */
 VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src,
-                                                size_t size);
+                                                size_t size, voxcolor_error *err);
 
 /* Writes the colour at INDEX (< view->count) to RGB_OUT[0..2]. Reads two page
    table entries, counts the page's directory bytes below the colour's a
@@ -474,8 +587,23 @@ VOXCOLOR_API const char *voxcolor_status_string(voxcolor_status status) {
     case VOXCOLOR_ERR_VERSION: return "unsupported voxcolor format version";
     case VOXCOLOR_ERR_CORRUPT: return "corrupt voxcolor stream";
     case VOXCOLOR_ERR_TRAILING: return "bytes after the end of the voxcolor stream";
+    case VOXCOLOR_ERR_INVALID_ARGUMENT: return "invalid argument";
+    case VOXCOLOR_ERR_BUFFER_TOO_SMALL: return "output buffer too small";
+    case VOXCOLOR_ERR_WRITE: return "write failed";
+    case VOXCOLOR_ERR_INCOMPLETE: return "fewer colours pushed than declared";
     default: return "unknown status";
     }
+}
+
+/* Fills ERR (may be NULL) and returns ST. MESSAGE is static. */
+static voxcolor_status voxcolori_report(voxcolor_error *err, voxcolor_status st, const char *message,
+                                        uint64_t offset) {
+    if (err) {
+        err->status = st;
+        err->message = message;
+        err->byte_offset = offset;
+    }
+    return st;
 }
 
 VOXCOLOR_API uint32_t voxcolor_version(void) { return VOXCOLOR_VERSION; }
@@ -541,81 +669,106 @@ static VOXCOLORI_ALWAYS_INLINE unsigned voxcolori_nibble(const voxcolori_page *p
 
 /* Checks every page: its directory and blocks must tile it exactly, pages
    must follow each other without gaps where the page table says, and the
-   data must end with the 8 zero bytes. DATA_SIZE >= 8. */
-static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t data_size) {
+   data must end with the 8 zero bytes. DATA_SIZE >= 8. The data starts at
+   byte BASE of the stream (for the offsets in ERR). */
+static voxcolor_status voxcolori_check_pages(const voxcolor_view *v, uint64_t data_size, uint64_t base,
+                                             voxcolor_error *err) {
     uint64_t limit = data_size - 8, at = 0, page, pages;
     uint64_t page_size = 1ull << v->page_shift, k;
     unsigned wide = v->page_shift > 8;
     size_t i;
+    const voxcolor_status bad = VOXCOLOR_ERR_CORRUPT;
     pages = v->count ? ((v->count - 1) >> v->page_shift) + 1 : 0;
     for (page = 0; page < pages; page++) {
         uint64_t left = page + 1 < pages ? page_size : v->count - page * page_size;
         uint64_t start = 0, pos;
         voxcolori_page p;
-        if (voxcolori_page_offset(v, page) != at || limit - at < 1u + wide) return VOXCOLOR_ERR_CORRUPT;
+        if (voxcolori_page_offset(v, page) != at)
+            return voxcolori_report(err, bad, "page table entry is not where the previous page ends",
+                                    VOXCOLOR_HEADER_SIZE + page * (v->wide ? 8u : 4u));
+        if (limit - at < 1u + wide) return voxcolori_report(err, bad, "page past the block data", base + at);
         k = voxcolori_index(v->data + at, wide) + 1;
-        if (k > left || voxcolori_directory_bytes(k, wide) > limit - at) return VOXCOLOR_ERR_CORRUPT;
+        if (k > left) return voxcolori_report(err, bad, "more blocks than colours in a page", base + at);
+        if (voxcolori_directory_bytes(k, wide) > limit - at)
+            return voxcolori_report(err, bad, "page directory past the block data", base + at);
         voxcolori_page_open(v->data, at, wide, &p);
         /* The nibble after the last block's is zero. */
-        if (!(p.last & 1) && p.modes[p.last >> 1] >> 4) return VOXCOLOR_ERR_CORRUPT;
+        if (!(p.last & 1) && p.modes[p.last >> 1] >> 4)
+            return voxcolori_report(err, bad, "nonzero padding nibble after the last block's mode",
+                                    base + (uint64_t)(p.modes + (p.last >> 1) - v->data));
         for (k = 0, pos = p.payload; k <= p.last; k++) {
             unsigned h = voxcolori_nibble(&p, k);
             uint64_t end = voxcolori_end(&p, k) + 1;
             if (k && !(k & ((1u << VOXCOLORI_GROUP_SHIFT) - 1)) &&
                 voxcolori_load_le(p.checkpoints + 2 * ((k >> VOXCOLORI_GROUP_SHIFT) - 1), 2) != pos - p.payload)
-                return VOXCOLOR_ERR_CORRUPT;
+                return voxcolori_report(
+                    err, bad, "checkpoint differs from the payload offset of its group",
+                    base + (uint64_t)(p.checkpoints + 2 * ((k >> VOXCOLORI_GROUP_SHIFT) - 1) - v->data));
             /* Known modes; ends grow and stay inside the page. */
-            if ((h & 7) > VOXCOLORI_MODE_RAW || h == (VOXCOLORI_MODE_RAW | 8) || end <= start || end > left)
-                return VOXCOLOR_ERR_CORRUPT;
+            if ((h & 7) > VOXCOLORI_MODE_RAW || h == (VOXCOLORI_MODE_RAW | 8))
+                return voxcolori_report(err, bad, "unknown block mode",
+                                        base + (uint64_t)(p.modes + (k >> 1) - v->data));
+            if (end <= start || end > left)
+                return voxcolori_report(err, bad, "block ends out of order or past the page", base + at);
             /* A block has at most 1024 * 24 + 48 bits: no overflow before this. */
             pos += voxcolori_block_bits(h & 7, h >> 3, end - start);
-            if (pos > 8 * limit) return VOXCOLOR_ERR_CORRUPT;
+            if (pos > 8 * limit) return voxcolori_report(err, bad, "block payload past the block data", base + limit);
             start = end;
         }
-        if (start != left) return VOXCOLOR_ERR_CORRUPT;
+        if (start != left) return voxcolori_report(err, bad, "blocks do not cover their page", base + at);
         /* Pages start on a byte; the bits up to it must be zero. */
-        if ((pos & 7) && voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7))) return VOXCOLOR_ERR_CORRUPT;
+        if ((pos & 7) && voxcolori_bits(v->data, pos, 8 - (unsigned)(pos & 7)))
+            return voxcolori_report(err, bad, "nonzero padding bits after a page", base + pos / 8);
         at = (pos + 7) / 8;
     }
-    if (at != limit) return VOXCOLOR_ERR_CORRUPT;
+    if (at != limit) return voxcolori_report(err, bad, "block data size differs from the pages' size", base + at);
     for (i = 0; i < 8; i++)
-        if (v->data[at + i]) return VOXCOLOR_ERR_CORRUPT;
-    return VOXCOLOR_OK;
+        if (v->data[at + i]) return voxcolori_report(err, bad, "nonzero closing bytes", base + at + i);
+    return voxcolori_report(err, VOXCOLOR_OK, "ok", UINT64_MAX);
 }
 
-VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src,
-                                                size_t size) {
+VOXCOLOR_API voxcolor_status voxcolor_view_init(voxcolor_view *view, const void *src, size_t size,
+                                                voxcolor_error *err) {
     const uint8_t *p = (const uint8_t *)src;
     voxcolor_view v;
     uint64_t pages, entry, rest, data_size;
     unsigned flags;
     voxcolor_status st;
-    VOXCOLOR_ASSERT(view && (src || !size));
+    if (!view) return voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "view is NULL", UINT64_MAX);
     memset(view, 0, sizeof *view);
-    if (size < VOXCOLOR_HEADER_SIZE) return VOXCOLOR_ERR_TRUNCATED;
-    if (memcmp(p + VOXCOLOR_OFF_MAGIC, "VXC1", 4) != 0) return VOXCOLOR_ERR_BAD_MAGIC;
+    if (!src && size)
+        return voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "stream is NULL with a nonzero size", UINT64_MAX);
+    if (size < VOXCOLOR_HEADER_SIZE)
+        return voxcolori_report(err, VOXCOLOR_ERR_TRUNCATED, "stream shorter than its header", size);
+    if (memcmp(p + VOXCOLOR_OFF_MAGIC, "VXC1", 4) != 0)
+        return voxcolori_report(err, VOXCOLOR_ERR_BAD_MAGIC, "magic is not VXC1", VOXCOLOR_OFF_MAGIC);
     if (voxcolori_load_le(p + VOXCOLOR_OFF_VERSION, 2) != VOXCOLOR_FORMAT_VERSION)
-        return VOXCOLOR_ERR_VERSION;
+        return voxcolori_report(err, VOXCOLOR_ERR_VERSION, "unknown stream format version", VOXCOLOR_OFF_VERSION);
     v.page_shift = p[VOXCOLOR_OFF_PAGE_SHIFT];
     flags = p[VOXCOLOR_OFF_FLAGS];
-    if (v.page_shift < VOXCOLOR_MIN_PAGE_SHIFT || v.page_shift > VOXCOLOR_MAX_PAGE_SHIFT ||
-        flags > 1)
-        return VOXCOLOR_ERR_CORRUPT;
+    if (v.page_shift < VOXCOLOR_MIN_PAGE_SHIFT || v.page_shift > VOXCOLOR_MAX_PAGE_SHIFT)
+        return voxcolori_report(err, VOXCOLOR_ERR_CORRUPT, "page shift out of range", VOXCOLOR_OFF_PAGE_SHIFT);
+    if (flags > 1) return voxcolori_report(err, VOXCOLOR_ERR_CORRUPT, "unknown flags", VOXCOLOR_OFF_FLAGS);
     v.wide = flags;
     v.count = voxcolori_load_le(p + VOXCOLOR_OFF_COUNT, 8);
     data_size = voxcolori_load_le(p + VOXCOLOR_OFF_DATA_SIZE, 8);
     pages = v.count ? ((v.count - 1) >> v.page_shift) + 1 : 0;
     entry = v.wide ? 8 : 4;
     rest = (uint64_t)size - VOXCOLOR_HEADER_SIZE;
-    if (pages > rest / entry) return VOXCOLOR_ERR_TRUNCATED;
+    if (pages > rest / entry)
+        return voxcolori_report(err, VOXCOLOR_ERR_TRUNCATED, "stream ends inside the page table", size);
     rest -= pages * entry;
-    if (data_size > rest) return VOXCOLOR_ERR_TRUNCATED;
-    if (data_size < rest) return VOXCOLOR_ERR_TRAILING;
-    if (data_size < 8 || data_size > UINT64_MAX / 8) return VOXCOLOR_ERR_CORRUPT;
+    if (data_size > rest)
+        return voxcolori_report(err, VOXCOLOR_ERR_TRUNCATED, "stream ends inside the block data", size);
+    if (data_size < rest)
+        return voxcolori_report(err, VOXCOLOR_ERR_TRAILING, "bytes after the block data",
+                                VOXCOLOR_HEADER_SIZE + pages * entry + data_size);
+    if (data_size < 8 || data_size > UINT64_MAX / 8)
+        return voxcolori_report(err, VOXCOLOR_ERR_CORRUPT, "block data size out of range", VOXCOLOR_OFF_DATA_SIZE);
     v.table = p + VOXCOLOR_HEADER_SIZE;
     v.data = v.table + (size_t)(pages * entry);
     v.data_size = data_size;
-    st = voxcolori_check_pages(&v, data_size);
+    st = voxcolori_check_pages(&v, data_size, VOXCOLOR_HEADER_SIZE + pages * entry, err);
     if (st == VOXCOLOR_OK) *view = v;
     return st;
 }
@@ -837,6 +990,7 @@ static int voxcolori_within(uint32_t d, double e) {
     uint64_t bits, m, hi, lo, dh, dl;
     int shift;
     memcpy(&bits, &e, sizeof bits);
+    bits &= ~(1ull << 63); /* -0 is 0 */
     if ((bits >> 52) >= 0x7ff) return 1; /* infinity */
     m = bits & ((1ull << 52) - 1);
     /* e = m 2^shift, then (255 e)^2 = 65025 m^2 2^(2 shift). */
@@ -868,6 +1022,11 @@ static uint64_t voxcolori_isqrt_up(uint64_t x) {
         if ((r + bit) * (r + bit) <= x) r += bit;
     return r * r < x ? r + 1 : r;
 }
+
+/* Effort VOXCOLOR_EFFORT_FAST: RGB565 endpoints from this squared RGB
+   bound up (else RGB888), or from this delta E up (CIELAB). */
+#define VOXCOLORI_FAST_565_THR2 49u
+#define VOXCOLORI_FAST_565_LAB 1.0
 
 /* Sets up the metric and the modes to try from the options. */
 static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) {
@@ -904,6 +1063,12 @@ static void voxcolori_enc_init(voxcolori_enc *e, const voxcolor_encode_opts *o) 
        6 units); RGB888 endpoints rarely pay off at large ones. */
     if (e->lab || e->thr2 >= 9) e->precisions[e->precision_count++] = 0;
     if (e->lab || e->thr2 < 100) e->precisions[e->precision_count++] = 1;
+    /* Fast: the one that pays off more often at this bound. */
+    if (o->effort == VOXCOLOR_EFFORT_FAST && e->precision_count == 2) {
+        e->precision_count = 1;
+        e->precisions[0] = e->lab ? (o->max_error >= VOXCOLORI_FAST_565_LAB ? 0u : 1u)
+                                  : (e->thr2 >= VOXCOLORI_FAST_565_THR2 ? 0u : 1u);
+    }
 }
 
 // -- Encoding: fitting one block
@@ -1481,125 +1646,494 @@ VOXCOLOR_API size_t voxcolor_encode_bound(size_t count) {
     return VOXCOLOR_HEADER_SIZE + 8 + pages * 11 + 3 * count;
 }
 
+// -- Encoding: options
+
+/* Checks every field of O, in every build. */
+static voxcolor_status voxcolori_check_opts(const voxcolor_encode_opts *o, voxcolor_error *err) {
+    const voxcolor_status bad = VOXCOLOR_ERR_INVALID_ARGUMENT;
+    if (o->zero_begin || o->zero_end)
+        return voxcolori_report(err, bad, "options not zero-initialised (zero_begin or zero_end is set)", UINT64_MAX);
+    if (!(o->max_error >= 0)) return voxcolori_report(err, bad, "max_error is negative or NaN", UINT64_MAX);
+    if ((uint32_t)o->metric >= VOXCOLOR_METRIC_COUNT)
+        return voxcolori_report(err, bad, "metric is not a voxcolor_metric", UINT64_MAX);
+    if (o->weight_bits > VOXCOLORI_MAX_WEIGHT_BITS)
+        return voxcolori_report(err, bad, "weight_bits is not 0..4", UINT64_MAX);
+    if (o->page_shift && (o->page_shift < VOXCOLOR_MIN_PAGE_SHIFT || o->page_shift > VOXCOLOR_MAX_PAGE_SHIFT))
+        return voxcolori_report(err, bad, "page_shift is not 0 or 4..10", UINT64_MAX);
+    if ((uint32_t)o->effort >= VOXCOLOR_EFFORT_COUNT)
+        return voxcolori_report(err, bad, "effort is not a voxcolor_effort", UINT64_MAX);
+    return VOXCOLOR_OK;
+}
+
+// -- Encoding: the built-in thread pool
+
+/* Workers that live for one voxcolor_encode or voxcolor_encoder_push call
+   and run every batch of it: created on the first batch, joined at the end
+   of the call. On the stack of that call; nothing is allocated. */
+#ifndef VOXCOLOR_NO_THREADS
+#if defined(_WIN32)
+#include <windows.h>
+typedef CRITICAL_SECTION voxcolori_mutex;
+typedef CONDITION_VARIABLE voxcolori_cond;
+typedef HANDLE voxcolori_thread;
+#define voxcolori_mutex_init(m) InitializeCriticalSection(m)
+#define voxcolori_mutex_destroy(m) DeleteCriticalSection(m)
+#define voxcolori_lock(m) EnterCriticalSection(m)
+#define voxcolori_unlock(m) LeaveCriticalSection(m)
+#define voxcolori_cond_init(c) InitializeConditionVariable(c)
+#define voxcolori_cond_destroy(c) ((void)(c))
+#define voxcolori_wait(c, m) SleepConditionVariableCS(c, m, INFINITE)
+#define voxcolori_wake_all(c) WakeAllConditionVariable(c)
+#else
+#include <pthread.h>
+typedef pthread_mutex_t voxcolori_mutex;
+typedef pthread_cond_t voxcolori_cond;
+typedef pthread_t voxcolori_thread;
+#define voxcolori_mutex_init(m) pthread_mutex_init(m, NULL)
+#define voxcolori_mutex_destroy(m) pthread_mutex_destroy(m)
+#define voxcolori_lock(m) pthread_mutex_lock(m)
+#define voxcolori_unlock(m) pthread_mutex_unlock(m)
+#define voxcolori_cond_init(c) pthread_cond_init(c, NULL)
+#define voxcolori_cond_destroy(c) pthread_cond_destroy(c)
+#define voxcolori_wait(c, m) pthread_cond_wait(c, m)
+#define voxcolori_wake_all(c) pthread_cond_broadcast(c)
+#endif
+
+typedef struct voxcolori_pool {
+    voxcolori_mutex lock;
+    voxcolori_cond wake, done;
+    voxcolor_job_fn job;
+    void *job_user;
+    uint32_t count, next, finished, generation, started;
+    int quit;
+    voxcolori_thread tid[VOXCOLOR_MAX_THREADS - 1];
+} voxcolori_pool;
+
+/* Runs the current round's jobs until none is left. Called and returns with
+   the lock held. */
+static void voxcolori_pool_work(voxcolori_pool *p) {
+    while (p->next < p->count) {
+        uint32_t i = p->next++;
+        voxcolor_job_fn job = p->job;
+        void *user = p->job_user;
+        voxcolori_unlock(&p->lock);
+        job(user, i);
+        voxcolori_lock(&p->lock);
+        if (++p->finished == p->count) voxcolori_wake_all(&p->done);
+    }
+}
+
+static void voxcolori_pool_worker(voxcolori_pool *p) {
+    uint32_t seen = 0;
+    voxcolori_lock(&p->lock);
+    for (;;) {
+        while (!p->quit && p->generation == seen) voxcolori_wait(&p->wake, &p->lock);
+        if (p->quit) break;
+        seen = p->generation;
+        voxcolori_pool_work(p);
+    }
+    voxcolori_unlock(&p->lock);
+}
+
+#if defined(_WIN32)
+static DWORD WINAPI voxcolori_pool_main(LPVOID p) {
+    voxcolori_pool_worker((voxcolori_pool *)p);
+    return 0;
+}
+#else
+static void *voxcolori_pool_main(void *p) {
+    voxcolori_pool_worker((voxcolori_pool *)p);
+    return NULL;
+}
+#endif
+
+/* Starts THREADS - 1 workers (fewer if the system refuses some: the calling
+   thread runs what they do not). */
+static void voxcolori_pool_start(voxcolori_pool *p, uint32_t threads) {
+    memset(p, 0, sizeof *p);
+    voxcolori_mutex_init(&p->lock);
+    voxcolori_cond_init(&p->wake);
+    voxcolori_cond_init(&p->done);
+    for (; p->started + 1 < threads; p->started++) {
+#if defined(_WIN32)
+        p->tid[p->started] = CreateThread(NULL, 0, voxcolori_pool_main, p, 0, NULL);
+        if (!p->tid[p->started]) break;
+#else
+        if (pthread_create(&p->tid[p->started], NULL, voxcolori_pool_main, p) != 0) break;
+#endif
+    }
+}
+
+/* voxcolor_thread_pool.run of the built-in pool: the calling thread works too. */
+static void voxcolori_pool_run(void *user, voxcolor_job_fn job, void *job_user, uint32_t count) {
+    voxcolori_pool *p = (voxcolori_pool *)user;
+    voxcolori_lock(&p->lock);
+    p->job = job;
+    p->job_user = job_user;
+    p->count = count;
+    p->next = 0;
+    p->finished = 0;
+    p->generation++;
+    voxcolori_wake_all(&p->wake);
+    voxcolori_pool_work(p);
+    while (p->finished < p->count) voxcolori_wait(&p->done, &p->lock);
+    voxcolori_unlock(&p->lock);
+}
+
+static void voxcolori_pool_stop(voxcolori_pool *p) {
+    uint32_t t;
+    voxcolori_lock(&p->lock);
+    p->quit = 1;
+    voxcolori_wake_all(&p->wake);
+    voxcolori_unlock(&p->lock);
+    for (t = 0; t < p->started; t++) {
+#if defined(_WIN32)
+        WaitForSingleObject(p->tid[t], INFINITE);
+        CloseHandle(p->tid[t]);
+#else
+        pthread_join(p->tid[t], NULL);
+#endif
+    }
+    voxcolori_cond_destroy(&p->wake);
+    voxcolori_cond_destroy(&p->done);
+    voxcolori_mutex_destroy(&p->lock);
+}
+#endif /* VOXCOLOR_NO_THREADS */
+
+// -- Encoding: streams
+
 /* Hands the buffered block data to the write callback. */
-static void voxcolori_flush_data(voxcolor_encoder *s) {
-    if (!s->failed && s->out_used &&
-        !s->write(s->user, s->data_offset + s->data_size - s->out_used, s->out, s->out_used))
-        s->failed = 1;
+static void voxcolori_flush_data(voxcolori_stream *s) {
+    if (!s->status && s->out_used &&
+        !s->write(s->user, s->data_offset + s->data_size - s->out_used, s->out, s->out_used)) {
+        s->status = s->inplace ? VOXCOLOR_ERR_BUFFER_TOO_SMALL : VOXCOLOR_ERR_WRITE;
+        s->message = s->inplace ? "the stream does not fit in the output buffer" : "the write callback failed";
+    }
     s->out_used = 0;
 }
 
 /* Hands the buffered page table entries to the write callback. */
-static void voxcolori_flush_table(voxcolor_encoder *s) {
+static void voxcolori_flush_table(voxcolori_stream *s) {
     uint64_t first = s->pages - s->table_used / s->entry;
-    if (!s->failed && s->table_used &&
-        !s->write(s->user, VOXCOLOR_HEADER_SIZE + first * s->entry, s->table, s->table_used))
-        s->failed = 1;
+    if (!s->status && s->table_used &&
+        !s->write(s->user, VOXCOLOR_HEADER_SIZE + first * s->entry, s->table, s->table_used)) {
+        s->status = s->inplace ? VOXCOLOR_ERR_BUFFER_TOO_SMALL : VOXCOLOR_ERR_WRITE;
+        s->message = s->inplace ? "the stream does not fit in the output buffer" : "the write callback failed";
+    }
     s->table_used = 0;
 }
 
-/* Encodes one page of N colours: its table entry, then its blocks. */
-static void voxcolori_encode_page(voxcolor_encoder *s, const uint8_t *rgb, size_t n) {
+/* Most bytes a page of N colours takes: one raw block (count, end, nibble). */
+static size_t voxcolori_page_most(unsigned page_shift, size_t n) {
+    return 2 * voxcolori_index_bytes(page_shift) + 1 + 3 * n;
+}
+
+/* Encodes one page of N colours into DST (voxcolori_page_most bytes free);
+   returns its size. Uses about 16 KiB of stack. */
+static size_t voxcolori_page_encode(const voxcolori_enc *e, const uint8_t *rgb, size_t n, uint8_t *dst) {
     uint64_t plan[1u << VOXCOLOR_MAX_PAGE_SHIFT]; /* 8 KiB */
     voxcolori_writer w;
-    size_t blocks, most = 2 * voxcolori_index_bytes(s->enc.page_shift) + 1 + 3 * n;
+    size_t blocks;
+    w.p = dst;
+    w.acc = 0;
+    w.n = 0;
+    blocks = voxcolori_plan_page(e, rgb, n, plan);
+    voxcolori_write_page(&w, rgb, plan, blocks, e->page_shift);
+    if (w.n) voxcolori_put(&w, 0, 8 - w.n);
+    VOXCOLOR_ASSERT((size_t)(w.p - dst) <= voxcolori_page_most(e->page_shift, n));
+    return (size_t)(w.p - dst);
+}
+
+/* Encodes one page of N colours on the calling thread: its table entry,
+   then its blocks. */
+static void voxcolori_encode_page(voxcolori_stream *s, const uint8_t *rgb, size_t n) {
+    size_t most = voxcolori_page_most(s->enc.page_shift, n), size;
     if (s->table_used + s->entry > sizeof s->table) voxcolori_flush_table(s);
     voxcolori_store_le(s->table + s->table_used, s->data_size, s->entry);
     s->table_used += s->entry;
     s->pages++;
     /* A page never takes more than one raw block would. */
     if (s->out_used + most > sizeof s->out) voxcolori_flush_data(s);
-    w.p = s->out + s->out_used;
-    w.acc = 0;
-    w.n = 0;
-    blocks = voxcolori_plan_page(&s->enc, rgb, n, plan);
-    voxcolori_write_page(&w, rgb, plan, blocks, s->enc.page_shift);
-    if (w.n) voxcolori_put(&w, 0, 8 - w.n);
-    VOXCOLOR_ASSERT((size_t)(w.p - (s->out + s->out_used)) <= most);
-    s->data_size += (uint64_t)(w.p - (s->out + s->out_used));
-    s->out_used = (uint32_t)(w.p - s->out);
+    size = voxcolori_page_encode(&s->enc, rgb, n, s->out + s->out_used);
+    s->data_size += size;
+    s->out_used += (uint32_t)size;
 }
 
-VOXCOLOR_API void voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
-                                        const voxcolor_encode_opts *opts, voxcolor_write_fn write,
-                                        void *user) {
+/* Pages of a batch per job: about 256 colours, so that the jobs even out. */
+static uint32_t voxcolori_pages_per_job(unsigned page_shift) {
+    return page_shift >= 8 ? 1u : 1u << (8 - page_shift);
+}
+
+/* Most pages in a batch: as many table entries as the stream buffers. */
+#define VOXCOLORI_BATCH_PAGES (sizeof(((voxcolori_stream *)0)->table) / 4)
+
+/* A batch of whole pages encoded in parallel: job J encodes pages
+   J * per_job .. into AREA + J * slot and records each page's offset from
+   there in the stream's table buffer. */
+typedef struct voxcolori_batch {
+    const voxcolori_stream *s;
+    const uint8_t *rgb;   /* the batch's first colour */
+    uint64_t colours;     /* colours in the batch */
+    uint8_t *area;
+    size_t slot;
+    uint32_t pages, per_job;
+    uint8_t *table;
+    uint32_t size[VOXCOLORI_BATCH_PAGES]; /* bytes job J wrote */
+} voxcolori_batch;
+
+static void voxcolori_batch_job(void *user, uint32_t job) {
+    voxcolori_batch *b = (voxcolori_batch *)user;
+    const voxcolori_stream *s = b->s;
+    size_t page = (size_t)1 << s->enc.page_shift;
+    uint32_t k = job * b->per_job, end = k + b->per_job < b->pages ? k + b->per_job : b->pages;
+    uint8_t *out = b->area + job * b->slot, *p = out;
+    for (; k < end; k++) {
+        uint64_t first = (uint64_t)k * page;
+        size_t n = b->colours - first < page ? (size_t)(b->colours - first) : page;
+        voxcolori_store_le(b->table + (size_t)k * s->entry, (uint64_t)(p - out), s->entry);
+        p += voxcolori_page_encode(&s->enc, b->rgb + 3 * (size_t)first, n, p);
+    }
+    b->size[job] = (uint32_t)(p - out);
+}
+
+/* Runs COUNT jobs on the caller's pool, the built-in one (started on first
+   use into *BUILTIN) or the calling thread. */
+static void voxcolori_run(voxcolori_stream *s, void *builtin, int *started, voxcolor_job_fn job,
+                          void *user, uint32_t count) {
+    uint32_t i;
+    if (s->pool.run) {
+        s->pool.run(s->pool.user, job, user, count);
+        return;
+    }
+#ifndef VOXCOLOR_NO_THREADS
+    if (!*started) {
+        voxcolori_pool_start((voxcolori_pool *)builtin, s->threads);
+        *started = 1;
+    }
+    voxcolori_pool_run(builtin, job, user, count);
+    return;
+#else
+    (void)builtin;
+    (void)started;
+#endif
+    for (i = 0; i < count; i++) job(user, i);
+}
+
+/* Encodes the N colours at RGB, whole pages (the last page of the stream
+   may be short), in batches run in parallel. The output of a batch goes to
+   AREA (AREA_SIZE bytes), or in place into voxcolor_encode's buffer, then
+   is written in order. Returns the colours encoded (fewer when a page does
+   not fit in the space left, or on failure). */
+static uint64_t voxcolori_encode_batches(voxcolori_stream *s, const uint8_t *rgb, uint64_t n, uint8_t *area,
+                                         size_t area_size) {
+#ifndef VOXCOLOR_NO_THREADS
+    voxcolori_pool pool;
+#else
+    int pool;
+#endif
+    voxcolori_batch b;
+    int started = 0;
+    size_t page = (size_t)1 << s->enc.page_shift, most = voxcolori_page_most(s->enc.page_shift, page);
+    uint64_t done = 0;
+    b.s = s;
+    b.table = s->table;
+    b.per_job = voxcolori_pages_per_job(s->enc.page_shift);
+    b.slot = b.per_job * most;
+    while (done < n && !s->status) {
+        uint64_t pages = (n - done + page - 1) >> s->enc.page_shift, limit = sizeof s->table / s->entry;
+        uint32_t jobs, j;
+        uint8_t *at = area, *to;
+        size_t space = area_size, total;
+        voxcolori_flush_data(s);
+        voxcolori_flush_table(s);
+        if (s->status) break;
+        if (s->inplace) {
+            uint64_t end = s->data_offset + s->data_size;
+            at = s->inplace + (size_t)end;
+            space = end + 8 <= s->inplace_size ? s->inplace_size - (size_t)end - 8 : 0;
+        }
+        if (pages > limit) pages = limit;
+        if (pages > space / most) pages = space / most;
+        jobs = (uint32_t)((pages + b.per_job - 1) / b.per_job);
+        if (jobs < 2) break; /* the rest goes one page at a time */
+        b.rgb = rgb + 3 * (size_t)done;
+        b.pages = (uint32_t)pages;
+        b.colours = n - done < pages * page ? n - done : pages * page;
+        b.area = at;
+        voxcolori_run(s, &pool, &started, voxcolori_batch_job, &b, jobs);
+        /* The jobs' output, moved together; the table entries made absolute. */
+        for (j = 0, to = at; j < jobs; j++) {
+            uint32_t k, end = (j + 1) * b.per_job < b.pages ? (j + 1) * b.per_job : b.pages;
+            uint64_t base = s->data_size + (uint64_t)(to - at);
+            memmove(to, at + j * b.slot, b.size[j]);
+            to += b.size[j];
+            for (k = j * b.per_job; k < end; k++)
+                voxcolori_store_le(s->table + (size_t)k * s->entry,
+                                   base + voxcolori_load_le(s->table + (size_t)k * s->entry, s->entry), s->entry);
+        }
+        total = (size_t)(to - at);
+        if (!s->inplace && !s->write(s->user, s->data_offset + s->data_size, at, total)) {
+            s->status = VOXCOLOR_ERR_WRITE;
+            s->message = "the write callback failed";
+        }
+        s->data_size += total;
+        s->table_used = b.pages * s->entry;
+        s->pages += b.pages;
+        done += b.colours;
+    }
+#ifndef VOXCOLOR_NO_THREADS
+    if (started) voxcolori_pool_stop(&pool);
+#else
+    (void)started;
+#endif
+    return done;
+}
+
+/* Sets up S; on failure S fails every later call. */
+static voxcolor_status voxcolori_stream_init(voxcolori_stream *s, uint64_t count, const voxcolor_encode_opts *opts,
+                                             voxcolor_write_fn write, void *user, voxcolor_error *err) {
     voxcolor_encode_opts defaults;
+    voxcolor_status st;
     uint64_t pages;
+    voxcolor_error e;
     memset(&defaults, 0, sizeof defaults);
     if (!opts) opts = &defaults;
-    VOXCOLOR_ASSERT(enc && write);
-    VOXCOLOR_ASSERT(opts->max_error >= 0); /* also rejects NaN */
-    VOXCOLOR_ASSERT(opts->metric == VOXCOLOR_METRIC_RGB || opts->metric == VOXCOLOR_METRIC_CIELAB);
-    VOXCOLOR_ASSERT(opts->weight_bits <= VOXCOLORI_MAX_WEIGHT_BITS);
-    VOXCOLOR_ASSERT(!opts->page_shift || (opts->page_shift >= VOXCOLOR_MIN_PAGE_SHIFT &&
-                                          opts->page_shift <= VOXCOLOR_MAX_PAGE_SHIFT));
-    voxcolori_enc_init(&enc->enc, opts);
-    enc->write = write;
-    enc->user = user;
-    enc->count = count;
-    enc->pushed = 0;
-    pages = count ? ((count - 1) >> enc->enc.page_shift) + 1 : 0;
+    st = voxcolori_check_opts(opts, &e);
+    if (!st && !write) st = voxcolori_report(&e, VOXCOLOR_ERR_INVALID_ARGUMENT, "write callback is NULL", UINT64_MAX);
+    s->status = st;
+    s->message = st ? e.message : "ok";
+    if (st) {
+        opts = &defaults; /* a valid state that fails every call */
+        if (err) *err = e;
+    }
+    voxcolori_enc_init(&s->enc, opts);
+    s->write = write;
+    s->user = user;
+    s->pool = opts->thread_pool;
+    s->threads = opts->threads < 1 ? 1 : opts->threads > VOXCOLOR_MAX_THREADS ? VOXCOLOR_MAX_THREADS : opts->threads;
+    s->count = count;
+    s->pushed = 0;
+    pages = count ? ((count - 1) >> s->enc.page_shift) + 1 : 0;
     /* 4-byte entries address 4 GiB of data: always enough below 2^30 colours. */
-    enc->entry = count > (1ull << 30) ? 8 : 4;
-    enc->data_offset = VOXCOLOR_HEADER_SIZE + pages * enc->entry;
-    enc->data_size = 0;
-    enc->pages = 0;
-    enc->held = 0;
-    enc->out_used = 0;
-    enc->table_used = 0;
-    enc->failed = 0;
+    s->entry = count > (1ull << 30) ? 8 : 4;
+    s->data_offset = VOXCOLOR_HEADER_SIZE + pages * s->entry;
+    s->data_size = 0;
+    s->pages = 0;
+    s->held = 0;
+    s->out_used = 0;
+    s->table_used = 0;
+    s->inplace = NULL;
+    s->inplace_size = 0;
+    return st ? st : voxcolori_report(err, VOXCOLOR_OK, "ok", UINT64_MAX);
 }
 
-VOXCOLOR_API uint64_t voxcolor_encoder_data_offset(const voxcolor_encoder *enc) {
-    VOXCOLOR_ASSERT(enc);
-    return enc->data_offset;
+/* 1 when S encodes pages in parallel. */
+static int voxcolori_parallel(const voxcolori_stream *s) {
+#ifdef VOXCOLOR_NO_THREADS
+    return s->pool.run != NULL;
+#else
+    return s->pool.run || s->threads > 1;
+#endif
 }
 
-VOXCOLOR_API int voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8, size_t n) {
-    VOXCOLOR_ASSERT(enc && (rgb8 || !n) && n <= enc->count - enc->pushed);
-    while (n && !enc->failed) {
-        uint64_t left = enc->count - enc->pushed + enc->held;
-        size_t page = (size_t)1 << enc->enc.page_shift, take;
+static voxcolor_status voxcolori_push(voxcolori_stream *s, const uint8_t *rgb8, size_t n, uint8_t *area,
+                                      size_t area_size) {
+    if (s->status) return s->status;
+    if ((!rgb8 && n) || n > s->count - s->pushed) {
+        s->status = VOXCOLOR_ERR_INVALID_ARGUMENT;
+        s->message = !rgb8 && n ? "colours are NULL with a nonzero count" : "more colours pushed than declared";
+        return s->status;
+    }
+    while (n && !s->status) {
+        uint64_t left = s->count - s->pushed + s->held;
+        size_t page = (size_t)1 << s->enc.page_shift, take;
         if (left < page) page = (size_t)left; /* the last page */
-        if (!enc->held && n >= page) {
-            /* A whole page in the caller's colours: no copy. */
-            voxcolori_encode_page(enc, rgb8, page);
-            take = page;
-        } else {
-            take = page - enc->held < n ? page - enc->held : n;
-            memcpy(enc->rgb + 3 * (size_t)enc->held, rgb8, 3 * take);
-            enc->held += (uint32_t)take;
-            if (enc->held == page) {
-                voxcolori_encode_page(enc, enc->rgb, page);
-                enc->held = 0;
+        if (!s->held && n >= page && voxcolori_parallel(s) && n - page >= page) {
+            /* Several whole pages in the caller's colours: in parallel, no copy.
+               The last page of the stream joins them when it is here. */
+            uint64_t whole = n == left ? n : n - n % ((size_t)1 << s->enc.page_shift);
+            take = (size_t)voxcolori_encode_batches(s, rgb8, whole, area, area_size);
+            if (take) {
+                s->pushed += take;
+                rgb8 += 3 * take;
+                n -= take;
+                continue;
             }
         }
-        enc->pushed += take;
+        if (!s->held && n >= page) {
+            /* A whole page in the caller's colours: no copy. */
+            voxcolori_encode_page(s, rgb8, page);
+            take = page;
+        } else {
+            take = page - s->held < n ? page - s->held : n;
+            memcpy(s->rgb + 3 * (size_t)s->held, rgb8, 3 * take);
+            s->held += (uint32_t)take;
+            if (s->held == page) {
+                voxcolori_encode_page(s, s->rgb, page);
+                s->held = 0;
+            }
+        }
+        s->pushed += take;
         rgb8 += 3 * take;
         n -= take;
     }
-    return !enc->failed;
+    return s->status;
 }
 
-VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc) {
+static uint64_t voxcolori_finish(voxcolori_stream *s, voxcolor_error *err) {
     uint8_t header[VOXCOLOR_HEADER_SIZE];
-    VOXCOLOR_ASSERT(enc);
-    if (enc->pushed != enc->count) enc->failed = 1;
+    if (!s->status && s->pushed != s->count) {
+        s->status = VOXCOLOR_ERR_INCOMPLETE;
+        s->message = "fewer colours pushed than declared";
+    }
     /* The 8 closing zero bytes. */
-    if (enc->out_used + 8 > sizeof enc->out) voxcolori_flush_data(enc);
-    memset(enc->out + enc->out_used, 0, 8);
-    enc->out_used += 8;
-    enc->data_size += 8;
-    voxcolori_flush_data(enc);
-    voxcolori_flush_table(enc);
+    if (s->out_used + 8 > sizeof s->out) voxcolori_flush_data(s);
+    memset(s->out + s->out_used, 0, 8);
+    s->out_used += 8;
+    s->data_size += 8;
+    voxcolori_flush_data(s);
+    voxcolori_flush_table(s);
     memcpy(header + VOXCOLOR_OFF_MAGIC, "VXC1", 4);
     voxcolori_store_le(header + VOXCOLOR_OFF_VERSION, VOXCOLOR_FORMAT_VERSION, 2);
-    header[VOXCOLOR_OFF_PAGE_SHIFT] = (uint8_t)enc->enc.page_shift;
-    header[VOXCOLOR_OFF_FLAGS] = enc->entry == 8 ? 1 : 0;
-    voxcolori_store_le(header + VOXCOLOR_OFF_COUNT, enc->count, 8);
-    voxcolori_store_le(header + VOXCOLOR_OFF_DATA_SIZE, enc->data_size, 8);
-    if (!enc->failed && !enc->write(enc->user, 0, header, sizeof header)) enc->failed = 1;
-    return enc->failed ? 0 : enc->data_offset + enc->data_size;
+    header[VOXCOLOR_OFF_PAGE_SHIFT] = (uint8_t)s->enc.page_shift;
+    header[VOXCOLOR_OFF_FLAGS] = s->entry == 8 ? 1 : 0;
+    voxcolori_store_le(header + VOXCOLOR_OFF_COUNT, s->count, 8);
+    voxcolori_store_le(header + VOXCOLOR_OFF_DATA_SIZE, s->data_size, 8);
+    if (!s->status && !s->write(s->user, 0, header, sizeof header)) {
+        s->status = s->inplace ? VOXCOLOR_ERR_BUFFER_TOO_SMALL : VOXCOLOR_ERR_WRITE;
+        s->message = s->inplace ? "the stream does not fit in the output buffer" : "the write callback failed";
+    }
+    if (s->status) {
+        voxcolori_report(err, s->status, s->message, UINT64_MAX);
+        return 0;
+    }
+    voxcolori_report(err, VOXCOLOR_OK, "ok", UINT64_MAX);
+    return s->data_offset + s->data_size;
+}
+
+VOXCOLOR_API voxcolor_status voxcolor_encoder_init(voxcolor_encoder *enc, uint64_t count,
+                                                   const voxcolor_encode_opts *opts,
+                                                   voxcolor_write_fn write, void *user,
+                                                   voxcolor_error *err) {
+    if (!enc) return voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "encoder is NULL", UINT64_MAX);
+    return voxcolori_stream_init(&enc->s, count, opts, write, user, err);
+}
+
+VOXCOLOR_API uint64_t voxcolor_encoder_data_offset(const voxcolor_encoder *enc) {
+    return enc ? enc->s.data_offset : 0;
+}
+
+VOXCOLOR_API voxcolor_status voxcolor_encoder_push(voxcolor_encoder *enc, const uint8_t *rgb8, size_t n) {
+    if (!enc) return VOXCOLOR_ERR_INVALID_ARGUMENT;
+    return voxcolori_push(&enc->s, rgb8, n, enc->batch, sizeof enc->batch);
+}
+
+VOXCOLOR_API uint64_t voxcolor_encoder_finish(voxcolor_encoder *enc, voxcolor_error *err) {
+    if (!enc) {
+        voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "encoder is NULL", UINT64_MAX);
+        return 0;
+    }
+    return voxcolori_finish(&enc->s, err);
 }
 
 /* voxcolor_encode's target: the caller's buffer. */
@@ -1616,18 +2150,31 @@ static int voxcolori_write_buffer(void *user, uint64_t offset, const void *bytes
 }
 
 VOXCOLOR_API size_t voxcolor_encode(uint8_t *dst, size_t dst_size, const uint8_t *rgb8,
-                                    size_t count, const voxcolor_encode_opts *opts) {
-    voxcolor_encoder enc; /* 16 KiB */
+                                    size_t count, const voxcolor_encode_opts *opts,
+                                    voxcolor_error *err) {
+    voxcolori_stream s; /* 15 KiB */
     voxcolori_buffer b;
-    VOXCOLOR_ASSERT(dst || !dst_size);
-    VOXCOLOR_ASSERT(rgb8 || !count);
+    if (!dst && dst_size) {
+        voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "dst is NULL with a nonzero size", UINT64_MAX);
+        return 0;
+    }
+    if (!rgb8 && count) {
+        voxcolori_report(err, VOXCOLOR_ERR_INVALID_ARGUMENT, "colours are NULL with a nonzero count", UINT64_MAX);
+        return 0;
+    }
     b.p = dst;
     b.size = dst_size;
-    voxcolor_encoder_init(&enc, count, opts, voxcolori_write_buffer, &b);
+    if (voxcolori_stream_init(&s, count, opts, voxcolori_write_buffer, &b, err)) return 0;
     /* Fails early when not even the page table fits. */
-    if (enc.data_offset + 8 > dst_size) return 0;
-    voxcolor_encoder_push(&enc, rgb8, count);
-    return (size_t)voxcolor_encoder_finish(&enc);
+    if (s.data_offset + 8 > dst_size) {
+        voxcolori_report(err, VOXCOLOR_ERR_BUFFER_TOO_SMALL, "the page table does not fit in the output buffer",
+                         UINT64_MAX);
+        return 0;
+    }
+    s.inplace = dst;
+    s.inplace_size = dst_size;
+    voxcolori_push(&s, rgb8, count, NULL, 0);
+    return (size_t)voxcolori_finish(&s, err);
 }
 
 // -- 2D mapping

@@ -4,11 +4,14 @@
    2017, Tables 2-4: size (% of 24-bit), global MSE, PSNR, largest error,
    encode speed, random and coherent lookup speed.
 
-   Usage: bench_color [--max N] [--quick] [--peers SCRIPT] NAME=IMAGE.ppm[,...] ...
+   Usage: bench_color [--max N] [--quick] [--threads-only] [--peers SCRIPT] NAME=IMAGE.ppm[,...] ...
    Each image (binary PPM, as bench/color_fetch.sh makes them) is read along
    a 2D Morton curve, as a voxelized surface's colours would be, and the
    images of one NAME are concatenated into one colour array. Speeds are per
-   core: single-threaded, in CPU time. With --peers, the array is also mapped
+   core: single-threaded, in CPU time, but in the first table of each set:
+   the encoder on 1 and 2 threads, default and fast effort (per CPU-second
+   and per wall second, with the previous encoder's sizes; --threads-only
+   prints only that table). With --peers, the array is also mapped
    to a 2D Morton image (voxcolor_to_image) and run through external image
    codecs by SCRIPT (bench/color_peers.sh); their decoded output is mapped
    back and measured like ours. */
@@ -16,12 +19,19 @@
 #define VOXCOLOR_IMPLEMENTATION
 #include "../voxcolor.h"
 #include "color_baselines.h"
+#include "color_previous.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+static double wall_seconds(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
 
 static double cpu_seconds(void) {
     struct timespec t;
@@ -145,10 +155,10 @@ static void run_ours(result *r, const uint8_t *rgb, size_t n, const voxcolor_enc
     uint8_t *buf = (uint8_t *)malloc(cap);
     voxcolor_view v;
     double t = cpu_seconds();
-    size = voxcolor_encode(buf, cap, rgb, n, o);
+    size = voxcolor_encode(buf, cap, rgb, n, o, NULL);
     r->encode_rate = (double)n / (cpu_seconds() - t);
     r->bits = 8 * (uint64_t)size;
-    if (voxcolor_view_init(&v, buf, size) != VOXCOLOR_OK) {
+    if (voxcolor_view_init(&v, buf, size, NULL) != VOXCOLOR_OK) {
         fprintf(stderr, "bench_color: own stream rejected\n");
         exit(1);
     }
@@ -186,6 +196,75 @@ static void run_baseline(result *r, const uint8_t *rgb, size_t n, int kind, doub
     r->batch_rate = 0;
     measure(r, rgb, n, c, get_baseline, idx, lookups);
     color_codec_free(c);
+}
+
+// -- Encoder threads and effort
+
+/* The encoder at 1 and 2 threads, default and fast effort: size (next to
+   the previous encoder's, and whether the bytes are the same), colours per
+   CPU-second (all threads' CPU time) and per wall second, each the best of
+   REPS runs, and the wall-time speed-up of 2 threads. */
+static void run_threads(const char *name, const uint8_t *rgb, size_t n, int reps) {
+    static const double bounds[] = {0, 0.01, 0.025, 0.05, 0.1};
+    size_t cap = voxcolor_encode_bound(n), k;
+    uint8_t *buf = (uint8_t *)malloc(cap), *prev = (uint8_t *)malloc(cap), *first = (uint8_t *)malloc(cap);
+    printf("Encoder threads and effort, %s (1 and 2 threads, default and fast effort, best of %d runs each; "
+           "CPU time of all threads; the previous encoder is the one before the parallel encoder):\n\n",
+           name, reps);
+    printf("| e_t | effort | size (%% of 24-bit) | previous encoder | same bytes | 1 thread (M/CPU-s) "
+           "| 2 threads (M/CPU-s) | 1 thread (M/s wall) | 2 threads (M/s wall) | speed-up (wall) |\n"
+           "|---|---|---|---|---|---|---|---|---|---|\n");
+    for (k = 0; k < sizeof bounds / sizeof bounds[0]; k++) {
+        size_t psize = previous_voxcolor_encode(prev, cap, rgb, n, bounds[k]), fsize = 0;
+        int effort;
+        for (effort = 0; effort < 2; effort++) {
+            double cpu[2] = {1e30, 1e30}, wall[2] = {1e30, 1e30};
+            size_t size = 0;
+            int t, r, same = 1;
+            char pcol[32], scol[16];
+            for (t = 0; t < 2; t++)
+                for (r = 0; r < reps; r++) {
+                    voxcolor_encode_opts o;
+                    double c0, w0, c, w;
+                    memset(&o, 0, sizeof o);
+                    o.max_error = bounds[k];
+                    o.effort = effort ? VOXCOLOR_EFFORT_FAST : VOXCOLOR_EFFORT_SMALLEST;
+                    o.threads = (uint32_t)(t + 1);
+                    c0 = cpu_seconds();
+                    w0 = wall_seconds();
+                    size = voxcolor_encode(buf, cap, rgb, n, &o, NULL);
+                    w = wall_seconds() - w0;
+                    c = cpu_seconds() - c0;
+                    if (!size) {
+                        fprintf(stderr, "bench_color: encode failed\n");
+                        exit(1);
+                    }
+                    if (c < cpu[t]) cpu[t] = c;
+                    if (w < wall[t]) wall[t] = w;
+                    /* Every run the same bytes: threads change nothing. */
+                    if (!t && !r) memcpy(first, buf, size), fsize = size;
+                    else if (size != fsize || memcmp(first, buf, size)) same = -1;
+                }
+            if (same < 0) {
+                fprintf(stderr, "bench_color: the thread count changed the stream\n");
+                exit(1);
+            }
+            if (!psize) snprintf(pcol, sizeof pcol, "-"), snprintf(scol, sizeof scol, "-");
+            else if (effort) snprintf(pcol, sizeof pcol, "%.2f%%", 100.0 * (double)psize / (3.0 * (double)n)),
+                             snprintf(scol, sizeof scol, "%s", psize == size && !memcmp(prev, buf, size) ? "yes" : "no");
+            else snprintf(pcol, sizeof pcol, "%.2f%%", 100.0 * (double)psize / (3.0 * (double)n)),
+                 snprintf(scol, sizeof scol, "%s", psize == size && !memcmp(prev, buf, size) ? "yes" : "**no**");
+            printf("| %g | %s | %.2f%% | %s | %s | %.2f | %.2f | %.2f | %.2f | %.2f |\n", bounds[k],
+                   effort ? "fast" : "default", 100.0 * (double)size / (3.0 * (double)n), pcol, scol,
+                   (double)n / cpu[0] / 1e6, (double)n / cpu[1] / 1e6, (double)n / wall[0] / 1e6,
+                   (double)n / wall[1] / 1e6, wall[0] / wall[1]);
+            fflush(stdout);
+        }
+    }
+    printf("\n");
+    free(buf);
+    free(prev);
+    free(first);
 }
 
 // -- External codecs on the 2D-mapped array
@@ -296,7 +375,7 @@ int main(int argc, char **argv) {
     static const double base_e[] = {0.01, 0.025, 0.038, 0.05, 0.1};
     static const uint32_t dado_k[] = {0, 4096, 2048, 256};
     size_t max = 0, a, k;
-    int quick = 0;
+    int quick = 0, threads_only = 0;
     const char *peers = NULL;
     char cpu[128];
     machine(cpu, sizeof cpu);
@@ -318,6 +397,10 @@ int main(int argc, char **argv) {
             quick = 1;
             continue;
         }
+        if (!strcmp(spec, "--threads-only")) {
+            threads_only = 1;
+            continue;
+        }
         if (!strcmp(spec, "--peers") && a + 1 < (size_t)argc) {
             peers = argv[++a];
             continue;
@@ -337,6 +420,12 @@ int main(int argc, char **argv) {
         lookups = 2000000;
         idx = random_indices(n, lookups);
         printf("### %s: %zu colours from %zu image%s\n\n", spec, n, images, images == 1 ? "" : "s");
+        run_threads(spec, rgb, n, quick ? 1 : 3);
+        if (threads_only) {
+            free(idx);
+            free(rgb);
+            continue;
+        }
         printf("| codec | setting | size (%% of 24-bit) | MSE | PSNR (dB) | max error | encode "
                "| random lookup | random, batched | coherent lookup |\n"
                "|---|---|---|---|---|---|---|---|---|---|\n");

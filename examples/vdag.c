@@ -1,7 +1,8 @@
 /* vdag: build, inspect, query and render .vdag files.
 
    vdag build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E]
-              [--color-bits W|auto] [--threads T] [--stats] [--no-colors]
+              [--color-bits W|auto] [--color-effort smallest|fast] [--threads T]
+              [--stats] [--no-colors]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -62,7 +63,7 @@ int vdag_open(const char *path, vdag_file *f) {
     case VOXDAG_COLORS_RGB8: f->has_colors = 1; break;
     case VOXDAG_COLORS_VOXCOLOR: {
         voxdag_info info;
-        voxcolor_status st = voxcolor_view_init(&f->colors, payload, size);
+        voxcolor_status st = voxcolor_view_init(&f->colors, payload, size, NULL);
         voxdag_get_info(f->dag, &info);
         if (st != VOXCOLOR_OK || f->colors.count != info.voxels) {
             vdag_close(f);
@@ -123,6 +124,7 @@ typedef struct build_args {
     int no_colors, stats, compress;
     double color_error;
     uint32_t color_bits; /* 0: auto */
+    voxcolor_effort color_effort;
     struct color_spill *spill;
     double t0;              /* when the command started */
     const char *last_stage; /* progress printed last */
@@ -278,11 +280,49 @@ static void print_build_summary(const voxdag *dag, const voxdag_build_stats *st,
 
 /* The builder's colours go to a temporary file as they are reduced (the
    builder's memory then does not grow with them) and come back once the
-   geometry is done. */
+   geometry is done: 3 bytes a voxel, in $TMPDIR (else /tmp), removed when
+   closed. */
 typedef struct color_spill {
     FILE *f; /* NULL: the build has no colours */
     uint64_t n;
+    const char *dir;
 } color_spill;
+
+/* Opens S's file: created and unlinked at once, so that nothing is left
+   behind whatever happens. */
+static int spill_open(color_spill *s) {
+    char path[4096];
+    int fd;
+    s->dir = getenv("TMPDIR");
+    if (!s->dir || !*s->dir) s->dir = "/tmp";
+    if (snprintf(path, sizeof path, "%s/vdag-colors-XXXXXX", s->dir) >= (int)sizeof path) return 0;
+    fd = mkstemp(path);
+    if (fd < 0) return 0;
+    unlink(path);
+    if (!(s->f = fdopen(fd, "w+b"))) close(fd);
+    return s->f != NULL;
+}
+
+/* Voxels a mesh voxelizes to, about: each triangle's area times the sum of
+   its normal's absolute components (the voxel columns it crosses along each
+   axis), in grid units. Shared edges make it a little high. */
+static double mesh_voxel_estimate(const double *grid, const uint32_t *indices, size_t triangles) {
+    double sum = 0;
+    size_t t;
+    for (t = 0; t < triangles; t++) {
+        const double *a = grid + 3 * (size_t)indices[3 * t], *b = grid + 3 * (size_t)indices[3 * t + 1],
+                     *c = grid + 3 * (size_t)indices[3 * t + 2];
+        double u[3], v[3], n[3];
+        int k;
+        for (k = 0; k < 3; k++) u[k] = b[k] - a[k], v[k] = c[k] - a[k];
+        n[0] = u[1] * v[2] - u[2] * v[1];
+        n[1] = u[2] * v[0] - u[0] * v[2];
+        n[2] = u[0] * v[1] - u[1] * v[0];
+        /* |n| is twice the area; area * (|nx| + |ny| + |nz|) / |n|. */
+        sum += 0.5 * (fabs(n[0]) + fabs(n[1]) + fabs(n[2]));
+    }
+    return sum;
+}
 
 static int spill_colors(void *user, const uint8_t *rgb, size_t n) {
     color_spill *s = (color_spill *)user;
@@ -323,13 +363,15 @@ static int encode_spill(FILE *f, uint64_t n, const build_args *a, grow_buf *g) {
     memset(&o, 0, sizeof o);
     o.max_error = a->color_error;
     o.weight_bits = a->color_bits;
-    if (ok) voxcolor_encoder_init(enc, n, &o, write_grow, g);
+    o.effort = a->color_effort;
+    o.threads = a->threads; /* whole pages of each slice in parallel */
+    ok = ok && voxcolor_encoder_init(enc, n, &o, write_grow, g, NULL) == VOXCOLOR_OK;
     while (ok && done < n) {
         size_t k = n - done < SLICE ? (size_t)(n - done) : SLICE;
-        ok = fread(rgb, 3, k, f) == k && voxcolor_encoder_push(enc, rgb, k);
+        ok = fread(rgb, 3, k, f) == k && voxcolor_encoder_push(enc, rgb, k) == VOXCOLOR_OK;
         done += k;
     }
-    ok = ok && voxcolor_encoder_finish(enc) == g->size;
+    ok = ok && voxcolor_encoder_finish(enc, NULL) == g->size;
     free(enc);
     free(rgb);
     return ok;
@@ -344,6 +386,8 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     voxdag_error err;
     double t0 = now_seconds();
     int rc;
+    fprintf(stderr, "vdag: colour spill: %.1f MiB of temporary disk in %s (%llu colours)\n",
+            (double)size / 1048576.0, spill->dir, (unsigned long long)spill->n);
     rewind(spill->f);
     if (!a->compress) {
         uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
@@ -364,9 +408,13 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
         rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
         free(g.data);
         if (!rc)
-            fprintf(stderr, "vdag: colours %llu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g) in %.2f s\n",
+            fprintf(stderr,
+                    "vdag: colours %llu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g, %s effort) in %.2f s on %u "
+                    "thread%s\n",
                     (unsigned long long)size, g.size, size ? 100.0 * (double)g.size / (double)size : 0.0,
-                    size ? 24.0 * (double)g.size / (double)size : 0.0, a->color_error, now_seconds() - t0);
+                    size ? 24.0 * (double)g.size / (double)size : 0.0, a->color_error,
+                    a->color_effort == VOXCOLOR_EFFORT_FAST ? "fast" : "smallest", now_seconds() - t0, a->threads,
+                    a->threads == 1 ? "" : "s");
     }
     if (rc) return vdag_fail("%s", err.message);
     voxdag_free(*dag);
@@ -374,8 +422,9 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     return 0;
 }
 
-/* Options of a build; its colours, if any, go to A's spill file. */
-static int build_opts(build_args *a, int colors, const double *bounds, voxdag_build_opts *o) {
+/* Options of a build; its colours, if any, go to A's spill file, about
+   VOXELS of them (an estimate, reported). */
+static int build_opts(build_args *a, int colors, const double *bounds, double voxels, voxdag_build_opts *o) {
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
     o->symmetry = a->symmetry;
@@ -386,7 +435,11 @@ static int build_opts(build_args *a, int colors, const double *bounds, voxdag_bu
     o->progress = progress;
     o->progress_user = a;
     if (!colors) return 0;
-    if (!(a->spill->f = tmpfile())) return vdag_fail("build: cannot create a temporary file for the colours");
+    if (!spill_open(a->spill))
+        return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
+                         strerror(errno));
+    fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
+            3.0 * voxels / 1048576.0, a->spill->dir);
     o->color_sink = spill_colors;
     o->color_sink_user = a->spill;
     return 0;
@@ -409,7 +462,7 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
         vdag_scene_free(sc);
         return vdag_fail("out of memory");
     }
-    if (build_opts(a, colors, bounds, &o)) {
+    if (build_opts(a, colors, bounds, colors ? mesh_voxel_estimate(grid, sc->indices, sc->triangle_count) : 0, &o)) {
         free(grid);
         vdag_scene_free(sc);
         return 1;
@@ -472,6 +525,12 @@ static int cmd_build(int argc, char **argv) {
             if (!parse_double(argv[++k], &a.color_error) || a.color_error < 0)
                 return vdag_fail("build: --color-error takes a number >= 0");
             a.compress = 1;
+        } else if (!strcmp(argv[k], "--color-effort") && k + 1 < argc) {
+            k++;
+            if (!strcmp(argv[k], "smallest")) a.color_effort = VOXCOLOR_EFFORT_SMALLEST;
+            else if (!strcmp(argv[k], "fast")) a.color_effort = VOXCOLOR_EFFORT_FAST;
+            else return vdag_fail("build: --color-effort takes smallest or fast");
+            a.compress = 1;
         } else if (!strcmp(argv[k], "--color-bits") && k + 1 < argc) {
             k++;
             if (!strcmp(argv[k], "auto")) a.color_bits = 0;
@@ -498,7 +557,7 @@ static int cmd_build(int argc, char **argv) {
         vdag_scene_free(&sc);
         return 1;
     }
-    rc = build_opts(&a, !a.no_colors && sc.point_rgb != NULL, bounds, &o);
+    rc = build_opts(&a, !a.no_colors && sc.point_rgb != NULL, bounds, (double)sc.point_count, &o);
     if (rc) {
         free(xyz);
         vdag_scene_free(&sc);
@@ -691,7 +750,7 @@ static int cmd_gen(int argc, char **argv) {
 static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...\n"
           "  build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E] [--color-bits W|auto]\n"
-          "                    [--threads T] [--stats] [--no-colors]\n"
+          "                    [--color-effort smallest|fast] [--threads T] [--stats] [--no-colors]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z\n"

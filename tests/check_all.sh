@@ -130,7 +130,7 @@ for cc in $CCS $CXXS; do
         for d in "" -DNDEBUG; do
             job "impl $cc $o ${d:-(asserts)} voxdag.h" ok \
                 "$cc $f $VOXDAG_WARN $o $d -c -o /dev/null -I. -DVOXDAG_IMPLEMENTATION $L/header_voxdag.c"
-            for c in "" -DCHECK_CUSTOM; do
+            for c in "" -DCHECK_CUSTOM -DVOXCOLOR_NO_THREADS; do
                 job "impl $cc $o ${d:-(asserts)} ${c:-default} voxcolor.h" ok \
                     "$cc $f $CONV $o $d $c -c -o /dev/null -I. -DVOXCOLOR_IMPLEMENTATION $L/header_voxcolor.c"
             done
@@ -159,6 +159,16 @@ if [ -n "$M32" ]; then
     done
 fi
 
+# voxcolor.h's Win32 thread pool: compiled by MinGW-w64 when it is installed.
+if have x86_64-w64-mingw32-gcc; then
+    for c in "" -DVOXCOLOR_NO_THREADS; do
+        job "mingw x86_64-w64-mingw32-gcc -O2 ${c:-default} voxcolor.h" ok \
+            "x86_64-w64-mingw32-gcc $C99 $CONV -O2 $c -c -o /dev/null -I. -DVOXCOLOR_IMPLEMENTATION $L/header_voxcolor.c"
+    done
+else
+    note "MinGW-w64 voxcolor.h compile skipped: x86_64-w64-mingw32-gcc not installed (gcc-mingw-w64-x86-64)"
+fi
+
 # -- Configuration errors
 cc1=$(echo $CCS | cut -d' ' -f1)
 job "error VOXDAG_MALLOC alone" "define both VOXDAG_MALLOC and VOXDAG_FREE" \
@@ -181,6 +191,11 @@ for cc in $CCS; do
          $cc $f -O2 -c -o $O/$cc-impl_voxcolor.o -I. $L/impl_voxcolor.c
          $cc $f -O2 -o $B/$cc-use -I. $L/use.c $O/$cc-impl_voxdag.o $O/$cc-impl_voxcolor.o $LIBS
          $B/$cc-use"
+    job "link $cc: voxcolor built with VOXCOLOR_NO_THREADS, used from a default unit" ok \
+        "$cc $f -O2 -DVOXCOLOR_NO_THREADS -c -o $O/$cc-impl_voxcolor_nothreads.o -I. $L/impl_voxcolor.c
+         $cc $f -O2 -c -o $O/$cc-impl_voxdag_for_nothreads.o -I. $L/impl_voxdag.c
+         $cc $f -O2 -o $B/$cc-use-nothreads -I. $L/use.c $O/$cc-impl_voxdag_for_nothreads.o $O/$cc-impl_voxcolor_nothreads.o $LIBS
+         $B/$cc-use-nothreads"
     job "link $cc -O0: both implementations in one unit" ok \
         "$cc $f -O0 -c -o $O/$cc-impl_both.o -I. $L/impl_both.c
          $cc $f -O0 -o $B/$cc-use-both -I. $L/use.c $O/$cc-impl_both.o $LIBS

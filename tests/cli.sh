@@ -96,6 +96,32 @@ check "build with --color-error 0" "$VDAG" build "$T/in.xyz" "$T/l.vdag" --level
 "$VDAG" export-voxels "$T/l.vdag" >"$T/export_l" 2>/dev/null
 check "lossless colours exact" cmp -s "$T/export_l" "$T/expected_export"
 
+# -- colour compression on threads, fast effort; the colour spill in $TMPDIR
+check "colour compression threads do not change the file" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/c1.vdag' --levels 5 --color-error 0.03 --threads 1 2>/dev/null &&
+    '$VDAG' build '$T/in.xyz' '$T/c2.vdag' --levels 5 --color-error 0.03 --threads 2 2>/dev/null &&
+    cmp -s '$T/c1.vdag' '$T/c2.vdag'"
+check "build with --color-effort fast" "$VDAG" build "$T/in.xyz" "$T/f.vdag" --levels 5 --color-error 0.03 --color-effort fast 2>/dev/null
+"$VDAG" export-voxels "$T/f.vdag" >"$T/export_f" 2>/dev/null
+check "fast-effort colours within e_t" python3 -c "
+a = [l.split() for l in open('$T/expected_export')]
+b = [l.split() for l in open('$T/export_f')]
+assert len(a) == len(b) == 3000 or len(a) == len(b)
+for p, q in zip(a, b):
+    assert p[:3] == q[:3]
+    assert sum((int(u) - int(v)) ** 2 for u, v in zip(p[3:], q[3:])) ** 0.5 / 255 <= 0.03 + 1e-9
+"
+check "--color-effort takes smallest or fast" sh -c "! '$VDAG' build '$T/in.xyz' '$T/x.vdag' --color-effort best 2>/dev/null"
+mkdir -p "$T/spill"
+check "the colour spill goes to TMPDIR, is reported up front and at the end, and is removed" sh -c "
+    TMPDIR='$T/spill' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 --color-error 0.03 2>'$T/err' &&
+    grep -q 'colour spill: about .* MiB of temporary disk in $T/spill (estimate' '$T/err' &&
+    grep -q 'colour spill: .* MiB of temporary disk in $T/spill ('\$(wc -l <'$T/expected_export')' colours)' '$T/err' &&
+    [ -z \"\$(ls -A '$T/spill')\" ]"
+check "an unusable TMPDIR fails with one line naming it" sh -c "
+    ! TMPDIR='$T/none' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 2 ] && grep -q '$T/none' '$T/err'"
+
 # -- symmetry off gives the same voxels; the same input gives the same bytes
 check "build --no-symmetry" "$VDAG" build "$T/in.xyz" "$T/n.vdag" --levels 5 --no-symmetry 2>/dev/null
 "$VDAG" export-voxels "$T/n.vdag" >"$T/export_n" 2>/dev/null

@@ -206,7 +206,7 @@ static voxdag_status to_voxcolor(voxdag **d, double bound, const voxdag_allocato
     if (!stream) return VOXDAG_ERR_OUT_OF_MEMORY;
     memset(&o, 0, sizeof o);
     o.max_error = bound;
-    len = voxcolor_encode(stream, cap, (const uint8_t *)rgb, size / 3, &o);
+    len = voxcolor_encode(stream, cap, (const uint8_t *)rgb, size / 3, &o, NULL);
     require(len > 0, "voxcolor_encode failed");
     st = voxdag_with_colors(*d, VOXDAG_COLORS_VOXCOLOR, stream, len, &e, NULL);
     a->free(a->user, stream, cap);
@@ -256,7 +256,7 @@ static void check(const scene *s, const voxdag *d, double bound) {
     require(kind == (!s->colors ? VOXDAG_COLORS_NONE : s->bound ? VOXDAG_COLORS_VOXCOLOR : VOXDAG_COLORS_RGB8),
             "colour kind");
     if (kind == VOXDAG_COLORS_VOXCOLOR) {
-        require(voxcolor_view_init(&view, payload, size) == VOXCOLOR_OK, "voxcolor stream rejected");
+        require(voxcolor_view_init(&view, payload, size, NULL) == VOXCOLOR_OK, "voxcolor stream rejected");
         require(view.count == s->distinct, "voxcolor count");
     }
     for (i = 0; i < s->distinct; i++) {

@@ -2,10 +2,11 @@
      bit 7 clear: an untrusted stream. It is validated; when accepted, every
        colour (up to a cap) is decoded singly and by ranges, which must agree.
      bit 7 set: RGB8 colours to encode with options from bits 0..6 (error
-       bound, metric, weight width, page size). The stream must validate and
-       every decoded colour must be within the bound; the streaming encoder,
-       fed in chunks of a size taken from the input, must make the same
-       bytes.
+       bound, metric, weight width, page size; the effort from the colour
+       count). The stream must validate and every decoded colour must be
+       within the bound; the encoder on 2..4 threads into a buffer of the
+       exact size, and the streaming encoder (on those threads too), fed in
+       chunks of a size taken from the input, must make the same bytes.
    Any violation aborts.
 
    Built with -DFUZZ_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
@@ -25,10 +26,16 @@
 
 static void fuzz_decode(const uint8_t *data, size_t size) {
     voxcolor_view v;
+    voxcolor_error err;
+    voxcolor_status st;
     uint8_t *all, one[3];
     size_t n, i;
-    if (voxcolor_view_init(&v, data, size) != VOXCOLOR_OK) {
+    memset(&err, 0xa5, sizeof err);
+    st = voxcolor_view_init(&v, data, size, &err);
+    require(err.status == st && err.message != NULL, "error report differs from the status");
+    if (st != VOXCOLOR_OK) {
         require(v.count == 0 && v.data == NULL, "rejected view not cleared");
+        require(err.byte_offset <= size, "error offset past the stream");
         return;
     }
     n = v.count < FUZZ_MAX_DECODE ? (size_t)v.count : FUZZ_MAX_DECODE;
@@ -104,10 +111,11 @@ static void fuzz_stream(const uint8_t *rgb, size_t n, const voxcolor_encode_opts
     fuzz_sink k;
     k.p = (uint8_t *)malloc(size);
     k.size = size;
-    voxcolor_encoder_init(enc, n, o, fuzz_write, &k);
+    require(voxcolor_encoder_init(enc, n, o, fuzz_write, &k, NULL) == VOXCOLOR_OK, "encoder_init");
     for (at = 0; at < n; at += chunk)
-        require(voxcolor_encoder_push(enc, rgb + 3 * at, n - at < chunk ? n - at : chunk), "push");
-    require(voxcolor_encoder_finish(enc) == size && memcmp(k.p, expect, size) == 0,
+        require(voxcolor_encoder_push(enc, rgb + 3 * at, n - at < chunk ? n - at : chunk) == VOXCOLOR_OK,
+                "push");
+    require(voxcolor_encoder_finish(enc, NULL) == size && memcmp(k.p, expect, size) == 0,
             "streamed and one-shot streams differ");
     free(k.p);
     free(enc);
@@ -125,9 +133,18 @@ static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
     if (o.metric == VOXCOLOR_METRIC_CIELAB) o.max_error *= 20; /* delta E units */
     o.weight_bits = ((sel >> 4) & 3) == 3 ? 0 : (sel >> 4) & 3;
     o.page_shift = (sel >> 6) & 1 ? 4 : 0;
-    len = voxcolor_encode(s, cap, rgb, n, &o);
+    o.effort = n & 1 ? VOXCOLOR_EFFORT_FAST : VOXCOLOR_EFFORT_SMALLEST;
+    len = voxcolor_encode(s, cap, rgb, n, &o, NULL);
     require(len > 0 && len <= cap, "encode failed");
-    require(voxcolor_view_init(&v, s, len) == VOXCOLOR_OK, "own stream rejected");
+    /* Threads change nothing; neither does a buffer of the exact size. */
+    {
+        uint8_t *t = (uint8_t *)malloc(len);
+        o.threads = 2 + (uint32_t)(n >> 1) % 3;
+        require(voxcolor_encode(t, len, rgb, n, &o, NULL) == len && memcmp(t, s, len) == 0,
+                "threads change the stream");
+        free(t);
+    }
+    require(voxcolor_view_init(&v, s, len, NULL) == VOXCOLOR_OK, "own stream rejected");
     require(v.count == n, "count");
     fuzz_stream(rgb, n, &o, s, len);
     voxcolor_view_get_range(&v, 0, n, d);

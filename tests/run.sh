@@ -36,6 +36,7 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
     total_fail=$((total_fail + f))
 }
 run unit "$build/test" $unit_args
+run voxcolor-ndebug "$build/test_voxcolor_ndebug"
 run cli sh tests/cli.sh "$build/vdag"
 run fuzz-import "$build/fuzz_import" $sweep tests/data/fuzz/import
 run fuzz-voxcolor "$build/fuzz_voxcolor" $sweep tests/data/fuzz/voxcolor

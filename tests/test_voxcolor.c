@@ -64,7 +64,7 @@ static size_t encode_new(const uint8_t *rgb, size_t n, const voxcolor_encode_opt
                          uint8_t **out) {
     size_t cap = voxcolor_encode_bound(n), size;
     *out = (uint8_t *)malloc(cap);
-    size = voxcolor_encode(*out, cap, rgb, n, o);
+    size = voxcolor_encode(*out, cap, rgb, n, o, NULL);
     return size;
 }
 
@@ -104,8 +104,9 @@ static void ref_endpoint(const uint8_t *data, uint64_t *pos, int prec, int out[3
 }
 
 /* Decodes a whole valid stream block by block into OUT; returns the number
-   of blocks per mode in MODES[0..5] (may be NULL). */
-static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6]) {
+   of blocks per mode in MODES[0..5] and of blocks with endpoints per
+   precision in PRECISIONS[0..1] (RGB565, RGB888); both may be NULL. */
+static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6], size_t precisions[2]) {
     int ps = s[6], wide = s[7] & 1, ib = ps > 8 ? 2 : 1;
     uint64_t count = ref_le(s + 8, 8), pages = count ? ((count - 1) >> ps) + 1 : 0;
     const uint8_t *data = s + 24 + pages * (wide ? 8 : 4);
@@ -132,6 +133,7 @@ static void ref_decode(const uint8_t *s, uint8_t *out, size_t modes[6]) {
             len = last + 1 - first;
             first += len;
             if (modes) modes[mode]++;
+            if (precisions && mode != 5) precisions[prec]++;
             if (mode == 5) {
                 for (j = 0; j < len; j++, i++)
                     for (k = 0; k < 3; k++) out[3 * i + k] = (uint8_t)ref_bits(data, &pos, 8);
@@ -164,10 +166,10 @@ static void check_roundtrip(const uint8_t *rgb, size_t n, const voxcolor_encode_
     voxcolor_view v;
     double worst = 0, bound = o ? o->max_error : 0;
     CHECK_MSG(size > 0, "%s", what);
-    CHECK_MSG(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK, "%s", what);
+    CHECK_MSG(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_OK, "%s", what);
     CHECK(v.count == n);
     voxcolor_view_get_range(&v, 0, n, a);
-    ref_decode(s, r, NULL);
+    ref_decode(s, r, NULL, NULL);
     for (i = 0; i < n; i++) {
         double e = rgb_error(rgb + 3 * i, a + 3 * i);
         voxcolor_view_get(&v, i, b + 3 * i);
@@ -237,7 +239,7 @@ static void test_options(void) {
             check_roundtrip(c, 9000, &o, what);
             size = encode_new(c, 9000, &o, &s);
             CHECK(size > 0 && s[6] == shift);
-            ref_decode(s, d, modes);
+            ref_decode(s, d, modes, NULL);
             for (m = 1; m <= 4; m++)
                 if (bits && m != bits) CHECK_MSG(modes[m] == 0, "%s: mode %zu used", what, m);
             free(s);
@@ -252,7 +254,7 @@ static void test_lossless(void) {
         uint8_t *c = make_colors(kind, 5000, 3), *s, *d = (uint8_t *)malloc(3 * 5000);
         size_t size = encode_new(c, 5000, NULL, &s);
         voxcolor_view v;
-        CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+        CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_OK);
         voxcolor_view_get_range(&v, 0, 5000, d);
         CHECK_MSG(memcmp(c, d, 3 * 5000) == 0, "%s not exact", kind_names[kind]);
         free(c);
@@ -294,7 +296,7 @@ static void test_cielab(void) {
         o.max_error = bounds[k];
         o.metric = VOXCOLOR_METRIC_CIELAB;
         size = encode_new(c, 6000, &o, &s);
-        CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+        CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_OK);
         voxcolor_view_get_range(&v, 0, 6000, d);
         for (i = 0; i < 6000; i++) {
             double a[3], b[3];
@@ -395,7 +397,7 @@ static void test_bound_and_small_buffers(void) {
             o.page_shift = shift;
             cap = voxcolor_encode_bound(n);
             s = (uint8_t *)malloc(cap);
-            size = voxcolor_encode(s, cap, c, n, &o);
+            size = voxcolor_encode(s, cap, c, n, &o, NULL);
             CHECK_MSG(size > 0 && size <= cap, "n=%zu size=%zu cap=%zu", n, size, cap);
             free(s);
         }
@@ -407,7 +409,7 @@ static void test_bound_and_small_buffers(void) {
     free(s);
     for (cap = 0; cap < need; cap += 1 + cap / 8) {
         uint8_t *b = (uint8_t *)malloc(cap ? cap : 1);
-        CHECK(voxcolor_encode(cap ? b : NULL, cap, c, 200, NULL) == 0);
+        CHECK(voxcolor_encode(cap ? b : NULL, cap, c, 200, NULL, NULL) == 0);
         free(b);
     }
     free(c);
@@ -445,7 +447,7 @@ static void test_golden(void) {
         0, 0, 0, 0, 0, 0, 0, 0, /* closing zero bytes */
     };
     uint8_t buf[128];
-    size_t size = voxcolor_encode(buf, sizeof buf, rgb, 3, NULL);
+    size_t size = voxcolor_encode(buf, sizeof buf, rgb, 3, NULL, NULL);
     CHECK(size == sizeof expect);
     CHECK(size == sizeof expect && memcmp(buf, expect, size) == 0);
     CHECK(VOXCOLOR_OFF_COUNT == 8 && VOXCOLOR_OFF_DATA_SIZE == 16 && VOXCOLOR_HEADER_SIZE == 24);
@@ -495,7 +497,7 @@ static void test_handmade_stream(void) {
     size_t size = handmade(s, 2, 0, 3, 0, 0);
     CHECK(size == 24 + 4 + 15 + 8);
     unsigned m;
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_OK);
     voxcolor_view_get_range(&v, 0, 5, out);
     CHECK(out[0] == 255 && out[1] == 0 && out[2] == 0);
     /* weight 2 of 2 bits = round(64 * 2 / 3) = 43: (e0 * 21 + e1 * 43 + 32) >> 6 */
@@ -506,26 +508,26 @@ static void test_handmade_stream(void) {
     /* Each defect alone is rejected. */
     for (m = 6; m < 8; m++) {
         size = handmade(s, m, 0, 3, 0, 0);
-        CHECK_MSG(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT, "mode %u", m);
+        CHECK_MSG(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT, "mode %u", m);
     }
     size = handmade(s, 2, 1, 3, 0, 0);
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 4, 0, 0); /* blocks of 4 and 1: payloads do not match */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 6, 0, 0); /* last colours 5 then 4: not growing */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 5, 0, 0); /* last colours 4 and 4 */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 1, 0); /* 9 closing bytes */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 0, 1); /* page table points past the start */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 0, 0);
     s[28 + 14] |= 0x80; /* a padding bit */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
     size = handmade(s, 2, 0, 3, 0, 0);
     s[size - 1] = 1; /* a closing byte */
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_ERR_CORRUPT);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_ERR_CORRUPT);
 }
 
 // -- Untrusted input
@@ -561,7 +563,7 @@ static void test_mutations(void) {
             uint8_t *t = (uint8_t *)malloc(cut ? cut : 1);
             voxcolor_view v;
             memcpy(t, s, cut);
-            CHECK_MSG(voxcolor_view_init(&v, cut ? t : NULL, cut) != VOXCOLOR_OK, "cut %zu", cut);
+            CHECK_MSG(voxcolor_view_init(&v, cut ? t : NULL, cut, NULL) != VOXCOLOR_OK, "cut %zu", cut);
             free(t);
         }
         {
@@ -569,7 +571,7 @@ static void test_mutations(void) {
             voxcolor_view v;
             memcpy(t, s, size);
             t[size] = 0;
-            CHECK(voxcolor_view_init(&v, t, size + 1) == VOXCOLOR_ERR_TRAILING);
+            CHECK(voxcolor_view_init(&v, t, size + 1, NULL) == VOXCOLOR_ERR_TRAILING);
             free(t);
         }
         for (i = 0; i < size; i++) {
@@ -585,7 +587,7 @@ static void test_mutations(void) {
                 else if (patch[p] == 0x1ff) t[i] = 0xff;
                 else t[i] = (uint8_t)(t[i] + patch[p]);
                 if (memcmp(t, s, size) == 0) continue;
-                if (voxcolor_view_init(&v, t, size) == VOXCOLOR_OK) {
+                if (voxcolor_view_init(&v, t, size, NULL) == VOXCOLOR_OK) {
                     accepted++;
                     decode_all(&v);
                 }
@@ -609,7 +611,7 @@ static void test_rejects_garbage(void) {
         uint8_t *t = (uint8_t *)malloc(size);                              \
         memcpy(t, s, size);                                                \
         t[off] = (uint8_t)(val);                                           \
-        CHECK(voxcolor_view_init(&v, t, size) == (expect));                \
+        CHECK(voxcolor_view_init(&v, t, size, NULL) == (expect));                \
         free(t);                                                           \
     } while (0)
     WITH(0, 'W', VOXCOLOR_ERR_BAD_MAGIC);
@@ -621,7 +623,7 @@ static void test_rejects_garbage(void) {
     WITH(15, 0x80, VOXCOLOR_ERR_TRUNCATED); /* 2^63 colours */
     WITH(23, 0x80, VOXCOLOR_ERR_TRUNCATED); /* 2^63 data bytes */
 #undef WITH
-    CHECK(voxcolor_view_init(&v, NULL, 0) == VOXCOLOR_ERR_TRUNCATED);
+    CHECK(voxcolor_view_init(&v, NULL, 0, NULL) == VOXCOLOR_ERR_TRUNCATED);
     CHECK(v.count == 0 && v.data == NULL);
     /* Random bytes behind a plausible header. */
     for (i = 0; i < 3000; i++) {
@@ -636,7 +638,7 @@ static void test_rejects_garbage(void) {
         for (k = 0; k < 8; k++) buf[8 + k] = (uint8_t)(count >> (8 * k));
         if (n < 24 + 4 * pages) continue;
         for (k = 0; k < 8; k++) buf[16 + k] = (uint8_t)((n - 24 - 4 * pages) >> (8 * k));
-        if (voxcolor_view_init(&v, buf, n) == VOXCOLOR_OK) decode_all(&v);
+        if (voxcolor_view_init(&v, buf, n, NULL) == VOXCOLOR_OK) decode_all(&v);
     }
     for (i = 0; i < VOXCOLOR_STATUS_COUNT; i++)
         CHECK(strlen(voxcolor_status_string((voxcolor_status)i)) > 0);
@@ -663,9 +665,9 @@ static void test_wide_table(void) {
         memcpy(t + 24 + 8 * i, s + 24 + 4 * i, 4);
     }
     memcpy(t + 24 + 8 * pages, s + 24 + 4 * pages, size - 24 - 4 * pages);
-    CHECK(voxcolor_view_init(&v, s, size) == VOXCOLOR_OK);
+    CHECK(voxcolor_view_init(&v, s, size, NULL) == VOXCOLOR_OK);
     voxcolor_view_get_range(&v, 0, 1000, a);
-    CHECK(voxcolor_view_init(&v, t, size + 4 * pages) == VOXCOLOR_OK && v.wide == 1);
+    CHECK(voxcolor_view_init(&v, t, size + 4 * pages, NULL) == VOXCOLOR_OK && v.wide == 1);
     voxcolor_view_get_range(&v, 0, 1000, b);
     CHECK(memcmp(a, b, 3000) == 0);
     free(s);
@@ -716,15 +718,15 @@ static uint64_t stream_encode(const uint8_t *rgb, size_t n, const voxcolor_encod
     uint64_t seed = n + chunk, size;
     size_t at = 0;
     memset(k, 0, sizeof *k);
-    voxcolor_encoder_init(enc, n, o, sink_write, k);
+    voxcolor_encoder_init(enc, n, o, sink_write, k, NULL);
     k->data_offset = k->data_end = (size_t)voxcolor_encoder_data_offset(enc);
     while (at < n) {
         size_t m = chunk ? chunk : test_rand_below(&seed, 700);
         if (m > n - at) m = n - at;
-        if (!voxcolor_encoder_push(enc, rgb + 3 * at, m)) break;
+        if (voxcolor_encoder_push(enc, rgb + 3 * at, m) != VOXCOLOR_OK) break;
         at += m;
     }
-    size = voxcolor_encoder_finish(enc);
+    size = voxcolor_encoder_finish(enc, NULL);
     free(enc);
     return size;
 }
@@ -782,24 +784,24 @@ static void test_stream_failures(void) {
         int ok = 1;
         memset(&k, 0, sizeof k);
         k.fail_at = fail;
-        voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k);
-        ok &= voxcolor_encoder_push(enc, rgb, 12345);
-        ok &= voxcolor_encoder_push(enc, rgb + 3 * 12345, 30000 - 12345);
+        voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k, NULL);
+        ok &= voxcolor_encoder_push(enc, rgb, 12345) == VOXCOLOR_OK;
+        ok &= voxcolor_encoder_push(enc, rgb + 3 * 12345, 30000 - 12345) == VOXCOLOR_OK;
         CHECK(ok == (k.calls < fail)); /* failed exactly when a write failed */
-        CHECK_MSG(voxcolor_encoder_finish(enc) == 0, "write %zu of %zu failed", fail, calls);
+        CHECK_MSG(voxcolor_encoder_finish(enc, NULL) == 0, "write %zu of %zu failed", fail, calls);
         free(k.bytes);
         free(k.written);
     }
     memset(&k, 0, sizeof k);
-    voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k);
-    CHECK(voxcolor_encoder_push(enc, rgb, 29999));
-    CHECK(voxcolor_encoder_finish(enc) == 0);
+    voxcolor_encoder_init(enc, 30000, NULL, sink_write, &k, NULL);
+    CHECK(voxcolor_encoder_push(enc, rgb, 29999) == VOXCOLOR_OK);
+    CHECK(voxcolor_encoder_finish(enc, NULL) == 0);
     free(k.bytes);
     free(k.written);
     /* Above 2^30 colours the page table has 8-byte entries. */
-    voxcolor_encoder_init(enc, (1ull << 30) + 1, NULL, sink_write, &k);
+    voxcolor_encoder_init(enc, (1ull << 30) + 1, NULL, sink_write, &k, NULL);
     CHECK(voxcolor_encoder_data_offset(enc) == 24 + 8 * ((1ull << 22) + 1));
-    voxcolor_encoder_init(enc, 1ull << 30, NULL, sink_write, &k);
+    voxcolor_encoder_init(enc, 1ull << 30, NULL, sink_write, &k, NULL);
     CHECK(voxcolor_encoder_data_offset(enc) == 24 + 4 * (1ull << 22));
     free(enc);
     free(rgb);
@@ -808,9 +810,288 @@ static void test_stream_failures(void) {
 static void test_empty(void) {
     uint8_t buf[64];
     voxcolor_view v;
-    size_t size = voxcolor_encode(buf, sizeof buf, NULL, 0, NULL);
+    size_t size = voxcolor_encode(buf, sizeof buf, NULL, 0, NULL, NULL);
     CHECK(size == 24 + 8);
-    CHECK(voxcolor_view_init(&v, buf, size) == VOXCOLOR_OK && v.count == 0);
+    CHECK(voxcolor_view_init(&v, buf, size, NULL) == VOXCOLOR_OK && v.count == 0);
+}
+
+// -- Options and errors
+
+/* Every out-of-range option, and every NULL pointer the calls do not allow,
+   gives VOXCOLOR_ERR_INVALID_ARGUMENT with a message: from voxcolor_encode
+   (nothing written to the buffer), voxcolor_encoder_init (then push and
+   finish fail and nothing is written) and voxcolor_view_init. The same
+   sweep runs under NDEBUG (tests/test_voxcolor_ndebug.c). */
+static int count_writes(void *user, uint64_t offset, const void *bytes, size_t size) {
+    (void)offset, (void)bytes, (void)size;
+    ++*(size_t *)user;
+    return 1;
+}
+
+static void test_invalid_options(void) {
+    uint8_t *c = make_colors(KIND_TEXTURE, 1000, 21), *buf;
+    size_t cap = voxcolor_encode_bound(1000), i, k;
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    voxcolor_error err;
+    voxcolor_view v;
+    buf = (uint8_t *)malloc(cap);
+    for (i = 0;; i++) {
+        voxcolor_encode_opts o;
+        size_t writes = 0;
+        memset(&o, 0, sizeof o);
+        switch (i) {
+        case 0: o.page_shift = 99; break;
+        case 1: o.page_shift = 2; break;
+        case 2: o.page_shift = 3; break;
+        case 3: o.page_shift = 11; break;
+        case 4: o.weight_bits = 5; break;
+        case 5: o.weight_bits = 0xffffffffu; break;
+        case 6: o.metric = (voxcolor_metric)2; break;
+        case 7: o.metric = (voxcolor_metric)-1; break;
+        case 8: o.max_error = -0.01; break;
+        case 9: o.max_error = NAN; break;
+        case 10: o.max_error = -INFINITY; break;
+        case 11: o.effort = (voxcolor_effort)2; break;
+        case 12: o.zero_begin = 1; break;
+        case 13: o.zero_end = 0xdeadbeef; break;
+        default: break;
+        }
+        if (i > 13) break;
+        memset(buf, 0xa5, cap);
+        memset(&err, 0, sizeof err);
+        CHECK_MSG(voxcolor_encode(buf, cap, c, 1000, &o, &err) == 0, "option case %zu accepted", i);
+        CHECK_MSG(err.status == VOXCOLOR_ERR_INVALID_ARGUMENT && err.message && *err.message, "case %zu", i);
+        for (k = 0; k < cap && buf[k] == 0xa5; k++) continue;
+        CHECK_MSG(k == cap, "case %zu wrote to the buffer", i);
+        CHECK(voxcolor_encode(buf, cap, c, 1000, &o, NULL) == 0); /* ERR may be NULL */
+        memset(&err, 0, sizeof err);
+        CHECK(voxcolor_encoder_init(enc, 1000, &o, count_writes, &writes, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+        CHECK(err.status == VOXCOLOR_ERR_INVALID_ARGUMENT && err.message);
+        CHECK(voxcolor_encoder_push(enc, c, 1000) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+        CHECK(voxcolor_encoder_finish(enc, &err) == 0 && err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+        CHECK_MSG(writes == 0, "case %zu: the encoder wrote", i);
+    }
+    /* An infinite bound is valid: every colour fits. */
+    {
+        voxcolor_encode_opts o;
+        memset(&o, 0, sizeof o);
+        o.max_error = INFINITY;
+        CHECK(voxcolor_encode(buf, cap, c, 1000, &o, &err) > 0 && err.status == VOXCOLOR_OK);
+    }
+    /* NULL pointers. */
+    CHECK(voxcolor_encode(NULL, 100, c, 10, NULL, &err) == 0 && err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encode(buf, cap, NULL, 10, NULL, &err) == 0 && err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encode(buf, cap, NULL, 0, NULL, &err) == 32 && err.status == VOXCOLOR_OK);
+    CHECK(voxcolor_encode(buf, 31, c, 0, NULL, &err) == 0 && err.status == VOXCOLOR_ERR_BUFFER_TOO_SMALL);
+    CHECK(voxcolor_encoder_init(NULL, 10, NULL, count_writes, NULL, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encoder_init(enc, 10, NULL, NULL, NULL, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encoder_push(NULL, c, 10) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encoder_finish(NULL, &err) == 0 && err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_encoder_data_offset(NULL) == 0);
+    {
+        size_t writes = 0;
+        CHECK(voxcolor_encoder_init(enc, 10, NULL, count_writes, &writes, &err) == VOXCOLOR_OK);
+        CHECK(voxcolor_encoder_push(enc, NULL, 0) == VOXCOLOR_OK);
+        CHECK(voxcolor_encoder_push(enc, NULL, 5) == VOXCOLOR_ERR_INVALID_ARGUMENT);
+        CHECK(voxcolor_encoder_push(enc, c, 5) == VOXCOLOR_ERR_INVALID_ARGUMENT); /* sticky */
+        CHECK(voxcolor_encoder_finish(enc, &err) == 0 && err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+        CHECK(voxcolor_encoder_init(enc, 10, NULL, count_writes, &writes, &err) == VOXCOLOR_OK);
+        CHECK(voxcolor_encoder_push(enc, c, 11) == VOXCOLOR_ERR_INVALID_ARGUMENT); /* more than declared */
+        CHECK(voxcolor_encoder_init(enc, 10, NULL, count_writes, &writes, &err) == VOXCOLOR_OK);
+        CHECK(voxcolor_encoder_push(enc, c, 9) == VOXCOLOR_OK);
+        CHECK(voxcolor_encoder_finish(enc, &err) == 0 && err.status == VOXCOLOR_ERR_INCOMPLETE);
+    }
+    CHECK(voxcolor_view_init(NULL, buf, 32, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT &&
+          err.status == VOXCOLOR_ERR_INVALID_ARGUMENT);
+    CHECK(voxcolor_view_init(&v, NULL, 32, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT && v.count == 0);
+    free(enc);
+    free(buf);
+    free(c);
+}
+
+/* A stream that fails to validate says where: offsets from FORMAT.md. */
+static void test_error_offsets(void) {
+    static const uint8_t rgb[9] = {0x12, 0x34, 0x56, 0x12, 0x34, 0x56, 0x12, 0x34, 0x56};
+    uint8_t s[64], t[65];
+    voxcolor_view v;
+    voxcolor_error err;
+    size_t size = voxcolor_encode(s, sizeof s, rgb, 3, NULL, &err);
+    CHECK(size == 42 && err.status == VOXCOLOR_OK);
+    CHECK(voxcolor_view_init(&v, s, size, &err) == VOXCOLOR_OK && err.status == VOXCOLOR_OK);
+#define EXPECT(stream, n, st, off)                                                          \
+    do {                                                                                    \
+        memset(&err, 0, sizeof err);                                                        \
+        CHECK(voxcolor_view_init(&v, stream, n, &err) == (st));                             \
+        CHECK_MSG(err.status == (st) && err.message && err.byte_offset == (uint64_t)(off), \
+                  "%s at %llu", err.message ? err.message : "-",                            \
+                  (unsigned long long)err.byte_offset);                                     \
+    } while (0)
+    EXPECT(s, 20, VOXCOLOR_ERR_TRUNCATED, 20); /* the stream's end */
+    EXPECT(s, size - 1, VOXCOLOR_ERR_TRUNCATED, size - 1);
+    memcpy(t, s, size);
+    t[size] = 0;
+    EXPECT(t, size + 1, VOXCOLOR_ERR_TRAILING, size); /* the first byte after the data */
+    memcpy(t, s, size);
+    t[1] = 'Y';
+    EXPECT(t, size, VOXCOLOR_ERR_BAD_MAGIC, 0);
+    memcpy(t, s, size);
+    t[4] = 4;
+    EXPECT(t, size, VOXCOLOR_ERR_VERSION, 4);
+    memcpy(t, s, size);
+    t[6] = 99;
+    EXPECT(t, size, VOXCOLOR_ERR_CORRUPT, 6);
+    memcpy(t, s, size);
+    t[7] = 2;
+    EXPECT(t, size, VOXCOLOR_ERR_CORRUPT, 7);
+    /* Block data from byte 28: block count, group end, the mode nibble at 30. */
+    memcpy(t, s, size);
+    t[30] = 0x0e; /* mode 6 */
+    EXPECT(t, size, VOXCOLOR_ERR_CORRUPT, 30);
+    memcpy(t, s, size);
+    t[30] = 0x88; /* a nonzero nibble after the last block's */
+    EXPECT(t, size, VOXCOLOR_ERR_CORRUPT, 30);
+    memcpy(t, s, size);
+    t[size - 3] = 1; /* a closing byte */
+    EXPECT(t, size, VOXCOLOR_ERR_CORRUPT, size - 3);
+#undef EXPECT
+}
+
+// -- Threads and effort
+
+/* A host thread pool: runs the jobs on the calling thread, last first, and
+   counts the calls and jobs. */
+typedef struct host_pool {
+    size_t runs, jobs;
+} host_pool;
+
+static void host_run(void *user, voxcolor_job_fn job, void *job_user, uint32_t count) {
+    host_pool *p = (host_pool *)user;
+    uint32_t i;
+    p->runs++;
+    p->jobs += count;
+    for (i = count; i--;) job(job_user, i);
+}
+
+/* Any thread count, the host's pool and the built-in one, one-shot and
+   streamed, give the serial encoder's bytes; so does a buffer of the exact
+   size (smaller batches), and one byte less fails cleanly. */
+static void test_threads_identical(void) {
+    static const size_t counts[] = {0, 5, 256, 257, 3000, 70000};
+    static const uint32_t threads[] = {2, 3, 8, 200};
+    static const double bounds[] = {0, 0.025, 0.1};
+    uint8_t *rgb = make_colors(KIND_TEXTURE, 70000, 31);
+    size_t c, b, t, shift;
+    for (c = 0; c < sizeof counts / sizeof counts[0]; c++)
+        for (b = 0; b < sizeof bounds / sizeof bounds[0]; b++)
+            for (shift = 4; shift <= 10; shift += 3) {
+                voxcolor_encode_opts o;
+                uint8_t *one, *par;
+                size_t n = counts[c], size, cap = voxcolor_encode_bound(n), got;
+                host_pool hp;
+                sink k;
+                voxcolor_error err;
+                memset(&o, 0, sizeof o);
+                o.max_error = bounds[b];
+                o.page_shift = (uint32_t)shift;
+                size = encode_new(rgb, n, &o, &one);
+                par = (uint8_t *)malloc(cap + 1);
+                for (t = 0; t < sizeof threads / sizeof threads[0]; t++) {
+                    o.threads = threads[t];
+                    got = voxcolor_encode(par, cap, rgb, n, &o, NULL);
+                    CHECK_MSG(got == size && memcmp(par, one, size) == 0, "n=%zu e_t=%g shift=%zu threads=%u", n,
+                              bounds[b], shift, threads[t]);
+                }
+                o.threads = 2;
+                /* The exact size: the parallel scratch shrinks to what is left. */
+                got = voxcolor_encode(par, size, rgb, n, &o, NULL);
+                CHECK_MSG(got == size && memcmp(par, one, size) == 0, "n=%zu shift=%zu exact buffer", n, shift);
+                got = voxcolor_encode(par, size - 1, rgb, n, &o, &err);
+                CHECK(got == 0 && err.status == VOXCOLOR_ERR_BUFFER_TOO_SMALL);
+                memset(&hp, 0, sizeof hp);
+                o.threads = 0;
+                o.thread_pool.run = host_run;
+                o.thread_pool.user = &hp;
+                got = voxcolor_encode(par, cap, rgb, n, &o, NULL);
+                CHECK_MSG(got == size && memcmp(par, one, size) == 0, "n=%zu shift=%zu host pool", n, shift);
+                if (n >= 3000) CHECK_MSG(hp.runs > 0 && hp.jobs >= 2 * hp.runs, "n=%zu: pool unused", n);
+                /* Streamed with the host's pool and with 3 threads, in chunks. */
+                got = stream_encode(rgb, n, &o, n > 1000 ? 1000 + shift : 0, &k);
+                CHECK_MSG(got == size && memcmp(k.bytes, one, size) == 0 && k.disorder == 0 && k.overlaps == 0,
+                          "n=%zu shift=%zu streamed, host pool", n, shift);
+                free(k.bytes);
+                free(k.written);
+                memset(&o.thread_pool, 0, sizeof o.thread_pool);
+                o.threads = 3;
+                got = stream_encode(rgb, n, &o, n, &k);
+                CHECK_MSG(got == size && memcmp(k.bytes, one, size) == 0 && k.disorder == 0 && k.overlaps == 0,
+                          "n=%zu shift=%zu streamed, 3 threads", n, shift);
+                free(k.bytes);
+                free(k.written);
+                free(par);
+                free(one);
+            }
+    free(rgb);
+}
+
+/* A failing write stops a parallel streaming encoder too. */
+static void test_threads_write_failure(void) {
+    uint8_t *rgb = make_colors(KIND_NOISY, 200000, 12);
+    voxcolor_encoder *enc = (voxcolor_encoder *)malloc(sizeof *enc);
+    voxcolor_encode_opts o;
+    voxcolor_error err;
+    size_t calls, fail;
+    sink k;
+    memset(&o, 0, sizeof o);
+    o.max_error = 0.02;
+    o.threads = 2;
+    stream_encode(rgb, 200000, &o, 200000, &k);
+    calls = k.calls;
+    free(k.bytes);
+    free(k.written);
+    CHECK(calls > 3);
+    for (fail = 1; fail <= calls; fail++) {
+        memset(&k, 0, sizeof k);
+        k.fail_at = fail;
+        CHECK(voxcolor_encoder_init(enc, 200000, &o, sink_write, &k, NULL) == VOXCOLOR_OK);
+        voxcolor_encoder_push(enc, rgb, 200000);
+        CHECK_MSG(voxcolor_encoder_finish(enc, &err) == 0 && err.status == VOXCOLOR_ERR_WRITE, "write %zu of %zu",
+                  fail, calls);
+        CHECK_MSG(k.calls == fail, "write %zu of %zu failed, then %zu calls", fail, calls, k.calls);
+        free(k.bytes);
+        free(k.written);
+    }
+    free(enc);
+    free(rgb);
+}
+
+/* The fast effort keeps the bound, uses one endpoint precision per stream,
+   and equals the default where the default tries only one. */
+static void test_effort(void) {
+    static const double bounds[] = {0, 0.01, 0.02, 0.025, 0.03, 0.038, 0.05, 0.1};
+    uint8_t *c = make_colors(KIND_TEXTURE, 20000, 17);
+    size_t k;
+    for (k = 0; k < sizeof bounds / sizeof bounds[0]; k++) {
+        voxcolor_encode_opts o;
+        uint8_t *fast, *def, *d = (uint8_t *)malloc(3 * 20000);
+        size_t sf, sd, fp[2] = {0, 0}, dp[2] = {0, 0};
+        char what[64];
+        memset(&o, 0, sizeof o);
+        o.max_error = bounds[k];
+        sd = encode_new(c, 20000, &o, &def);
+        o.effort = VOXCOLOR_EFFORT_FAST;
+        snprintf(what, sizeof what, "fast e_t=%g", bounds[k]);
+        check_roundtrip(c, 20000, &o, what);
+        sf = encode_new(c, 20000, &o, &fast);
+        ref_decode(fast, d, NULL, fp);
+        ref_decode(def, d, NULL, dp);
+        CHECK_MSG(!fp[0] || !fp[1], "%s: both precisions", what);
+        if (!dp[0] || !dp[1]) CHECK_MSG(sf == sd && memcmp(fast, def, sd) == 0, "%s differs", what);
+        else CHECK_MSG(sf >= sd, "%s smaller than the default", what);
+        free(fast);
+        free(def);
+        free(d);
+    }
+    free(c);
 }
 
 // -- 2D mapping
@@ -872,5 +1153,10 @@ const test_case test_voxcolor_cases[] = {
     {"voxcolor/stream_failures", test_stream_failures},
     {"voxcolor/empty", test_empty},
     {"voxcolor/morton2d", test_morton2d},
+    {"voxcolor/invalid_options", test_invalid_options},
+    {"voxcolor/error_offsets", test_error_offsets},
+    {"voxcolor/threads_identical", test_threads_identical},
+    {"voxcolor/threads_write_failure", test_threads_write_failure},
+    {"voxcolor/effort", test_effort},
     {NULL, NULL},
 };
