@@ -119,6 +119,7 @@ typedef struct build_args {
     uint32_t color_bits; /* 0: auto */
     struct color_spill *spill;
     double t0;              /* when the command started */
+    size_t input_items;     /* triangles or points read */
     const char *last_stage; /* progress printed last */
     int last_percent;
 } build_args;
@@ -480,6 +481,10 @@ static int cmd_build(int argc, char **argv) {
     memset(&limits, 0, sizeof limits);
     limits.skip_textures = a.no_colors; /* no colours kept: nothing to decode them for */
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    if (!sc.triangle_count && !sc.point_count)
+        fprintf(stderr, "vdag: warning: %s holds no triangles and no points (lines are not voxelized): "
+                        "the result has no voxels\n", a.in);
+    a.input_items = sc.triangle_count ? sc.triangle_count : sc.point_count;
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);
@@ -519,6 +524,9 @@ static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxd
         return 1;
     }
     print_build_summary(dag, &st, seconds);
+    if (!st.voxels && a->input_items)
+        fprintf(stderr, "vdag: warning: %s gave no voxels (its triangles or points lie outside the grid, "
+                        "or are degenerate)\n", a->in);
     rc = voxdag_save_file(dag, a->out, err) != VOXDAG_OK;
     voxdag_free(dag);
     if (rc) return vdag_fail("%s: %s", a->out, err->message);

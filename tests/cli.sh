@@ -125,6 +125,59 @@ printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemt
 check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
 check "--no-colors skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors 2>'$T/err' && ! grep -q warning '$T/err'"
 
+# -- more formats: STL (ASCII and binary) give the same square; a float .xyz
+# is a point cloud fitted into the grid (voxel = floor((p - lo) * 2^L / extent),
+# the top face clamped), computed here
+python3 - "$T" <<'EOF'
+import struct, sys
+t = sys.argv[1]
+tris = [((0, 0, 0), (8, 0, 0), (8, 8, 0)), ((0, 0, 0), (8, 8, 0), (0, 8, 0))]
+with open(t + "/sq_a.stl", "w") as f:
+    f.write("solid sq\n")
+    for tri in tris:
+        f.write("facet normal 0 0 1\nouter loop\n" + "".join("vertex %g %g %g\n" % v for v in tri) + "endloop\nendfacet\n")
+    f.write("endsolid sq\n")
+with open(t + "/sq_b.stl", "wb") as f:
+    f.write(b"solid written by a CAD tool".ljust(80, b" ") + struct.pack("<I", len(tris)))
+    for tri in tris:
+        f.write(struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *v) for v in tri) + b"\0\0")
+pts = [(0.5, 1.25, -2.0), (3.75, 0.0, 1.5), (1.0, 2.5, 0.25), (2.0, 2.0, 2.0), (0.0, 0.0, 0.0)]
+with open(t + "/pts.xyz", "w") as f:
+    for p in pts:
+        f.write("%r %r %r 0.0 0.0 1.0\n" % p)
+lo = [min(p[k] for p in pts) for k in range(3)]
+ext = max(max(p[k] for p in pts) - lo[k] for k in range(3))
+n = 16
+vox = sorted(set(tuple(min(n - 1, int((p[k] - lo[k]) * n / ext)) for k in range(3)) for p in pts))
+open(t + "/pts_expected", "w").write("".join("%d %d %d\n" % v for v in vox))
+EOF
+for f in sq_a sq_b; do
+    check "build $f.stl" "$VDAG" build "$T/$f.stl" "$T/$f.vdag" --levels 3 2>/dev/null
+    check "$f.stl is the 8x8 layer z = 0" sh -c "'$VDAG' export-voxels '$T/$f.vdag' | cut -d' ' -f1-3 >'$T/$f.got' &&
+        python3 -c \"
+got = [tuple(map(int, l.split())) for l in open('$T/$f.got')]
+assert sorted(got) == sorted((x, y, 0) for x in range(8) for y in range(8)), got[:5]
+\""
+done
+check "build a float .xyz point cloud" "$VDAG" build "$T/pts.xyz" "$T/pts.vdag" --levels 4 2>/dev/null
+check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | sort >'$T/pts.got' &&
+    sort '$T/pts_expected' | cmp -s - '$T/pts.got'"
+
+# -- inputs that give nothing: a warning, or an error that says why
+: >"$T/empty.obj"
+check "an empty .obj warns that nothing is voxelized" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'warning:.*no triangles and no points' '$T/err'"
+printf 'AC3Db\nMATERIAL "m" rgb 1 1 1\nOBJECT world\nkids 1\nOBJECT poly\nnumvert 2\n0 0 0\n1 1 1\nnumsurf 1\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 0 0\nkids 0\n' >"$T/lines.ac"
+check "an .ac file of lines only warns" sh -c "'$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'warning:.*no triangles' '$T/err'"
+python3 -c "open('$T/wide.obj', 'wb').write('v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n'.encode('utf-16'))"
+check "a UTF-16 .obj is refused as such" sh -c "! '$VDAG' build '$T/wide.obj' '$T/e.vdag' 2>'$T/err' &&
+    grep -q 'UTF-16' '$T/err'"
+printf '\357\273\277AC3Db\nMATERIAL "m" rgb 1 0 0\nOBJECT world\nkids 0\n' >"$T/bom.ac"
+check "an .ac file with a UTF-8 BOM is read" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 2>/dev/null
+mkdir "$T/adir.obj"
+check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.vdag' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
+
 # -- the demo scene generator
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
