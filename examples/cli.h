@@ -20,6 +20,12 @@ void vdag_close(vdag_file *f);
 /* Colour of voxel INDEX (white when the file has no colours). Thread-safe. */
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]);
 
+/* The box of the occupied voxels, BOX = x0 y0 z0 x1 y1 z1 in grid units,
+   half-open; all zero when the DAG has no voxel. Returns 1 when it has one.
+   The one place the tool learns it: computed by visiting every voxel until
+   the library records the box in the file. */
+int vdag_voxel_box(const voxdag *dag, uint32_t box[6]);
+
 /* Prints "vdag: MESSAGE" on stderr; returns 1 (the failing exit status). */
 int vdag_fail(const char *fmt, ...);
 

@@ -7,8 +7,11 @@
      looks along normalize(f + sx r + sy u) with s = tan(fov / 2),
      sx = (2 (i + 0.5) / W - 1) s W / H and sy = (1 - 2 (j + 0.5) / H) s.
      Rays start at the eye with t in [0, inf), so t is a distance.
-   - Default camera: target the grid's centre, eye along (1, -1.4, 0.9) from
-     it, far enough that the grid's bounding sphere fits the picture.
+   - Axes: z up, as every built file has them (vdag build --up).
+   - Default camera, a three-quarter view of the occupied voxels: target the
+     centre of their box (vdag_voxel_box; the whole grid when there is no
+     voxel), eye along (1, -1.4, 0.9) from it, far enough that the box's
+     bounding sphere fits the narrower field of view.
    - Shading: colour x (AMBIENT + (1 - AMBIENT) max(0, n . l)) with n the
      entry face normal and l = normalize(LIGHT); the voxel a ray starts in
      gets factor 1. With --shadows, a lit face whose shadow ray towards l is
@@ -275,6 +278,7 @@ int vdag_cmd_render(int argc, char **argv) {
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, secs;
     int have_eye = 0, have_target = 0, i, k;
+    uint32_t box[6];
     unsigned threads, t;
     pthread_t tid[64];
     if (argc < 3) return vdag_fail(usage);
@@ -313,11 +317,15 @@ int vdag_cmd_render(int argc, char **argv) {
     job.file = &f;
     job.levels = info.levels;
     job.cam.s = tan(fov * 3.14159265358979323846 / 360);
+    if (!vdag_voxel_box(f.dag, box)) /* empty: the whole grid */
+        for (k = 0; k < 3; k++) box[k] = 0, box[k + 3] = 1u << info.levels;
     if (!have_target)
-        for (k = 0; k < 3; k++) target[k] = (double)(1u << info.levels) / 2;
-    if (!have_eye) { /* the grid's bounding sphere fits the narrower field of view */
+        for (k = 0; k < 3; k++) target[k] = ((double)box[k] + box[k + 3]) / 2;
+    if (!have_eye) { /* the bounding sphere of the occupied box fits the narrower field of view */
         double dir[3] = {1, -1.4, 0.9}, s = job.cam.s * (job.cam.w < job.cam.h ? (double)job.cam.w / job.cam.h : 1);
-        double dist = sqrt(3.0) / 2 * (1u << info.levels) * sqrt(1 + 1 / (s * s));
+        double r = 0, dist;
+        for (k = 0; k < 3; k++) r += ((double)box[k + 3] - box[k]) * ((double)box[k + 3] - box[k]) / 4;
+        dist = sqrt(r) * sqrt(1 + 1 / (s * s));
         normalize3(dir);
         for (k = 0; k < 3; k++) eye[k] = target[k] + dist * dir[k];
     }

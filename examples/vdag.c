@@ -87,6 +87,22 @@ void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]) {
     else if (!voxdag_color(f->dag, index, rgb)) rgb[0] = rgb[1] = rgb[2] = 255;
 }
 
+static int grow_box(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    uint32_t *box = (uint32_t *)user, v[3];
+    int k;
+    v[0] = x, v[1] = y, v[2] = z;
+    for (k = 0; k < 3; k++) {
+        if (!index || v[k] < box[k]) box[k] = v[k];
+        if (!index || v[k] + 1 > box[k + 3]) box[k + 3] = v[k] + 1;
+    }
+    return 0;
+}
+
+int vdag_voxel_box(const voxdag *dag, uint32_t box[6]) {
+    memset(box, 0, 6 * sizeof *box);
+    return voxdag_for_each_voxel(dag, grow_box, box) > 0;
+}
+
 static double now_seconds(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -120,6 +136,7 @@ typedef struct build_args {
     struct color_spill *spill;
     double t0;              /* when the command started */
     size_t input_items;     /* triangles or points read */
+    char up;                /* the input's up axis: 'x', 'y', 'z'; 0: the format's default */
     const char *last_stage; /* progress printed last */
     int last_percent;
 } build_args;
@@ -133,6 +150,46 @@ static void progress(void *user, const char *stage, double fraction) {
     a->last_stage = stage;
     a->last_percent = percent;
     fprintf(stderr, "vdag: %s %3d%% (%.1f s)\n", stage, percent, now_seconds() - a->t0);
+}
+
+/* The tool's axes are z up (x right, y away from a viewer in front):
+   renders, the default camera and every built file use them. A file's up
+   axis (--up, or the default of its format) is turned to +z by a rotation:
+   y up: (x, y, z) -> (x, -z, y); x up: (x, y, z) -> (y, z, x). Formats
+   whose usual exporters write y up (.obj, .ply, .off) default to y; .stl
+   (CAD and 3D printing), .xyz and .vox default to z; .spm and .ac are
+   turned to z up by the importer and default to z. */
+static char default_up(const char *path) {
+    const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+    static const char *const y_up[] = {"obj", "ply", "off"};
+    size_t i;
+    for (i = 0; dot && i < sizeof y_up / sizeof y_up[0]; i++) {
+        const char *a = dot + 1, *b = y_up[i];
+        while (*a && (*a | 0x20) == *b) a++, b++;
+        if (!*a && !*b) return 'y';
+    }
+    return 'z';
+}
+
+/* Turns N points (3 doubles each) so that axis UP becomes +z. Voxels
+   (integer cells) flip an axis as max - v, so they stay cells >= 0. */
+static void turn_up(double *p, size_t n, char up, int voxels) {
+    double top = 0;
+    size_t i;
+    if (up == 'z') return;
+    for (i = 0; voxels && up == 'y' && i < n; i++)
+        if (p[3 * i + 2] > top) top = p[3 * i + 2];
+    for (i = 0; i < n; i++) {
+        double x = p[3 * i], y = p[3 * i + 1], z = p[3 * i + 2];
+        if (up == 'y') {
+            p[3 * i + 1] = voxels ? top - z : -z;
+            p[3 * i + 2] = y;
+        } else {
+            p[3 * i] = y;
+            p[3 * i + 1] = z;
+            p[3 * i + 2] = x;
+        }
+    }
 }
 
 /* Points to grid voxels: integer voxels as they are, point clouds and mesh
@@ -450,6 +507,10 @@ static int cmd_build(int argc, char **argv) {
                 return vdag_fail("build: --levels takes 2..%d", VOXDAG_MAX_LEVELS);
         } else if (!strcmp(argv[k], "--threads") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.threads) || !a.threads) return vdag_fail("build: --threads takes a count >= 1");
+        } else if (!strcmp(argv[k], "--up") && k + 1 < argc) {
+            k++;
+            if (strlen(argv[k]) != 1 || !strchr("xyz", argv[k][0])) return vdag_fail("build: --up takes x, y or z");
+            a.up = argv[k][0];
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
@@ -481,6 +542,9 @@ static int cmd_build(int argc, char **argv) {
     memset(&limits, 0, sizeof limits);
     limits.skip_textures = a.no_colors; /* no colours kept: nothing to decode them for */
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    if (!a.up) a.up = default_up(a.in);
+    turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
+    turn_up(sc.positions, sc.vertex_count, a.up, 0);
     if (!sc.triangle_count && !sc.point_count)
         fprintf(stderr, "vdag: warning: %s holds no triangles and no points (lines are not voxelized): "
                         "the result has no voxels\n", a.in);
@@ -544,11 +608,12 @@ static int cmd_info(int argc, char **argv) {
     vdag_file f;
     voxdag_info in;
     int json = argc > 2 && !strcmp(argv[2], "--json");
-    uint32_t l;
+    uint32_t l, box[6];
     double geo_bits;
     if (argc < 2 || argc > 3 || (argc == 3 && !json)) return vdag_fail("usage: vdag info FILE [--json]");
     if (!vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &in);
+    vdag_voxel_box(f.dag, box);
     geo_bits = in.voxels ? 8.0 * (double)(in.node_bytes + in.brick_bytes) / (double)in.voxels : 0.0;
     if (json) {
         printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"nodes_per_level\": [", in.levels,
@@ -561,7 +626,8 @@ static int cmd_info(int argc, char **argv) {
                (unsigned long long)in.brick_bytes, (unsigned long long)in.color_bytes);
         printf("\"bits_per_voxel\": %.6f, \"color_format\": \"%s\", \"color_bits_per_voxel\": %.6f", geo_bits,
                color_kind_name(in.color_kind), in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
-        if (in.has_bounds)
+        printf(", \"voxel_box\": [%u, %u, %u, %u, %u, %u]", box[0], box[1], box[2], box[3], box[4], box[5]);
+        if (in.has_bounds) /* the grid's world box */
             printf(", \"bounds\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]", in.bounds[0], in.bounds[1],
                    in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
         printf("}\n");
@@ -579,9 +645,18 @@ static int cmd_info(int argc, char **argv) {
                (unsigned long long)in.color_bytes,
                in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
         printf("file        %llu bytes\n", (unsigned long long)in.file_bytes);
-        if (in.has_bounds)
-            printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0], in.bounds[1], in.bounds[2],
-                   in.bounds[3], in.bounds[4], in.bounds[5]);
+        if (in.voxels)
+            printf("occupied    voxels (%u, %u, %u) - (%u, %u, %u), grid units, half-open\n", box[0], box[1], box[2],
+                   box[3], box[4], box[5]);
+        if (in.has_bounds) {
+            double cell = (in.bounds[3] - in.bounds[0]) / (double)(1u << in.levels);
+            printf("grid world box  (%g, %g, %g) - (%g, %g, %g), the source's units\n", in.bounds[0], in.bounds[1],
+                   in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
+            if (in.voxels)
+                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0] + cell * box[0],
+                       in.bounds[1] + cell * box[1], in.bounds[2] + cell * box[2], in.bounds[0] + cell * box[3],
+                       in.bounds[1] + cell * box[4], in.bounds[2] + cell * box[5]);
+        }
     }
     vdag_close(&f);
     return 0;

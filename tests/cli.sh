@@ -110,7 +110,7 @@ check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1
 
 # -- meshes: an axis-aligned square fitted into the grid fills one or two layers
 printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 0 8 0 1 0 0\nf 1 2 3\nf 1 3 4\n' >"$T/square.obj"
-check "build a coloured .obj" "$VDAG" build "$T/square.obj" "$T/sq.vdag" --levels 3 2>/dev/null
+check "build a coloured .obj" "$VDAG" build "$T/square.obj" "$T/sq.vdag" --levels 3 --up z 2>/dev/null
 check "the square is the 8x8 layer z = 0, red" sh -c "'$VDAG' export-voxels '$T/sq.vdag' | python3 -c \"
 import sys
 v = [tuple(map(int, l.split())) for l in sys.stdin]
@@ -149,7 +149,7 @@ lo = [min(p[k] for p in pts) for k in range(3)]
 ext = max(max(p[k] for p in pts) - lo[k] for k in range(3))
 n = 16
 vox = sorted(set(tuple(min(n - 1, int((p[k] - lo[k]) * n / ext)) for k in range(3)) for p in pts))
-open(t + "/pts_expected", "w").write("".join("%d %d %d\n" % v for v in vox))
+open(t + "/pts_expected", "w").write("".join(sorted("%d %d %d\n" % v for v in vox)))
 EOF
 for f in sq_a sq_b; do
     check "build $f.stl" "$VDAG" build "$T/$f.stl" "$T/$f.vdag" --levels 3 2>/dev/null
@@ -160,8 +160,74 @@ assert sorted(got) == sorted((x, y, 0) for x in range(8) for y in range(8)), got
 \""
 done
 check "build a float .xyz point cloud" "$VDAG" build "$T/pts.xyz" "$T/pts.vdag" --levels 4 2>/dev/null
-check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | sort >'$T/pts.got' &&
-    sort '$T/pts_expected' | cmp -s - '$T/pts.got'"
+check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/pts_expected'"
+
+# -- orientation: z up; a file's up axis (--up, default per format) is turned
+# to +z: y up (x, y, z) -> (x, -z, y), x up (x, y, z) -> (y, z, x); the
+# expected voxels are the rotated points fitted into the grid, computed here
+python3 - "$T" <<'EOF'
+import sys
+t = sys.argv[1]
+pts = [(0.5, 1.25, -2.0), (3.75, 0.0, 1.5), (1.0, 2.5, 0.25), (2.0, 2.0, 2.0), (0.0, 0.0, 0.0), (0.0, 7.0, 0.5)]
+with open(t + "/up.xyz", "w") as f:
+    for p in pts:
+        f.write("%r %r %r\n" % p)
+turn = {"x": lambda p: (p[1], p[2], p[0]), "y": lambda p: (p[0], -p[2], p[1]), "z": lambda p: p}
+for up, rot in turn.items():
+    q = [rot(p) for p in pts]
+    lo = [min(p[k] for p in q) for k in range(3)]
+    ext = max(max(p[k] for p in q) - lo[k] for k in range(3))
+    vox = sorted(set(tuple(min(15, int((p[k] - lo[k]) * 16 / ext)) for k in range(3)) for p in q))
+    open(t + "/up_" + up, "w").write("".join(sorted("%d %d %d\n" % v for v in vox)))
+EOF
+for up in x y z; do
+    check "build --up $up turns that axis to +z" sh -c "'$VDAG' build '$T/up.xyz' '$T/up.vdag' --levels 4 --up $up 2>/dev/null &&
+        '$VDAG' export-voxels '$T/up.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/up_$up'"
+done
+check "a float .xyz defaults to z up" sh -c "'$VDAG' build '$T/up.xyz' '$T/up.vdag' --levels 4 2>/dev/null &&
+    '$VDAG' export-voxels '$T/up.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/up_z'"
+check "--up takes x, y or z" sh -c "! '$VDAG' build '$T/up.xyz' '$T/up.vdag' --up w 2>/dev/null"
+printf 'v 0 0 0\nv 8 0 0\nv 8 8 0\nv 0 8 0\nf 1 2 3\nf 1 3 4\n' >"$T/upsq.obj"
+check "an .obj defaults to y up: its x-y square stands as the layer y = 0" sh -c "
+    '$VDAG' build '$T/upsq.obj' '$T/upsq.vdag' --levels 3 2>/dev/null && '$VDAG' export-voxels '$T/upsq.vdag' | python3 -c \"
+import sys
+v = sorted(tuple(map(int, l.split()[:3])) for l in sys.stdin)
+assert v == sorted((x, 0, z) for x in range(8) for z in range(8)), v[:5]
+\""
+
+# -- framing: a small model in a large grid fills the default view (more
+# than a tenth of the pixels), and is not clipped (no border pixel covered)
+python3 -c "
+with open('$T/small.xyz', 'w') as f:
+    for x in range(4):
+        for y in range(4):
+            for z in range(6):
+                f.write('%d %d %d\n' % (150 + x, 90 + y, 20 + z))"
+"$VDAG" build "$T/small.xyz" "$T/small.vdag" --levels 8 2>/dev/null
+check "info --json gives the occupied voxel box" sh -c "'$VDAG' info '$T/small.vdag' --json | python3 -c \"
+import json, sys
+assert json.load(sys.stdin)['voxel_box'] == [150, 90, 20, 154, 94, 26]
+\""
+check "info names the grid world box and the occupied box" sh -c "'$VDAG' info '$T/sq.vdag' >'$T/info.txt' &&
+    grep -q '^grid world box' '$T/info.txt' && grep -q '^occupied' '$T/info.txt' && ! grep -q '^bounds' '$T/info.txt'"
+check "render: the default camera frames the occupied voxels" sh -c "'$VDAG' render '$T/small.vdag' '$T/small.png' --size 64x48 2>/dev/null &&
+    python3 -c \"
+import struct, zlib
+b = open('$T/small.png', 'rb').read()
+w, h = struct.unpack('>II', b[16:24])
+at, idat = 8, b''
+while at < len(b):
+    n, = struct.unpack('>I', b[at:at + 4])
+    if b[at + 4:at + 8] == b'IDAT':
+        idat += b[at + 8:at + 8 + n]
+    at += 12 + n
+raw = zlib.decompress(idat)
+row = 1 + 3 * w
+cover = [[raw[y * row + 1 + 3 * x:y * row + 4 + 3 * x] != bytes((205, 218, 235)) for x in range(w)] for y in range(h)]
+frac = sum(map(sum, cover)) / float(w * h)
+assert frac > 0.1, frac
+assert not any(cover[0]) and not any(cover[-1]) and not any(r[0] or r[-1] for r in cover), 'clipped'
+\""
 
 # -- inputs that give nothing: a warning, or an error that says why
 : >"$T/empty.obj"
