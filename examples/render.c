@@ -25,6 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <errno.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -182,6 +184,7 @@ typedef struct render_job {
     uint8_t *rgb;
     uint32_t tiles_x, tiles, next, done;
     int last_percent;
+    int tty; /* progress on stderr, a terminal */
     pthread_mutex_t lock;
 } render_job;
 
@@ -244,7 +247,7 @@ static void *render_worker(void *arg) {
                 render_pixel(job, x, y, job->rgb + 3 * ((size_t)y * job->cam.w + x));
         pthread_mutex_lock(&job->lock);
         percent = (int)(100.0 * ++job->done / job->tiles);
-        if (percent / 10 != job->last_percent / 10) {
+        if (job->tty && percent / 10 != job->last_percent / 10) { /* in place, on a terminal only */
             job->last_percent = percent;
             fprintf(stderr, "\rrender: %3d%%", percent);
         }
@@ -272,12 +275,12 @@ static int parse_numbers(int argc, char **argv, int *i, double *out, int count) 
 
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS]";
+                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet]";
     render_job job;
     vdag_file f;
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, secs;
-    int have_eye = 0, have_target = 0, i, k;
+    int have_eye = 0, have_target = 0, quiet = 0, i, k;
     uint32_t box[6];
     unsigned threads, t;
     pthread_t tid[64];
@@ -308,13 +311,16 @@ int vdag_cmd_render(int argc, char **argv) {
             if (!parse_numbers(argc, argv, &i, &lod, 1) || lod < 0) return vdag_fail("render: --lod takes pixels >= 0");
         } else if (!strcmp(a, "--shadows")) {
             job.shadows = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
         } else {
             return vdag_fail("render: unknown option '%s' (%s)", a, usage);
         }
     }
-    if (!vdag_open(argv[1], &f)) return 1;
+    if (!vdag_check_output(argv[1], argv[2]) || !vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &info);
     job.file = &f;
+    job.tty = !quiet && isatty(2);
     job.levels = info.levels;
     job.cam.s = tan(fov * 3.14159265358979323846 / 360);
     if (!vdag_voxel_box(f.dag, box)) /* empty: the whole grid */
@@ -363,12 +369,14 @@ int vdag_cmd_render(int argc, char **argv) {
     while (t > 0) pthread_join(tid[--t], NULL);
     secs = seconds_now() - t0;
     pthread_mutex_destroy(&job.lock);
-    fprintf(stderr, "\rrender: %ux%u in %.3f s, %.2f Mrays/s (%u threads)\n", job.cam.w, job.cam.h, secs,
-            (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6, threads);
+    if (!quiet)
+        fprintf(stderr, "%srender: %ux%u in %.3f s, %.2f Mrays/s (%u threads)\n", job.tty ? "\r" : "", job.cam.w,
+                job.cam.h, secs, (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6, threads);
+    errno = 0;
     if (!write_png(argv[2], job.rgb, job.cam.w, job.cam.h)) {
         free(job.rgb);
         vdag_close(&f);
-        return vdag_fail("render: cannot write %s", argv[2]);
+        return vdag_fail("render: cannot write %s (%s)", argv[2], errno ? strerror(errno) : "write error");
     }
     free(job.rgb);
     vdag_close(&f);

@@ -248,6 +248,45 @@ check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
 
+# -- help, version, progress, safety
+for c in build info validate lookup rays render export-voxels gen; do
+    check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
+done
+check "every build and render option in --help with its default" sh -c "
+    for o in --levels --up --no-symmetry --color-error --color-bits --no-colors --chunk-levels --threads --force --stats --quiet; do
+        '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
+    for o in --size --eye --target --fov --shadows --lod --threads; do
+        '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
+    '$VDAG' render --help | grep -- '--eye' | grep -q 'grid units' && '$VDAG' lookup --help | grep -q 'grid units' &&
+    '$VDAG' rays --help | grep -q 'grid units'"
+check "vdag --version" sh -c "'$VDAG' --version | grep -q '^vdag [0-9]*\.[0-9]*\.[0-9]*'"
+cp "$T/in.xyz" "$T/keep.xyz"
+check "build refuses to write over its input, also by another name" sh -c "
+    ! '$VDAG' build '$T/keep.xyz' '$T/keep.xyz' 2>'$T/err' && grep -q 'is the input' '$T/err' &&
+    ! '$VDAG' build '$T/keep.xyz' '$T/./keep.xyz' 2>/dev/null && ln -s keep.xyz '$T/alias.xyz' &&
+    ! '$VDAG' build '$T/keep.xyz' '$T/alias.xyz' 2>/dev/null && cmp -s '$T/keep.xyz' '$T/in.xyz'"
+check "render refuses to write over its input" sh -c "! '$VDAG' render '$T/a.vdag' '$T/a.vdag' 2>/dev/null && '$VDAG' validate '$T/a.vdag' 2>/dev/null"
+check "a directory as output or as a .vdag says so" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T' 2>'$T/err' && grep -q 'is a directory' '$T/err' &&
+    ! '$VDAG' info '$T' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
+check "write and open errors carry the OS reason" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T/no/such/dir.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
+    ! '$VDAG' info '$T/none.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
+    ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && grep -q 'No such file or directory' '$T/err'"
+check "progress into a pipe: plain lines, no carriage return, a few lines" sh -c "
+    '$VDAG' build '$T/demo.xyz' '$T/p.vdag' --color-error 0.02 2>&1 >/dev/null | tee '$T/log' >/dev/null &&
+    ! grep -q \"\$(printf '\\r')\" '$T/log' && [ \$(wc -l <'$T/log') -le 30 ]"
+check "--quiet: nothing on stderr" sh -c "'$VDAG' build '$T/demo.xyz' '$T/p.vdag' --quiet 2>'$T/err' && [ ! -s '$T/err' ] &&
+    '$VDAG' render '$T/p.vdag' '$T/p.png' --size 8x8 --quiet 2>'$T/err' && [ ! -s '$T/err' ]"
+printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 4 4 8 0 1 0\nf 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' >"$T/tetra.obj"
+check "a small coloured mesh builds in a few MiB (builder peak < 8 MiB at 2^10)" sh -c "
+    '$VDAG' build '$T/tetra.obj' '$T/tetra.vdag' --threads 2 2>'$T/err' &&
+    awk '/ peak / { for (i = 1; i <= NF; i++) if (\$i == \"peak\") v = \$(i + 1) } END { exit !(v != \"\" && v + 0 < 8) }' '$T/err'"
+check "--chunk-levels takes 2..8, and does not change the file" sh -c "! '$VDAG' build '$T/tetra.obj' '$T/t.vdag' --chunk-levels 9 2>/dev/null &&
+    '$VDAG' build '$T/tetra.obj' '$T/t8.vdag' --chunk-levels 8 2>/dev/null && cmp -s '$T/t8.vdag' '$T/tetra.vdag'"
+check "a build estimated past the machine's memory needs --force" sh -c "
+    ! timeout 60 '$VDAG' build '$T/tetra.obj' '$T/huge.vdag' --levels 21 2>'$T/err' && grep -q -- '--force' '$T/err' && [ ! -e '$T/huge.vdag' ]"
+
 # -- vdag rays / vdag render: answers from an independent python3 oracle
 # Scene: 400 random voxels in 16^3; rays along the axes (unit and non-unit
 # directions) from outside the grid and from inside voxels, whose first hit,
