@@ -1,5 +1,5 @@
 # voxdag: examples, tests, demo and benchmarks.
-#   make          build the vdag tool (build/vdag)
+#   make          build the vdag tool (build/vdag; installs libstb-dev when missing)
 #   make test     install missing test packages, run every test
 #   make test-full the same with exhaustive mutation sweeps (long)
 #   make check-all build matrix, link/symbol checks, determinism (in make test)
@@ -16,17 +16,17 @@ THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 HEADERS := voxdag.h voxcolor.h
 
-VDAG_SRC := examples/vdag.c examples/import.c examples/render.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c examples/import.c
+VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c tests/test_image.c examples/import.c examples/image_stb.c
 
-# Texture decoding (examples/image.h): OpenImageIO when installed, compiled
-# with $(CXX) and linked with the C++ driver; else a stub. These are expanded
-# when a recipe runs, so `make test` sees what `make deps` just installed.
-OIIO       = $(shell pkg-config --exists OpenImageIO 2>/dev/null && echo 1)
-IMAGE_CC   = $(if $(OIIO),$(CXX) -std=c++14 $(shell pkg-config --cflags OpenImageIO) examples/image_oiio.cpp,$(CC) $(CSTD) examples/image_none.c)
-IMAGE_LIBS = $(if $(OIIO),$(shell pkg-config --libs OpenImageIO))
-LINK       = $(if $(OIIO),$(CXX),$(CC))
-IMAGE_DEPS := examples/image.h examples/image_oiio.cpp examples/image_none.c
+# Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
+# libstb-dev, a header compiled into the tool: nothing at run time. `make`
+# installs the package when the header is missing (examples/deps.sh).
+STB_IMAGE := /usr/include/stb/stb_image.h
+# The tests keep OpenImageIO as the reference decoder (tests/oiio_ref.cpp,
+# compiled with $(CXX); the test program links with the C++ driver).
+OIIO_CFLAGS = $(shell pkg-config --cflags OpenImageIO)
+OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO)
 
 .PHONY: all test deps demo bench clean
 
@@ -35,29 +35,30 @@ all: $(BUILD)/vdag
 $(BUILD):
 	@mkdir -p $(BUILD)
 
+$(STB_IMAGE):
+	@sh examples/deps.sh
+
 # Objects: $(BUILD)/opt for the tool, $(BUILD)/san (sanitizers) for tests.
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h tests/count_alloc.h tests/import_test.h $(wildcard examples/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/opt/image.o: $(IMAGE_DEPS)
+$(BUILD)/opt/examples/image_stb.o $(BUILD)/san/examples/image_stb.o: $(STB_IMAGE)
+$(BUILD)/san/oiio_ref.o: tests/oiio_ref.cpp tests/oiio_ref.h
 	@mkdir -p $(@D)
-	$(IMAGE_CC) $(WARN) $(OPT) -c -o $@
-$(BUILD)/san/image.o: $(IMAGE_DEPS)
-	@mkdir -p $(@D)
-	$(IMAGE_CC) $(WARN) -O1 -g $(SAN) -c -o $@
+	$(CXX) -std=c++14 $(OIIO_CFLAGS) $(WARN) -O1 -g $(SAN) -c -o $@ tests/oiio_ref.cpp
 
 # import.c includes import_scene.c (.spm and .ac share its helpers).
 $(BUILD)/opt/examples/import.o $(BUILD)/san/examples/import.o: examples/import_scene.c
 
-$(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o) $(BUILD)/opt/image.o
-	$(LINK) $(OPT) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
+$(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o)
+	$(CC) $(OPT) -o $@ $^ $(THREADS) -lm
 
 # Tests run with AddressSanitizer and UndefinedBehaviorSanitizer.
-$(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/image.o
-	$(LINK) $(SAN) -o $@ $^ $(IMAGE_LIBS) $(THREADS) -lm
+$(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/oiio_ref.o
+	$(CXX) $(SAN) -o $@ $^ $(OIIO_LIBS) $(THREADS) -lm
 
 # voxcolor's option and argument checks in a release build (-DNDEBUG),
 # sanitized: they must not be asserts.

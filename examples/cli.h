@@ -20,6 +20,20 @@ void vdag_close(vdag_file *f);
 /* Colour of voxel INDEX (white when the file has no colours). Thread-safe. */
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]);
 
+/* The box of the occupied voxels, BOX = x0 y0 z0 x1 y1 z1 in grid units,
+   half-open; all zero when the DAG has no voxel (the file's voxel box).
+   Returns 1 when it has one. */
+int vdag_voxel_box(const voxdag *dag, uint32_t box[6]);
+
+/* Checks that OUT may be written: not a directory, and not the file IN
+   (also under another name: same device and inode). Returns 1, or 0 after
+   printing why. IN may be NULL. */
+int vdag_check_output(const char *in, const char *out);
+
+/* When ARGV (a command's arguments, ARGV[0] its name) holds --help or -h:
+   prints COMMAND's usage, options and defaults on stdout and returns 1. */
+int vdag_help(const char *command, int argc, char **argv);
+
 /* Prints "vdag: MESSAGE" on stderr; returns 1 (the failing exit status). */
 int vdag_fail(const char *fmt, ...);
 

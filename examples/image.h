@@ -1,7 +1,8 @@
-/* Texture images for the vdag tool: decodes a file (PNG, JPEG, ... as the
-   build supports) to 8-bit RGB. Two implementations: image_oiio.cpp uses
-   OpenImageIO; image_none.c, used when OpenImageIO is not installed, always
-   fails with "texture decoding not built in". */
+/* Texture images for the vdag tool: decodes a file (PNG, JPEG, TGA, BMP,
+   PNM) to 8-bit RGB and alpha. Two implementations: image_stb.c (the tool's,
+   with stb_image) and image_none.c (programs that read no texture: the
+   importer fuzz target and benchmarks), which always fails with "texture
+   decoding not built in". */
 #ifndef VDAG_IMAGE_H
 #define VDAG_IMAGE_H
 
@@ -17,11 +18,12 @@ extern "C" {
 
 typedef struct vdag_image {
     uint32_t width, height;
-    uint8_t *rgb; /* width*height*3 bytes, rows top to bottom */
+    uint8_t *rgb;   /* width*height*3 bytes, rows top to bottom */
+    uint8_t *alpha; /* width*height bytes, or NULL when every texel is opaque */
 } vdag_image;
 
-/* Reads the image at PATH into OUT (grey images become RGB; alpha and extra
-   channels are dropped). Returns 1 on success; 0 with a one-line reason in
+/* Reads the image at PATH into OUT (grey images become RGB; alpha is kept
+   when some texel is not opaque; 16-bit channels are cut to 8 bits). Returns 1 on success; 0 with a one-line reason in
    ERR (when err_size > 0) and OUT zeroed otherwise. Release with
    vdag_image_free. Thread-safe. */
 int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size);

@@ -1,4 +1,4 @@
-/* Texture decoding left out of the build (OpenImageIO was not found). */
+/* Texture decoding left out (programs that read no texture). */
 #include "image.h"
 
 #include <stdio.h>
@@ -6,7 +6,7 @@
 
 int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size) {
     out->width = out->height = 0;
-    out->rgb = NULL;
+    out->rgb = out->alpha = NULL;
     if (err_size) snprintf(err, err_size, "%s: texture decoding not built in", path);
     return 0;
 }
@@ -14,6 +14,7 @@ int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_siz
 void vdag_image_free(vdag_image *image) {
     if (!image) return;
     free(image->rgb);
-    image->rgb = NULL;
+    free(image->alpha);
+    image->rgb = image->alpha = NULL;
     image->width = image->height = 0;
 }

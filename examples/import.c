@@ -2,8 +2,10 @@
    top of shared helpers: error messages, growable arrays, a text cursor and a
    bounds-checked binary reader. Every size read from a file is checked
    against the bytes that remain before anything is allocated for it. */
+#define _POSIX_C_SOURCE 200809L /* fileno, fstat */
 #include "import.h"
 
+#include <sys/stat.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -72,6 +74,19 @@ static int vi_fail(vi_ctx *c, const char *fmt, ...) {
     vsnprintf(c->err + n, c->err_size - (size_t)n, fmt, ap);
     va_end(ap);
     return 0;
+}
+
+/* Prints "vdag: warning: FORMAT: message" on stderr unless the limits ask
+   for quiet: for what an import tolerates or leaves out. */
+static void vi_warn(vi_ctx *c, const char *fmt, ...) VI_PRINTF;
+static void vi_warn(vi_ctx *c, const char *fmt, ...) {
+    va_list ap;
+    if (c->limits.quiet) return;
+    fprintf(stderr, "vdag: warning: %s: ", c->format);
+    va_start(ap, fmt);
+    vfprintf(stderr, fmt, ap);
+    va_end(ap);
+    fputc('\n', stderr);
 }
 
 // -- Growable arrays
@@ -210,6 +225,16 @@ static int vi_real(vi_span tok, double *out) {
     return end == buf + n;
 }
 
+/* 1 if TOK is written as a decimal integer: an optional sign, then digits. */
+static int vi_integer_syntax(vi_span tok) {
+    const char *s = tok.s;
+    if (s < tok.e && (*s == '-' || *s == '+')) s++;
+    if (s == tok.e) return 0;
+    for (; s < tok.e; s++)
+        if (*s < '0' || *s > '9') return 0;
+    return 1;
+}
+
 /* Parses TOK as a decimal integer with an optional sign and a magnitude of at
    most 2^62; 0 otherwise. */
 static int vi_int(vi_span tok, int64_t *out) {
@@ -323,25 +348,48 @@ static void vi_set_triangles(vdag_scene *s, vi_buf *tris) {
     tris->data = NULL;
 }
 
-// -- .xyz: one voxel per line, "x y z" or "x y z r g b"
+/* Sets T to the text DATA, past a UTF-8 byte order mark. Text in UTF-16
+   (a UTF-16 byte order mark, or a NUL byte among the first two) is refused
+   with a message that says so. */
+static int vi_text_start(vi_ctx *c, const char *data, size_t size, vi_text *t) {
+    const unsigned char *u = (const unsigned char *)data;
+    t->p = data;
+    t->end = data + size;
+    t->line = 0;
+    if (size >= 3 && u[0] == 0xEF && u[1] == 0xBB && u[2] == 0xBF) t->p += 3;
+    else if (size >= 2 && ((u[0] == 0xFF && u[1] == 0xFE) || (u[0] == 0xFE && u[1] == 0xFF) || !u[0] || !u[1]))
+        return vi_fail(c, "the file is UTF-16 text (or binary); save it as UTF-8 or ASCII");
+    return 1;
+}
 
-/* The first voxel line decides whether the file has colours; every other
-   line must then have the same number of values. */
+// -- .xyz: voxels ("x y z" or "x y z r g b"), or a point cloud
+
+/* Every value is read as a number; the file is a voxel list when every
+   coordinate is written as an integer, else a point cloud. The first data
+   line decides the number of values (3 or 6): every other line must agree.
+   In a voxel list the 4th-6th values are colours (integers 0..255, else an
+   error); in a point cloud they are colours when every one of them is an
+   integer 0..255, else they are ignored (normals, as point-set tools write). */
 static int vi_parse_xyz(vi_ctx *c, vi_text *t, vdag_scene *out) {
-    vi_buf pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
-    int fields = 0;
-    uint64_t first_line = 0;
+    vi_buf pts = {NULL, 0, 0}, extra = {NULL, 0, 0};
+    int fields = 0, integral = 1, extra_rgb = 1;
+    uint64_t first_line = 0, bad_voxel_line = 0, bad_colour_line = 0;
     vi_span line, tok;
+    size_t i;
     while (vi_line(t, &line)) {
-        int64_t v[6];
-        double *p;
-        int i, n = 0;
+        double v[6], *p;
+        int k, n = 0;
         while (vi_tok(&line, &tok)) {
             if (n == 6) goto too_many;
-            if (!vi_int(tok, &v[n++])) {
-                vi_fail(c, "line %llu: value %d is not an integer", (vi_ull)t->line, n);
+            if (!vi_real(tok, &v[n]) || !vi_coord_ok(v[n])) {
+                vi_fail(c, "line %llu: value %d is not a finite number", (vi_ull)t->line, n + 1);
                 goto fail;
             }
+            if (!vi_integer_syntax(tok)) {
+                if (n < 3) integral = 0;
+                else extra_rgb = 0;
+            }
+            n++;
         }
         if (n == 0) continue;
         if (n != 3 && n != 6) goto too_many;
@@ -353,34 +401,47 @@ static int vi_parse_xyz(vi_ctx *c, vi_text *t, vdag_scene *out) {
                     (vi_ull)t->line, n, (vi_ull)first_line, fields);
             goto fail;
         }
-        for (i = 0; i < 3; i++)
-            if (v[i] < 0 || v[i] > (int64_t)UINT32_MAX) {
-                vi_fail(c, "line %llu: coordinate outside 0..4294967295", (vi_ull)t->line);
+        for (k = 0; k < 3; k++) {
+            if (!vi_coord_ok(v[k])) {
+                vi_fail(c, "line %llu: coordinate is not finite or too large", (vi_ull)t->line);
                 goto fail;
             }
-        for (i = 3; i < n; i++)
-            if (v[i] < 0 || v[i] > 255) {
-                vi_fail(c, "line %llu: colour outside 0..255", (vi_ull)t->line);
-                goto fail;
+            if (!bad_voxel_line && (v[k] < 0 || v[k] > (double)UINT32_MAX)) bad_voxel_line = t->line;
+        }
+        for (k = 3; k < n; k++)
+            if (!(v[k] >= 0 && v[k] <= 255 && v[k] == floor(v[k]))) {
+                extra_rgb = 0;
+                if (!bad_colour_line) bad_colour_line = t->line;
             }
         if (!(p = (double *)vi_push(c, &pts, sizeof(double), 3))) goto fail;
-        for (i = 0; i < 3; i++) p[i] = (double)v[i];
+        memcpy(p, v, 3 * sizeof *p);
         if (n == 6) {
-            uint8_t *q = (uint8_t *)vi_push(c, &rgb, 1, 3);
-            if (!q) goto fail;
-            for (i = 0; i < 3; i++) q[i] = (uint8_t)v[3 + i];
+            if (!(p = (double *)vi_push(c, &extra, sizeof(double), 3))) goto fail;
+            memcpy(p, v + 3, 3 * sizeof *p);
         }
     }
-    out->points_are_voxels = 1;
+    if (integral && bad_voxel_line) {
+        vi_fail(c, "line %llu: coordinate outside 0..4294967295", (vi_ull)bad_voxel_line);
+        goto fail;
+    }
+    if (integral && bad_colour_line) {
+        vi_fail(c, "line %llu: colour outside 0..255", (vi_ull)bad_colour_line);
+        goto fail;
+    }
+    if (extra.count && extra_rgb) {
+        if (!(out->point_rgb = (uint8_t *)vi_alloc(c, extra.count, 1))) goto fail;
+        for (i = 0; i < extra.count; i++) out->point_rgb[i] = (uint8_t)((const double *)extra.data)[i];
+    }
+    vi_buf_free(&extra);
+    out->points_are_voxels = integral;
     out->point_count = pts.count / 3;
     out->points = (double *)pts.data;
-    out->point_rgb = (uint8_t *)rgb.data;
     return 1;
 too_many:
     vi_fail(c, "line %llu: expected \"x y z\" or \"x y z r g b\"", (vi_ull)t->line);
 fail:
     vi_buf_free(&pts);
-    vi_buf_free(&rgb);
+    vi_buf_free(&extra);
     return 0;
 }
 
@@ -547,8 +608,8 @@ static int vi_ply_header(vi_ply *p, vi_text *t, vi_buf *elems, vi_buf *props) {
             if ((q->type = vi_ply_type(tok)) < 0)
                 return vi_fail(c, "line %llu: unknown property type", (vi_ull)t->line);
             if (!vi_tok(&line, &q->name)) return vi_fail(c, "line %llu: property has no name", (vi_ull)t->line);
-        } else {
-            return vi_fail(c, "line %llu: unknown header keyword", (vi_ull)t->line);
+        } else { /* e.g. a comment without its keyword, as some exporters write */
+            vi_warn(c, "line %llu: unknown header line skipped", (vi_ull)t->line);
         }
     }
     if (!format) return vi_fail(c, "header has no format line");
@@ -804,6 +865,137 @@ done:
     return ok;
 }
 
+// -- .stl: binary and ASCII triangle soups
+
+/* ASCII: "solid [name]", then facets "facet normal nx ny nz", "outer loop",
+   three or more "vertex x y z" lines, "endloop", "endfacet", and
+   "endsolid [name]"; several solids may follow each other. Keywords in any
+   case; normals are ignored; polygons of more than three vertices are
+   fan-triangulated. */
+static int vi_parse_stl_ascii(vi_ctx *c, vi_text *t, vi_buf *pos, vi_buf *tris) {
+    enum { SOLID, FACET, LOOP, VERTEX, ENDFACET } want = SOLID;
+    vi_span line, kw, tok;
+    uint32_t first = 0, corners = 0;
+    while (vi_line(t, &line)) {
+        if (!vi_tok(&line, &kw)) continue;
+        if (want == SOLID) {
+            if (!vi_is_nocase(kw, "solid"))
+                return vi_fail(c, "line %llu: expected \"solid\"", (vi_ull)t->line);
+            want = FACET;
+        } else if (want == FACET) {
+            if (vi_is_nocase(kw, "endsolid")) {
+                want = SOLID;
+            } else if (!vi_is_nocase(kw, "facet")) {
+                return vi_fail(c, "line %llu: expected \"facet\" or \"endsolid\"", (vi_ull)t->line);
+            } else {
+                want = LOOP;
+            }
+        } else if (want == LOOP) {
+            if (!vi_is_nocase(kw, "outer") || !vi_tok(&line, &tok) || !vi_is_nocase(tok, "loop"))
+                return vi_fail(c, "line %llu: expected \"outer loop\"", (vi_ull)t->line);
+            want = VERTEX;
+            corners = 0;
+            first = (uint32_t)(pos->count / 3);
+        } else if (want == VERTEX && vi_is_nocase(kw, "vertex")) {
+            double *p;
+            int k;
+            if (pos->count / 3 >= VI_NONE - 1) return vi_fail(c, "more than 4294967294 vertices");
+            if (!(p = (double *)vi_push(c, pos, sizeof *p, 3))) return 0;
+            for (k = 0; k < 3; k++)
+                if (!vi_tok(&line, &tok) || !vi_real(tok, &p[k]) || !vi_coord_ok(p[k]))
+                    return vi_fail(c, "line %llu: expected \"vertex x y z\" with finite numbers", (vi_ull)t->line);
+            if (++corners >= 3) {
+                uint32_t *q = (uint32_t *)vi_push(c, tris, sizeof *q, 3);
+                if (!q) return 0;
+                q[0] = first;
+                q[1] = first + corners - 2;
+                q[2] = first + corners - 1;
+            }
+        } else if (want == VERTEX) {
+            if (!vi_is_nocase(kw, "endloop"))
+                return vi_fail(c, "line %llu: expected \"vertex\" or \"endloop\"", (vi_ull)t->line);
+            if (corners < 3) return vi_fail(c, "line %llu: a facet with fewer than 3 vertices", (vi_ull)t->line);
+            want = ENDFACET;
+        } else {
+            if (!vi_is_nocase(kw, "endfacet")) return vi_fail(c, "line %llu: expected \"endfacet\"", (vi_ull)t->line);
+            want = FACET;
+        }
+    }
+    if (want != SOLID) return vi_fail(c, "file ends inside a solid (no \"endsolid\")");
+    return 1;
+}
+
+static vi_span vi_first5(const char *p) {
+    vi_span s;
+    s.s = p;
+    s.e = p + 5;
+    return s;
+}
+
+/* Binary: an 80-byte header, a u32 triangle count, then per triangle a
+   normal (ignored), three vertices (f32 x y z each) and a u16 attribute
+   (ignored), little-endian. A file of exactly that size is binary even
+   when its header starts with "solid" (as some exporters write); any other
+   file starting with "solid" is ASCII. Bytes after the last triangle get a
+   warning. */
+static int vi_parse_stl(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
+    vi_buf pos = {NULL, 0, 0}, tris = {NULL, 0, 0};
+    uint64_t n = size >= 84 ? vi_uint(data + 80, 4, 0) : 0;
+    vi_text t;
+    int ok = 0;
+    size_t i, k;
+    t.p = (const char *)data;
+    t.end = t.p + size;
+    t.line = 0;
+    if (size >= 3 && !memcmp(data, "\xEF\xBB\xBF", 3)) t.p += 3; /* a UTF-8 byte order mark */
+    if (size >= 84 && (uint64_t)size - 84 == 50 * n) {
+        /* binary, exact size */
+    } else if (t.end - t.p >= 5 && vi_is_nocase(vi_first5(t.p), "solid")) {
+        if (!vi_parse_stl_ascii(c, &t, &pos, &tris)) goto done;
+        goto mesh;
+    } else if (size < 84) {
+        return vi_fail(c, "not an STL file (no \"solid\" and shorter than a binary header)");
+    } else if ((uint64_t)size - 84 < 50 * n) {
+        return vi_fail(c, "binary header declares %llu triangles, the file holds %llu", (vi_ull)n,
+                       (vi_ull)((size - 84) / 50));
+    } else {
+        vi_warn(c, "%llu bytes after the last of %llu triangles ignored", (vi_ull)(size - 84 - 50 * n), (vi_ull)n);
+    }
+    if (3 * n >= VI_NONE) return vi_fail(c, "more than 4294967294 vertices");
+    if (!(out->positions = (double *)vi_alloc(c, (size_t)n, 9 * sizeof(double))) ||
+        !(out->indices = (uint32_t *)vi_alloc(c, (size_t)n, 3 * sizeof(uint32_t))))
+        goto done;
+    for (i = 0; i < 3 * (size_t)n; i++) {
+        const uint8_t *v = data + 84 + 50 * (i / 3) + 12 + 12 * (i % 3);
+        for (k = 0; k < 3; k++) {
+            uint32_t w = (uint32_t)vi_uint(v + 4 * k, 4, 0);
+            float f;
+            memcpy(&f, &w, 4);
+            if (!vi_coord_ok(f)) {
+                vi_fail(c, "triangle %llu: coordinate is not finite or too large", (vi_ull)(i / 3));
+                goto done;
+            }
+            out->positions[3 * i + k] = f;
+        }
+        out->indices[i] = (uint32_t)i;
+    }
+    out->vertex_count = 3 * (size_t)n;
+    out->triangle_count = (size_t)n;
+    return 1;
+mesh:
+    out->vertex_count = pos.count / 3;
+    out->positions = (double *)pos.data;
+    pos.data = NULL;
+    out->triangle_count = tris.count / 3;
+    out->indices = (uint32_t *)tris.data;
+    tris.data = NULL;
+    ok = 1;
+done:
+    vi_buf_free(&pos);
+    vi_buf_free(&tris);
+    return ok;
+}
+
 // -- Hash map: 64-bit hash → 32-bit index, equality decided by the caller
 
 typedef struct vi_map_slot {
@@ -871,7 +1063,12 @@ static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) 
     int ok = 1, too_big = 0;
     FILE *f = fopen(path, "rb");
     long known;
+    struct stat st;
     if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
+    if (!fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return vi_fail(c, "is a directory, not a file");
+    }
     /* Reserve the size when it is known, so that big files are not copied. */
     if (!fseek(f, 0, SEEK_END) && (known = ftell(f)) > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
         too_big = (uint64_t)known > c->limits.max_input_bytes;
@@ -1041,7 +1238,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
         s->images[s->image_count] = img;
         e->image = (int32_t)s->image_count++;
     } else {
-        fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
+        if (!c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
     }
     *image = e->image;
     return 1;
@@ -1315,10 +1512,8 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file
     }
     sub.err = o->c->err;
     sub.err_size = o->c->err_size;
-    t.p = data;
-    t.end = data + size;
-    t.line = 0;
-    if (!(dir = vi_dirname(&sub, path)) || !vi_mtl_parse(&sub, &t, &mtls)) goto done;
+    if (!vi_text_start(&sub, data, size, &t) || !(dir = vi_dirname(&sub, path)) || !vi_mtl_parse(&sub, &t, &mtls))
+        goto done;
     for (i = 0; i < mtls.count; i++) {
         const vi_mtl *m = &((const vi_mtl *)mtls.data)[i];
         vi_name_key key;
@@ -1343,7 +1538,7 @@ done:
 static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file) {
     char why[512];
     int r = vi_obj_mtllib(o, out, cache, file, why, sizeof why);
-    if (r < 0) fprintf(stderr, "vdag: warning: %s; its materials stay white\n", why);
+    if (r < 0 && !o->c->limits.quiet) fprintf(stderr, "vdag: warning: %s; its materials stay white\n", why);
     return r != 0;
 }
 
@@ -1671,6 +1866,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     vi_reader r;
     vi_buf models = {NULL, 0, 0}, nodes = {NULL, 0, 0}, hidden = {NULL, 0, 0}, pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
     const uint8_t *b, *palette = NULL;
+    size_t palette_entries = 0;
     uint8_t pal[256][3];
     uint32_t version, n, m, size_xyz[3];
     int have_size = 0, ok = 0;
@@ -1732,11 +1928,12 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             model->count = count;
             model->voxels = vi_take(&body, (size_t)count * 4);
             have_size = 0;
-        } else if (!memcmp(id, "RGBA", 4)) {
-            if (!(palette = vi_take(&body, 1024))) {
-                vi_fail(c, "byte %llu: RGBA chunk too short", (vi_ull)at);
-                goto done;
-            }
+        } else if (!memcmp(id, "RGBA", 4)) { /* 256 entries; shorter ones, as some tools write, are padded */
+            palette = body.data;
+            palette_entries = body.size / 4 < 256 ? body.size / 4 : 256;
+            if (palette_entries < 255) /* entry 255 is never used (colour indices are 1..255) */
+                vi_warn(c, "byte %llu: RGBA chunk of %llu bytes (1024 expected); the missing entries are "
+                           "MagicaVoxel's default colours", (vi_ull)at, (vi_ull)body.size);
         } else if (!memcmp(id, "nTRN", 4) || !memcmp(id, "nGRP", 4) || !memcmp(id, "nSHP", 4)) {
             vi_vox_node *node = (vi_vox_node *)vi_push(c, &nodes, sizeof *node, 1);
             if (!node) goto done;
@@ -1760,11 +1957,8 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     }
 
     /* Colour index k + 1 is palette entry k. */
-    if (palette) {
-        for (i = 0; i < 256; i++) memcpy(pal[i], palette + 4 * i, 3);
-    } else {
-        vi_vox_default_palette(pal);
-    }
+    vi_vox_default_palette(pal);
+    for (i = 0; palette && i < palette_entries; i++) memcpy(pal[i], palette + 4 * i, 3);
     if (nodes.count) {
         const vi_vox_node *sorted = (const vi_vox_node *)nodes.data;
         qsort(nodes.data, nodes.count, sizeof(vi_vox_node), vi_i32_order);
@@ -1814,8 +2008,8 @@ done:
 
 // -- Entry points
 
-enum { VI_XYZ, VI_PLY, VI_OBJ, VI_OFF, VI_VOX, VI_MTL, VI_SPM, VI_AC, VI_FORMAT_COUNT };
-static const char *const vi_formats[VI_FORMAT_COUNT] = {"xyz", "ply", "obj", "off", "vox", "mtl", "spm", "ac"};
+enum { VI_XYZ, VI_PLY, VI_OBJ, VI_OFF, VI_VOX, VI_MTL, VI_SPM, VI_AC, VI_STL, VI_FORMAT_COUNT };
+static const char *const vi_formats[VI_FORMAT_COUNT] = {"xyz", "ply", "obj", "off", "vox", "mtl", "spm", "ac", "stl"};
 
 static int vi_format(const char *ext) {
     vi_span s;
@@ -1833,19 +2027,17 @@ static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_
     int ok;
     memset(out, 0, sizeof *out);
     if (c->err_size) c->err[0] = 0;
-    t.p = data;
-    t.end = data + size;
-    t.line = 0;
-    switch (format) {
-    case VI_XYZ: ok = vi_parse_xyz(c, &t, out); break;
-    case VI_PLY: ok = vi_parse_ply(c, &t, out); break;
-    case VI_OBJ: ok = vi_parse_obj(c, &t, out); break;
-    case VI_OFF: ok = vi_parse_off(c, &t, out); break;
+    switch (format) { /* text formats: past a UTF-8 byte order mark, UTF-16 refused */
+    case VI_XYZ: ok = vi_text_start(c, data, size, &t) && vi_parse_xyz(c, &t, out); break;
+    case VI_PLY: ok = vi_text_start(c, data, size, &t) && vi_parse_ply(c, &t, out); break;
+    case VI_OBJ: ok = vi_text_start(c, data, size, &t) && vi_parse_obj(c, &t, out); break;
+    case VI_OFF: ok = vi_text_start(c, data, size, &t) && vi_parse_off(c, &t, out); break;
     case VI_VOX: ok = vi_parse_vox(c, (const uint8_t *)data, size, out); break;
-    case VI_MTL: ok = vi_parse_mtl(c, &t, out); break;
+    case VI_MTL: ok = vi_text_start(c, data, size, &t) && vi_parse_mtl(c, &t, out); break;
     case VI_SPM: ok = vi_parse_spm(c, (const uint8_t *)data, size, out); break;
-    case VI_AC: ok = vi_parse_ac(c, &t, out); break;
-    default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"); break;
+    case VI_AC: ok = vi_text_start(c, data, size, &t) && vi_parse_ac(c, &t, out); break;
+    case VI_STL: ok = vi_parse_stl(c, (const uint8_t *)data, size, out); break;
+    default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .stl, .vox, .mtl, .spm or .ac)"); break;
     }
     if (ok && out->point_count > c->limits.max_points)
         ok = vi_fail(c, "more than max_points (%llu) points", (vi_ull)c->limits.max_points);

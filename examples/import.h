@@ -1,15 +1,25 @@
-/* Scene importers for the vdag tool: .xyz, .ply, .obj(+.mtl), .off, .vox,
-   and game scenes .spm and .ac (rules in import_scene.c).
+/* Scene importers for the vdag tool: .xyz, .ply, .obj(+.mtl), .off, .stl,
+   .vox, and game scenes .spm and .ac (rules in import_scene.c).
    Every parser reads untrusted bytes: it returns 0 with a message on any
    malformed input, never crashes, and frees what it allocated. Counts read
    from a file are checked against the bytes left before anything is sized
    by them; coordinates must be finite with a magnitude of at most 1e30.
+   Text formats (all but .vox, .spm and binary .stl) may start with a UTF-8
+   byte order mark; UTF-16 text is refused with a message that says so.
+   What an importer tolerates or skips gets a warning on stderr (unless
+   vdag_import_limits.quiet). Coordinates stay in the file's own axes,
+   except where a format's rules below say otherwise.
 
    Formats, and the rules where they leave a choice:
-   - .xyz: "x y z" or "x y z r g b" per line, non-negative integers below
-     2^32 and colours 0..255; '#' starts a comment. The first voxel line
-     decides whether the file has colours: every line must then agree.
-   - .ply: ASCII, binary little- and big-endian; any scalar types. Vertex
+   - .xyz: "x y z" or "x y z r g b" per line; '#' starts a comment. The
+     first data line decides the number of values: every line must agree.
+     When every coordinate is written as an integer the file is a voxel
+     list (integers 0..2^32-1, colours integers 0..255); otherwise (a
+     decimal point or an exponent anywhere) it is a point cloud, and the
+     4th-6th values are colours when all of them are integers 0..255, else
+     they are ignored (normals, as point-set tools write).
+   - .ply: ASCII, binary little- and big-endian; any scalar types. Header
+     lines with an unknown keyword are skipped with a warning. Vertex
      x y z, optional red green blue (integers 0..255, ushort 0..65535, or
      floats 0..1) and s t / u v texture coordinates; face vertex_indices
      (or vertex_index) lists, fan-triangulated. Other elements and
@@ -26,10 +36,17 @@
      that cannot be decoded leaves image = -1 (the Kd colour) and a warning
      on stderr. Faces with texture coordinates give one vertex per distinct
      (v, vt) pair; corners without vt get uv (0, 0). No faces: a point cloud.
+   - .stl: binary (80-byte header, u32 count, 50 bytes per triangle) or
+     ASCII ("solid", facets of "vertex x y z" lines, "endsolid"; keywords in
+     any case, several solids in a row, normals ignored). A file whose size
+     is exactly that of its binary count is binary even when its header
+     starts with "solid", as some exporters write; bytes after the last
+     binary triangle are ignored with a warning. No colours are read.
    - .mtl on its own: every material, in file order.
    - .vox (MagicaVoxel 150 and 200): colour index i is RGBA entry i - 1
      (index 0 is empty); without an RGBA chunk, MagicaVoxel's default
-     palette. With a scene graph (nTRN, nGRP, nSHP from node 0, first
+     palette, which also fills the entries a short RGBA chunk lacks (some
+     tools write 1020 bytes: entry 255 is never used). With a scene graph (nTRN, nGRP, nSHP from node 0, first
      animation frame), each model's centre sits at its transform's origin:
      voxel v fills the cell holding R (v + 1/2 - size/2) + t, rounded down
      where that lands on a cell corner; without one, models keep their own
@@ -63,6 +80,8 @@ typedef struct vdag_import_limits {
     uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
     int skip_textures;        /* 1: do not decode texture images (materials keep
                                  their colours; for callers that need no colours) */
+    int quiet;                /* 1: no warnings on stderr (what an import
+                                 tolerates, skips or cannot decode) */
 } vdag_import_limits;
 
 #ifndef VDAG_IMPORT_MAX_INPUT_BYTES
@@ -104,8 +123,8 @@ typedef struct vdag_scene {
     vdag_image *images;
 } vdag_scene;
 
-/* Reads PATH, choosing the parser by extension (.xyz .ply .obj .off .vox
-   .mtl .spm .ac). LIMITS may be NULL (the defaults).
+/* Reads PATH, choosing the parser by extension (.xyz .ply .obj .off .stl
+   .vox .mtl .spm .ac); a directory is refused as such. LIMITS may be NULL (the defaults).
    Returns 1 on success; 0 with a one-line reason in err otherwise. */
 int vdag_import_file(const char *path, const vdag_import_limits *limits, vdag_scene *out,
                      char *err, size_t err_size);

@@ -272,7 +272,8 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
         if (!c->base_dir || m->tex1.s == m->tex1.e) continue;
         if (!vs_stk_texture(c, c->base_dir, m->tex1, &path)) goto done;
         if (!path) {
-            fprintf(stderr, "vdag: warning: texture %.*s not found; using white\n", (int)vi_len(m->tex1), m->tex1.s);
+            if (!c->limits.quiet)
+                fprintf(stderr, "vdag: warning: texture %.*s not found; using white\n", (int)vi_len(m->tex1), m->tex1.s);
             continue;
         }
         {

@@ -7,8 +7,11 @@
      looks along normalize(f + sx r + sy u) with s = tan(fov / 2),
      sx = (2 (i + 0.5) / W - 1) s W / H and sy = (1 - 2 (j + 0.5) / H) s.
      Rays start at the eye with t in [0, inf), so t is a distance.
-   - Default camera: target the grid's centre, eye along (1, -1.4, 0.9) from
-     it, far enough that the grid's bounding sphere fits the picture.
+   - Axes: z up, as every built file has them (vdag build --up).
+   - Default camera, a three-quarter view of the occupied voxels: target the
+     centre of their box (the file's voxel box; the whole grid when there is no
+     voxel), eye along (1, -1.4, 0.9) from it, far enough that the box's
+     bounding sphere fits the narrower field of view.
    - Shading: colour x (AMBIENT + (1 - AMBIENT) max(0, n . l)) with n the
      entry face normal and l = normalize(LIGHT); the voxel a ray starts in
      gets factor 1. With --shadows, a lit face whose shadow ray towards l is
@@ -22,6 +25,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <errno.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -179,6 +184,7 @@ typedef struct render_job {
     uint8_t *rgb;
     uint32_t tiles_x, tiles, next, done;
     int last_percent;
+    int tty; /* progress on stderr, a terminal */
     pthread_mutex_t lock;
 } render_job;
 
@@ -241,7 +247,7 @@ static void *render_worker(void *arg) {
                 render_pixel(job, x, y, job->rgb + 3 * ((size_t)y * job->cam.w + x));
         pthread_mutex_lock(&job->lock);
         percent = (int)(100.0 * ++job->done / job->tiles);
-        if (percent / 10 != job->last_percent / 10) {
+        if (job->tty && percent / 10 != job->last_percent / 10) { /* in place, on a terminal only */
             job->last_percent = percent;
             fprintf(stderr, "\rrender: %3d%%", percent);
         }
@@ -269,12 +275,13 @@ static int parse_numbers(int argc, char **argv, int *i, double *out, int count) 
 
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS]";
+                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet]";
     render_job job;
     vdag_file f;
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, secs;
-    int have_eye = 0, have_target = 0, i, k;
+    int have_eye = 0, have_target = 0, quiet = 0, i, k;
+    uint32_t box[6];
     unsigned threads, t;
     pthread_t tid[64];
     if (argc < 3) return vdag_fail(usage);
@@ -304,20 +311,27 @@ int vdag_cmd_render(int argc, char **argv) {
             if (!parse_numbers(argc, argv, &i, &lod, 1) || lod < 0) return vdag_fail("render: --lod takes pixels >= 0");
         } else if (!strcmp(a, "--shadows")) {
             job.shadows = 1;
+        } else if (!strcmp(a, "--quiet")) {
+            quiet = 1;
         } else {
             return vdag_fail("render: unknown option '%s' (%s)", a, usage);
         }
     }
-    if (!vdag_open(argv[1], &f)) return 1;
+    if (!vdag_check_output(argv[1], argv[2]) || !vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &info);
     job.file = &f;
+    job.tty = !quiet && isatty(2);
     job.levels = info.levels;
     job.cam.s = tan(fov * 3.14159265358979323846 / 360);
+    if (!vdag_voxel_box(f.dag, box)) /* empty: the whole grid */
+        for (k = 0; k < 3; k++) box[k] = 0, box[k + 3] = 1u << info.levels;
     if (!have_target)
-        for (k = 0; k < 3; k++) target[k] = (double)(1u << info.levels) / 2;
-    if (!have_eye) { /* the grid's bounding sphere fits the narrower field of view */
+        for (k = 0; k < 3; k++) target[k] = ((double)box[k] + box[k + 3]) / 2;
+    if (!have_eye) { /* the bounding sphere of the occupied box fits the narrower field of view */
         double dir[3] = {1, -1.4, 0.9}, s = job.cam.s * (job.cam.w < job.cam.h ? (double)job.cam.w / job.cam.h : 1);
-        double dist = sqrt(3.0) / 2 * (1u << info.levels) * sqrt(1 + 1 / (s * s));
+        double r = 0, dist;
+        for (k = 0; k < 3; k++) r += ((double)box[k + 3] - box[k]) * ((double)box[k + 3] - box[k]) / 4;
+        dist = sqrt(r) * sqrt(1 + 1 / (s * s));
         normalize3(dir);
         for (k = 0; k < 3; k++) eye[k] = target[k] + dist * dir[k];
     }
@@ -355,12 +369,14 @@ int vdag_cmd_render(int argc, char **argv) {
     while (t > 0) pthread_join(tid[--t], NULL);
     secs = seconds_now() - t0;
     pthread_mutex_destroy(&job.lock);
-    fprintf(stderr, "\rrender: %ux%u in %.3f s, %.2f Mrays/s (%u threads)\n", job.cam.w, job.cam.h, secs,
-            (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6, threads);
+    if (!quiet)
+        fprintf(stderr, "%srender: %ux%u in %.3f s, %.2f Mrays/s (%u threads)\n", job.tty ? "\r" : "", job.cam.w,
+                job.cam.h, secs, (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6, threads);
+    errno = 0;
     if (!write_png(argv[2], job.rgb, job.cam.w, job.cam.h)) {
         free(job.rgb);
         vdag_close(&f);
-        return vdag_fail("render: cannot write %s", argv[2]);
+        return vdag_fail("render: cannot write %s (%s)", argv[2], errno ? strerror(errno) : "write error");
     }
     free(job.rgb);
     vdag_close(&f);

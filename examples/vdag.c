@@ -1,8 +1,9 @@
 /* vdag: build, inspect, query and render .vdag files.
 
-   vdag build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E]
-              [--color-bits W|auto] [--color-effort smallest|fast] [--threads T]
-              [--stats] [--no-colors]
+   vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
+              [--no-symmetry] [--color-error E] [--color-bits W|auto]
+              [--color-effort smallest|fast] [--no-colors] [--chunk-levels C]
+              [--threads T] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -26,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -48,12 +50,26 @@ unsigned vdag_cpu_count(void) {
     return n < 1 ? 1 : n > 64 ? 64 : (unsigned)n;
 }
 
+int vdag_check_output(const char *in, const char *out) {
+    struct stat a, b;
+    if (!stat(out, &b) && S_ISDIR(b.st_mode)) return !vdag_fail("%s: is a directory, not a file to write", out);
+    if (in && !stat(in, &a) && !stat(out, &b) && a.st_dev == b.st_dev && a.st_ino == b.st_ino)
+        return !vdag_fail("%s: is the input file %s; refusing to write over it", out, in);
+    return 1;
+}
+
 int vdag_open(const char *path, vdag_file *f) {
     voxdag_error err;
     const void *payload;
     size_t size;
+    struct stat fs;
     memset(f, 0, sizeof *f);
+    if (stat(path, &fs)) return !vdag_fail("%s: cannot open (%s)", path, strerror(errno));
+    if (S_ISDIR(fs.st_mode)) return !vdag_fail("%s: is a directory, not a .vdag file", path);
+    errno = 0;
     if (voxdag_load_file(path, NULL, &f->dag, &err) != VOXDAG_OK) {
+        if (err.status == VOXDAG_ERR_IO && errno)
+            return !vdag_fail("%s: %s (%s: %s)", path, voxdag_status_string(err.status), err.message, strerror(errno));
         if (err.byte_offset != UINT64_MAX)
             return !vdag_fail("%s: %s (%s at byte %llu)", path, voxdag_status_string(err.status), err.message,
                               (unsigned long long)err.byte_offset);
@@ -86,6 +102,86 @@ void vdag_close(vdag_file *f) {
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]) {
     if (f->colors.count) voxcolor_view_get(&f->colors, index, rgb);
     else if (!voxdag_color(f->dag, index, rgb)) rgb[0] = rgb[1] = rgb[2] = 255;
+}
+
+int vdag_voxel_box(const voxdag *dag, uint32_t box[6]) {
+    voxdag_info in;
+    voxdag_get_info(dag, &in);
+    memcpy(box, in.voxel_box, sizeof in.voxel_box);
+    return in.voxels > 0;
+}
+
+// -- Help: every command, every option with its default and units
+
+static const struct {
+    const char *name, *text;
+} help_texts[] = {
+    {"build",
+     "usage: vdag build IN OUT.vdag [options]\n"
+     "Builds a .vdag file from IN: .xyz (voxels \"x y z [r g b]\", integers; with decimal\n"
+     "coordinates a point cloud), .ply, .obj (+ .mtl, textures PNG/JPEG/TGA/BMP/PNM), .off,\n"
+     ".stl, .vox, .spm, .ac. Meshes and point clouds are fitted into the 2^L grid by their\n"
+     "bounding box; voxel lists keep their coordinates. OUT may not be IN.\n"
+     "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
+     "                     point clouds; voxel lists: the smallest grid that holds them)\n"
+     "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
+     "                     z for .stl .xyz .vox .spm .ac)\n"
+     "  --symmetry G       share subtrees equal up to: none (identical only), reflect (the 8\n"
+     "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
+     "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
+     "  --color-error E    compress colours with voxcolor, each within E (RGB distance / 255,\n"
+     "                     0 = lossless) (default: colours stored raw, 24 bits each)\n"
+     "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
+     "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
+     "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
+     "  --no-colors        drop colours, decode no texture (default: keep them)\n"
+     "  --chunk-levels C   voxelize meshes in chunks of 2^C voxels per axis, 2..8 (default:\n"
+     "                     chosen from the mesh: 5 for coloured meshes under 65536 triangles, else 8)\n"
+     "  --threads T        worker threads, >= 1 (default: the processors online)\n"
+     "  --force            build even when the estimate exceeds the machine's memory (default:\n"
+     "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
+     "  --stats            also count the nodes per level under all three symmetry groups\n"
+     "                     (three times the work) (default: off)\n"
+     "  --quiet            warnings and errors only (default: progress and a summary on stderr)\n"},
+    {"info", "usage: vdag info FILE [--json]\n"
+             "Prints levels, voxels, nodes and bytes per level, bits per voxel, colours, the grid's world\n"
+             "box (the source's units) and the box of the occupied voxels (grid units, half-open).\n"
+             "  --json   one JSON object instead of the text (default: text)\n"},
+    {"validate", "usage: vdag validate FILE\nExit status 0 when FILE is a valid .vdag file, else 1 with a one-line reason.\n"},
+    {"lookup", "usage: vdag lookup FILE x y z\n"
+               "Prints \"0\" when voxel (x, y, z) is empty, else \"1 INDEX R G B\". Coordinates are\n"
+               "grid units: integers 0..2^L-1.\n"},
+    {"rays", "usage: vdag rays FILE\n"
+             "Reads rays from stdin, one a line \"ox oy oz dx dy dz\" (numbers, grid units: the grid\n"
+             "spans [0, 2^L)^3), prints a line a ray: \"miss\", or \"hit T X Y Z NX NY NZ INDEX R G B\"\n"
+             "(T: distance along the ray in units of |d|; N: the entry face normal).\n"},
+    {"render", "usage: vdag render FILE OUT.png [options]\n"
+               "Ray traces a shaded picture, z up. OUT may not be FILE.\n"
+               "  --size WxH        picture size, 1..16384 each (default: 640x480)\n"
+               "  --eye x y z       camera position, grid units (default: a three-quarter view from\n"
+               "                    +x, -y, above, far enough that the occupied voxels fit)\n"
+               "  --target x y z    point looked at, grid units (default: the occupied voxels' centre)\n"
+               "  --fov deg         vertical field of view in degrees, (0, 180) (default: 50)\n"
+               "  --shadows         shadows towards the light (default: off)\n"
+               "  --lod PIXELS      stop at cells smaller than PIXELS pixels (default: 0, full detail)\n"
+               "  --threads T       threads, 0..64, 0 = the processors online (default: 0)\n"
+               "  --quiet           no progress or timing on stderr\n"},
+    {"export-voxels", "usage: vdag export-voxels FILE\n"
+                      "Prints every voxel as \"x y z r g b\" (grid units), in voxel-index order.\n"},
+    {"gen", "usage: vdag gen demo OUT.xyz [--levels L]\n"
+            "Writes the built-in demo scene as a voxel list.\n"
+            "  --levels L   grid of 2^L voxels per axis, 4..10 (default: 7)\n"},
+};
+
+int vdag_help(const char *command, int argc, char **argv) {
+    size_t i;
+    int k;
+    for (k = 1; k < argc; k++)
+        if (!strcmp(argv[k], "--help") || !strcmp(argv[k], "-h")) break;
+    if (k == argc) return 0;
+    for (i = 0; i < sizeof help_texts / sizeof help_texts[0]; i++)
+        if (!strcmp(help_texts[i].name, command)) fputs(help_texts[i].text, stdout);
+    return 1;
 }
 
 static double now_seconds(void) {
@@ -127,19 +223,76 @@ typedef struct build_args {
     voxcolor_effort color_effort;
     struct color_spill *spill;
     double t0;              /* when the command started */
+    size_t input_items;     /* triangles or points read */
+    char up;                /* the input's up axis: 'x', 'y', 'z'; 0: the format's default */
     const char *last_stage; /* progress printed last */
     int last_percent;
+    int tty, line_open;     /* stderr is a terminal; a progress line is open on it */
+    int quiet;              /* --quiet: warnings and errors only */
+    int force;              /* --force: build even past the machine's memory */
+    uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
 } build_args;
 
-/* Prints a stage's progress when its whole percentage changes, with the
-   seconds since the command started. */
+/* Progress of a build: on a terminal, one line per stage updated in place
+   at each whole percent; elsewhere (logs, pipes) a plain line when a stage
+   starts and at each quarter; nothing with --quiet. */
 static void progress(void *user, const char *stage, double fraction) {
     build_args *a = (build_args *)user;
-    int percent = (int)(100 * fraction);
-    if (a->last_stage && !strcmp(a->last_stage, stage) && a->last_percent == percent) return;
+    int percent = (int)(100 * fraction), new_stage = !a->last_stage || strcmp(a->last_stage, stage) != 0;
+    if (a->quiet || (!new_stage && a->last_percent == percent)) return;
+    if (!a->tty && !new_stage && percent / 25 == a->last_percent / 25) return;
+    if (a->tty) fprintf(stderr, "%svdag: %s %3d%% (%.1f s)", a->line_open ? (new_stage ? "\n" : "\r") : "", stage,
+                        percent, now_seconds() - a->t0);
+    else fprintf(stderr, "vdag: %s %3d%% (%.1f s)\n", stage, percent, now_seconds() - a->t0);
+    a->line_open = a->tty;
     a->last_stage = stage;
     a->last_percent = percent;
-    fprintf(stderr, "vdag: %s %3d%% (%.1f s)\n", stage, percent, now_seconds() - a->t0);
+}
+
+/* Ends a progress line left open on a terminal. */
+static void progress_end(build_args *a) {
+    if (a->line_open) fputc('\n', stderr);
+    a->line_open = 0;
+}
+
+/* The tool's axes are z up (x right, y away from a viewer in front):
+   renders, the default camera and every built file use them. A file's up
+   axis (--up, or the default of its format) is turned to +z by a rotation:
+   y up: (x, y, z) -> (x, -z, y); x up: (x, y, z) -> (y, z, x). Formats
+   whose usual exporters write y up (.obj, .ply, .off) default to y; .stl
+   (CAD and 3D printing), .xyz and .vox default to z; .spm and .ac are
+   turned to z up by the importer and default to z. */
+static char default_up(const char *path) {
+    const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+    static const char *const y_up[] = {"obj", "ply", "off"};
+    size_t i;
+    for (i = 0; dot && i < sizeof y_up / sizeof y_up[0]; i++) {
+        const char *a = dot + 1, *b = y_up[i];
+        while (*a && (*a | 0x20) == *b) a++, b++;
+        if (!*a && !*b) return 'y';
+    }
+    return 'z';
+}
+
+/* Turns N points (3 doubles each) so that axis UP becomes +z. Voxels
+   (integer cells) flip an axis as max - v, so they stay cells >= 0. */
+static void turn_up(double *p, size_t n, char up, int voxels) {
+    double top = 0;
+    size_t i;
+    if (up == 'z') return;
+    for (i = 0; voxels && up == 'y' && i < n; i++)
+        if (p[3 * i + 2] > top) top = p[3 * i + 2];
+    for (i = 0; i < n; i++) {
+        double x = p[3 * i], y = p[3 * i + 1], z = p[3 * i + 2];
+        if (up == 'y') {
+            p[3 * i + 1] = voxels ? top - z : -z;
+            p[3 * i + 2] = y;
+        } else {
+            p[3 * i] = y;
+            p[3 * i + 1] = z;
+            p[3 * i + 2] = x;
+        }
+    }
 }
 
 /* Points to grid voxels: integer voxels as they are, point clouds and mesh
@@ -386,8 +539,9 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     voxdag_error err;
     double t0 = now_seconds();
     int rc;
-    fprintf(stderr, "vdag: colour spill: %.1f MiB of temporary disk in %s (%llu colours)\n",
-            (double)size / 1048576.0, spill->dir, (unsigned long long)spill->n);
+    if (!a->quiet)
+        fprintf(stderr, "vdag: colour spill: %.1f MiB of temporary disk in %s (%llu colours)\n",
+                (double)size / 1048576.0, spill->dir, (unsigned long long)spill->n);
     rewind(spill->f);
     if (!a->compress) {
         uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
@@ -407,7 +561,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
         }
         rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
         free(g.data);
-        if (!rc)
+        if (!rc && !a->quiet)
             fprintf(stderr,
                     "vdag: colours %llu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g, %s effort) in %.2f s on %u "
                     "thread%s\n",
@@ -438,14 +592,45 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
     if (!spill_open(a->spill))
         return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
                          strerror(errno));
-    fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
-            3.0 * voxels / 1048576.0, a->spill->dir);
+    if (!a->quiet)
+        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
+                3.0 * voxels / 1048576.0, a->spill->dir);
     o->color_sink = spill_colors;
     o->color_sink_user = a->spill;
     return 0;
 }
 
-static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0);
+static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0);
+
+/* A rough estimate of a mesh build, printed before a long one (more than
+   10^7 voxels): voxels about twice the surface area in grid units (a
+   conservative voxelization is about two voxels thick), memory about 4
+   bytes a voxel for the nodes, plus 3 for uncompressed colours. Past the
+   machine's memory the build needs --force. Returns 0 after printing why it
+   stops. */
+static int mesh_estimate(const build_args *a, const vdag_scene *sc, const double *grid, int colors) {
+    double area = 0, voxels, bytes, machine;
+    size_t t;
+    long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+    for (t = 0; t < sc->triangle_count; t++) {
+        const double *p = grid + 3 * (size_t)sc->indices[3 * t], *q = grid + 3 * (size_t)sc->indices[3 * t + 1],
+                     *r = grid + 3 * (size_t)sc->indices[3 * t + 2];
+        double u[3], v[3], c[3];
+        int k;
+        for (k = 0; k < 3; k++) u[k] = q[k] - p[k], v[k] = r[k] - p[k];
+        c[0] = u[1] * v[2] - u[2] * v[1], c[1] = u[2] * v[0] - u[0] * v[2], c[2] = u[0] * v[1] - u[1] * v[0];
+        area += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    voxels = 2 * area + (double)sc->triangle_count;
+    bytes = voxels * (4 + (colors && !a->compress ? 3 : 0));
+    machine = pages > 0 && page > 0 ? (double)pages * (double)page : 0;
+    if (voxels > 1e7 && !a->quiet)
+        fprintf(stderr, "vdag: estimate: about %.3g voxels and %.0f MiB (rough)\n", voxels, bytes / 1048576.0);
+    if (machine > 0 && bytes > machine && !a->force)
+        return !vdag_fail("build: the estimate (%.0f MiB) exceeds this machine's memory (%.0f MiB); "
+                          "lower --levels, or add --force to try anyway", bytes / 1048576.0, machine / 1048576.0);
+    return 1;
+}
 
 static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     double bounds[6], *grid;
@@ -455,8 +640,9 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     voxdag_error err;
     int colors = !a->no_colors && (sc->vertex_rgb || sc->material_count), rc;
     if (!a->levels) a->levels = 10;
-    fprintf(stderr, "vdag: voxelizing %zu triangles into %u^3 (%.1f s)\n", sc->triangle_count, 1u << a->levels,
-            now_seconds() - t0);
+    if (!a->quiet)
+        fprintf(stderr, "vdag: voxelizing %zu triangles into %u^3 (%.1f s)\n", sc->triangle_count, 1u << a->levels,
+                now_seconds() - t0);
     grid = mesh_to_grid(sc, a->levels, bounds);
     if (!grid) {
         vdag_scene_free(sc);
@@ -465,6 +651,14 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     if (build_opts(a, colors, bounds, colors ? mesh_voxel_estimate(grid, sc->indices, sc->triangle_count) : 0, &o)) {
         free(grid);
         vdag_scene_free(sc);
+        return 1;
+    }
+    /* Small coloured meshes in small chunks: a chunk holds a colour per voxel. */
+    o.chunk_levels = a->chunk_levels ? a->chunk_levels : colors && sc->triangle_count < 65536 ? 5 : 8;
+    if (!mesh_estimate(a, sc, grid, colors)) {
+        free(grid);
+        vdag_scene_free(sc);
+        if (a->spill->f) fclose(a->spill->f);
         return 1;
     }
     memset(&mesh, 0, sizeof mesh);
@@ -503,12 +697,24 @@ static int cmd_build(int argc, char **argv) {
     a.spill = &spill;
     a.t0 = t0;
     a.threads = vdag_cpu_count();
+    a.tty = isatty(2);
     for (k = 1; k < argc; k++) {
         if (!strcmp(argv[k], "--levels") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.levels) || a.levels < 2 || a.levels > VOXDAG_MAX_LEVELS)
                 return vdag_fail("build: --levels takes 2..%d", VOXDAG_MAX_LEVELS);
         } else if (!strcmp(argv[k], "--threads") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.threads) || !a.threads) return vdag_fail("build: --threads takes a count >= 1");
+        } else if (!strcmp(argv[k], "--up") && k + 1 < argc) {
+            k++;
+            if (strlen(argv[k]) != 1 || !strchr("xyz", argv[k][0])) return vdag_fail("build: --up takes x, y or z");
+            a.up = argv[k][0];
+        } else if (!strcmp(argv[k], "--chunk-levels") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.chunk_levels) || a.chunk_levels < 2 || a.chunk_levels > 8)
+                return vdag_fail("build: --chunk-levels takes 2..8");
+        } else if (!strcmp(argv[k], "--force")) {
+            a.force = 1;
+        } else if (!strcmp(argv[k], "--quiet")) {
+            a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
@@ -547,11 +753,19 @@ static int cmd_build(int argc, char **argv) {
             return vdag_fail("build: too many arguments");
         }
     }
-    if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--no-symmetry] ...");
-    fprintf(stderr, "vdag: reading %s\n", a.in);
+    if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
+    if (!vdag_check_output(a.in, a.out)) return 1;
+    if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
     memset(&limits, 0, sizeof limits);
     limits.skip_textures = a.no_colors; /* no colours kept: nothing to decode them for */
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    if (!a.up) a.up = default_up(a.in);
+    turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
+    turn_up(sc.positions, sc.vertex_count, a.up, 0);
+    if (!sc.triangle_count && !sc.point_count)
+        fprintf(stderr, "vdag: warning: %s holds no triangles and no points (lines are not voxelized): "
+                        "the result has no voxels\n", a.in);
+    a.input_items = sc.triangle_count ? sc.triangle_count : sc.point_count;
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);
@@ -576,12 +790,13 @@ static int cmd_build(int argc, char **argv) {
 
 /* Finishes a build whose input is all added (FAILED: adding failed, B is
    freed), compresses colours when asked, and saves. */
-static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0) {
+static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0) {
     voxdag *dag = NULL;
     voxdag_build_stats st;
     int rc = failed;
     double seconds;
     if (!rc) rc = voxdag_builder_finish(b, &dag, &st, err) != VOXDAG_OK;
+    progress_end(a);
     seconds = now_seconds() - t0;
     if (!rc && a->spill->f) rc = attach_colors(&dag, a->spill, a);
     else if (rc) vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
@@ -590,11 +805,16 @@ static int finish_build(const build_args *a, voxdag_builder *b, int failed, voxd
         voxdag_free(dag);
         return 1;
     }
-    print_build_summary(dag, &st, seconds);
+    if (!a->quiet) print_build_summary(dag, &st, seconds);
+    if (!st.voxels && a->input_items)
+        fprintf(stderr, "vdag: warning: %s gave no voxels (its triangles or points lie outside the grid, "
+                        "or are degenerate)\n", a->in);
+    errno = 0;
     rc = voxdag_save_file(dag, a->out, err) != VOXDAG_OK;
     voxdag_free(dag);
+    if (rc && errno) return vdag_fail("%s: %s (%s)", a->out, err->message, strerror(errno));
     if (rc) return vdag_fail("%s: %s", a->out, err->message);
-    fprintf(stderr, "vdag: wrote %s\n", a->out);
+    if (!a->quiet) fprintf(stderr, "vdag: wrote %s\n", a->out);
     return 0;
 }
 
@@ -627,7 +847,7 @@ static int cmd_info(int argc, char **argv) {
                (unsigned long long)in.brick_bytes, (unsigned long long)in.color_bytes);
         printf("\"bits_per_voxel\": %.6f, \"color_format\": \"%s\", \"color_bits_per_voxel\": %.6f", geo_bits,
                color_kind_name(in.color_kind), in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
-        if (in.has_bounds)
+        if (in.has_bounds) /* the grid's world box */
             printf(", \"bounds\": [%.17g, %.17g, %.17g, %.17g, %.17g, %.17g]", in.bounds[0], in.bounds[1],
                    in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
         printf("}\n");
@@ -635,8 +855,6 @@ static int cmd_info(int argc, char **argv) {
         printf("levels      %u (grid %u^3)\n", in.levels, 1u << in.levels);
         printf("voxels      %llu\n", (unsigned long long)in.voxels);
         printf("symmetry    %s\n", symmetry_name(in.symmetry));
-        printf("voxel box   %u %u %u .. %u %u %u (occupied voxels, grid units)\n", in.voxel_box[0], in.voxel_box[1],
-               in.voxel_box[2], in.voxel_box[3], in.voxel_box[4], in.voxel_box[5]);
         printf("level       nodes        bytes\n");
         for (l = 0; l + 1 < in.levels; l++)
             printf("%5u %11llu %12llu%s\n", l, (unsigned long long)in.nodes[l],
@@ -647,9 +865,19 @@ static int cmd_info(int argc, char **argv) {
                (unsigned long long)in.color_bytes,
                in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
         printf("file        %llu bytes\n", (unsigned long long)in.file_bytes);
-        if (in.has_bounds)
-            printf("bounds      (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0], in.bounds[1], in.bounds[2],
-                   in.bounds[3], in.bounds[4], in.bounds[5]);
+        if (in.voxels)
+            printf("occupied    voxels (%u, %u, %u) - (%u, %u, %u), grid units, half-open\n", in.voxel_box[0],
+                   in.voxel_box[1], in.voxel_box[2], in.voxel_box[3], in.voxel_box[4], in.voxel_box[5]);
+        if (in.has_bounds) {
+            double cell = (in.bounds[3] - in.bounds[0]) / (double)(1u << in.levels);
+            printf("grid world box  (%g, %g, %g) - (%g, %g, %g), the source's units\n", in.bounds[0], in.bounds[1],
+                   in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
+            if (in.voxels)
+                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0] + cell * in.voxel_box[0],
+                       in.bounds[1] + cell * in.voxel_box[1], in.bounds[2] + cell * in.voxel_box[2],
+                       in.bounds[0] + cell * in.voxel_box[3], in.bounds[1] + cell * in.voxel_box[4],
+                       in.bounds[2] + cell * in.voxel_box[5]);
+        }
     }
     vdag_close(&f);
     return 0;
@@ -748,14 +976,16 @@ static int cmd_gen(int argc, char **argv) {
 // -- main
 
 static int usage(FILE *f) {
-    fputs("usage: vdag COMMAND ...\n"
-          "  build IN OUT.vdag [--levels L] [--no-symmetry] [--color-error E] [--color-bits W|auto]\n"
-          "                    [--color-effort smallest|fast] [--threads T] [--stats] [--no-colors]\n"
+    fputs("usage: vdag COMMAND ...   (vdag COMMAND --help: its options and defaults; vdag --version)\n"
+          "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
+          "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
+          "                    [--no-colors] [--chunk-levels C] [--threads T] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
-          "  lookup FILE x y z\n"
-          "  rays FILE                 (rays 'ox oy oz dx dy dz' on stdin)\n"
-          "  render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] [--fov deg] [--threads T]\n"
+          "  lookup FILE x y z         (grid units)\n"
+          "  rays FILE                 (rays 'ox oy oz dx dy dz' on stdin, grid units)\n"
+          "  render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] [--fov deg]\n"
+          "                      [--shadows] [--lod PIXELS] [--threads T] [--quiet]\n"
           "  export-voxels FILE\n"
           "  gen demo OUT.xyz [--levels L]\n",
           f);
@@ -772,8 +1002,16 @@ int main(int argc, char **argv) {
     size_t i;
     if (argc < 2) return usage(stderr);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) return usage(stdout);
+    if (!strcmp(argv[1], "--version")) {
+        printf("vdag %d.%d.%d (voxdag.h %u, .vdag format %d)\n", VOXDAG_VERSION_MAJOR, VOXDAG_VERSION_MINOR,
+               VOXDAG_VERSION_PATCH, (unsigned)voxdag_version(), VOXDAG_FORMAT_VERSION);
+        return 0;
+    }
     for (i = 0; i < sizeof commands / sizeof commands[0]; i++)
-        if (!strcmp(argv[1], commands[i].name)) return commands[i].fn(argc - 1, argv + 1);
+        if (!strcmp(argv[1], commands[i].name)) {
+            if (vdag_help(commands[i].name, argc - 1, argv + 1)) return 0;
+            return commands[i].fn(argc - 1, argv + 1);
+        }
     vdag_fail("unknown command '%s' (see vdag --help)", argv[1]);
     return 1;
 }

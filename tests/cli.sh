@@ -146,7 +146,7 @@ check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1
 
 # -- meshes: an axis-aligned square fitted into the grid fills one or two layers
 printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 0 8 0 1 0 0\nf 1 2 3\nf 1 3 4\n' >"$T/square.obj"
-check "build a coloured .obj" "$VDAG" build "$T/square.obj" "$T/sq.vdag" --levels 3 2>/dev/null
+check "build a coloured .obj" "$VDAG" build "$T/square.obj" "$T/sq.vdag" --levels 3 --up z 2>/dev/null
 check "the square is the 8x8 layer z = 0, red" sh -c "'$VDAG' export-voxels '$T/sq.vdag' | python3 -c \"
 import sys
 v = [tuple(map(int, l.split())) for l in sys.stdin]
@@ -161,9 +161,167 @@ printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemt
 check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
 check "--no-colors skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors 2>'$T/err' && ! grep -q warning '$T/err'"
 
+# -- more formats: STL (ASCII and binary) give the same square; a float .xyz
+# is a point cloud fitted into the grid (voxel = floor((p - lo) * 2^L / extent),
+# the top face clamped), computed here
+python3 - "$T" <<'EOF'
+import struct, sys
+t = sys.argv[1]
+tris = [((0, 0, 0), (8, 0, 0), (8, 8, 0)), ((0, 0, 0), (8, 8, 0), (0, 8, 0))]
+with open(t + "/sq_a.stl", "w") as f:
+    f.write("solid sq\n")
+    for tri in tris:
+        f.write("facet normal 0 0 1\nouter loop\n" + "".join("vertex %g %g %g\n" % v for v in tri) + "endloop\nendfacet\n")
+    f.write("endsolid sq\n")
+with open(t + "/sq_b.stl", "wb") as f:
+    f.write(b"solid written by a CAD tool".ljust(80, b" ") + struct.pack("<I", len(tris)))
+    for tri in tris:
+        f.write(struct.pack("<3f", 0, 0, 1) + b"".join(struct.pack("<3f", *v) for v in tri) + b"\0\0")
+pts = [(0.5, 1.25, -2.0), (3.75, 0.0, 1.5), (1.0, 2.5, 0.25), (2.0, 2.0, 2.0), (0.0, 0.0, 0.0)]
+with open(t + "/pts.xyz", "w") as f:
+    for p in pts:
+        f.write("%r %r %r 0.0 0.0 1.0\n" % p)
+lo = [min(p[k] for p in pts) for k in range(3)]
+ext = max(max(p[k] for p in pts) - lo[k] for k in range(3))
+n = 16
+vox = sorted(set(tuple(min(n - 1, int((p[k] - lo[k]) * n / ext)) for k in range(3)) for p in pts))
+open(t + "/pts_expected", "w").write("".join(sorted("%d %d %d\n" % v for v in vox)))
+EOF
+for f in sq_a sq_b; do
+    check "build $f.stl" "$VDAG" build "$T/$f.stl" "$T/$f.vdag" --levels 3 2>/dev/null
+    check "$f.stl is the 8x8 layer z = 0" sh -c "'$VDAG' export-voxels '$T/$f.vdag' | cut -d' ' -f1-3 >'$T/$f.got' &&
+        python3 -c \"
+got = [tuple(map(int, l.split())) for l in open('$T/$f.got')]
+assert sorted(got) == sorted((x, y, 0) for x in range(8) for y in range(8)), got[:5]
+\""
+done
+check "build a float .xyz point cloud" "$VDAG" build "$T/pts.xyz" "$T/pts.vdag" --levels 4 2>/dev/null
+check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/pts_expected'"
+
+# -- orientation: z up; a file's up axis (--up, default per format) is turned
+# to +z: y up (x, y, z) -> (x, -z, y), x up (x, y, z) -> (y, z, x); the
+# expected voxels are the rotated points fitted into the grid, computed here
+python3 - "$T" <<'EOF'
+import sys
+t = sys.argv[1]
+pts = [(0.5, 1.25, -2.0), (3.75, 0.0, 1.5), (1.0, 2.5, 0.25), (2.0, 2.0, 2.0), (0.0, 0.0, 0.0), (0.0, 7.0, 0.5)]
+with open(t + "/up.xyz", "w") as f:
+    for p in pts:
+        f.write("%r %r %r\n" % p)
+turn = {"x": lambda p: (p[1], p[2], p[0]), "y": lambda p: (p[0], -p[2], p[1]), "z": lambda p: p}
+for up, rot in turn.items():
+    q = [rot(p) for p in pts]
+    lo = [min(p[k] for p in q) for k in range(3)]
+    ext = max(max(p[k] for p in q) - lo[k] for k in range(3))
+    vox = sorted(set(tuple(min(15, int((p[k] - lo[k]) * 16 / ext)) for k in range(3)) for p in q))
+    open(t + "/up_" + up, "w").write("".join(sorted("%d %d %d\n" % v for v in vox)))
+EOF
+for up in x y z; do
+    check "build --up $up turns that axis to +z" sh -c "'$VDAG' build '$T/up.xyz' '$T/up.vdag' --levels 4 --up $up 2>/dev/null &&
+        '$VDAG' export-voxels '$T/up.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/up_$up'"
+done
+check "a float .xyz defaults to z up" sh -c "'$VDAG' build '$T/up.xyz' '$T/up.vdag' --levels 4 2>/dev/null &&
+    '$VDAG' export-voxels '$T/up.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/up_z'"
+check "--up takes x, y or z" sh -c "! '$VDAG' build '$T/up.xyz' '$T/up.vdag' --up w 2>/dev/null"
+printf 'v 0 0 0\nv 8 0 0\nv 8 8 0\nv 0 8 0\nf 1 2 3\nf 1 3 4\n' >"$T/upsq.obj"
+check "an .obj defaults to y up: its x-y square stands as the layer y = 0" sh -c "
+    '$VDAG' build '$T/upsq.obj' '$T/upsq.vdag' --levels 3 2>/dev/null && '$VDAG' export-voxels '$T/upsq.vdag' | python3 -c \"
+import sys
+v = sorted(tuple(map(int, l.split()[:3])) for l in sys.stdin)
+assert v == sorted((x, 0, z) for x in range(8) for z in range(8)), v[:5]
+\""
+
+# -- framing: a small model in a large grid fills the default view (more
+# than a tenth of the pixels), and is not clipped (no border pixel covered)
+python3 -c "
+with open('$T/small.xyz', 'w') as f:
+    for x in range(4):
+        for y in range(4):
+            for z in range(6):
+                f.write('%d %d %d\n' % (150 + x, 90 + y, 20 + z))"
+"$VDAG" build "$T/small.xyz" "$T/small.vdag" --levels 8 2>/dev/null
+check "info --json gives the occupied voxel box" sh -c "'$VDAG' info '$T/small.vdag' --json | python3 -c \"
+import json, sys
+assert json.load(sys.stdin)['voxel_box'] == [150, 90, 20, 154, 94, 26]
+\""
+check "info names the grid world box and the occupied box" sh -c "'$VDAG' info '$T/sq.vdag' >'$T/info.txt' &&
+    grep -q '^grid world box' '$T/info.txt' && grep -q '^occupied' '$T/info.txt' && ! grep -q '^bounds' '$T/info.txt'"
+check "render: the default camera frames the occupied voxels" sh -c "'$VDAG' render '$T/small.vdag' '$T/small.png' --size 64x48 2>/dev/null &&
+    python3 -c \"
+import struct, zlib
+b = open('$T/small.png', 'rb').read()
+w, h = struct.unpack('>II', b[16:24])
+at, idat = 8, b''
+while at < len(b):
+    n, = struct.unpack('>I', b[at:at + 4])
+    if b[at + 4:at + 8] == b'IDAT':
+        idat += b[at + 8:at + 8 + n]
+    at += 12 + n
+raw = zlib.decompress(idat)
+row = 1 + 3 * w
+cover = [[raw[y * row + 1 + 3 * x:y * row + 4 + 3 * x] != bytes((205, 218, 235)) for x in range(w)] for y in range(h)]
+frac = sum(map(sum, cover)) / float(w * h)
+assert frac > 0.1, frac
+assert not any(cover[0]) and not any(cover[-1]) and not any(r[0] or r[-1] for r in cover), 'clipped'
+\""
+
+# -- inputs that give nothing: a warning, or an error that says why
+: >"$T/empty.obj"
+check "an empty .obj warns that nothing is voxelized" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'warning:.*no triangles and no points' '$T/err'"
+printf 'AC3Db\nMATERIAL "m" rgb 1 1 1\nOBJECT world\nkids 1\nOBJECT poly\nnumvert 2\n0 0 0\n1 1 1\nnumsurf 1\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 0 0\nkids 0\n' >"$T/lines.ac"
+check "an .ac file of lines only warns" sh -c "'$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'warning:.*no triangles' '$T/err'"
+python3 -c "open('$T/wide.obj', 'wb').write('v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n'.encode('utf-16'))"
+check "a UTF-16 .obj is refused as such" sh -c "! '$VDAG' build '$T/wide.obj' '$T/e.vdag' 2>'$T/err' &&
+    grep -q 'UTF-16' '$T/err'"
+printf '\357\273\277AC3Db\nMATERIAL "m" rgb 1 0 0\nOBJECT world\nkids 0\n' >"$T/bom.ac"
+check "an .ac file with a UTF-8 BOM is read" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 2>/dev/null
+mkdir "$T/adir.obj"
+check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.vdag' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
+
 # -- the demo scene generator
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
+
+# -- help, version, progress, safety
+for c in build info validate lookup rays render export-voxels gen; do
+    check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
+done
+check "every build and render option in --help with its default" sh -c "
+    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --force --stats --quiet; do
+        '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
+    for o in --size --eye --target --fov --shadows --lod --threads; do
+        '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
+    '$VDAG' render --help | grep -- '--eye' | grep -q 'grid units' && '$VDAG' lookup --help | grep -q 'grid units' &&
+    '$VDAG' rays --help | grep -q 'grid units'"
+check "vdag --version" sh -c "'$VDAG' --version | grep -q '^vdag [0-9]*\.[0-9]*\.[0-9]*'"
+cp "$T/in.xyz" "$T/keep.xyz"
+check "build refuses to write over its input, also by another name" sh -c "
+    ! '$VDAG' build '$T/keep.xyz' '$T/keep.xyz' 2>'$T/err' && grep -q 'is the input' '$T/err' &&
+    ! '$VDAG' build '$T/keep.xyz' '$T/./keep.xyz' 2>/dev/null && ln -s keep.xyz '$T/alias.xyz' &&
+    ! '$VDAG' build '$T/keep.xyz' '$T/alias.xyz' 2>/dev/null && cmp -s '$T/keep.xyz' '$T/in.xyz'"
+check "render refuses to write over its input" sh -c "! '$VDAG' render '$T/a.vdag' '$T/a.vdag' 2>/dev/null && '$VDAG' validate '$T/a.vdag' 2>/dev/null"
+check "a directory as output or as a .vdag says so" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T' 2>'$T/err' && grep -q 'is a directory' '$T/err' &&
+    ! '$VDAG' info '$T' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
+check "write and open errors carry the OS reason" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T/no/such/dir.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
+    ! '$VDAG' info '$T/none.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
+    ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && grep -q 'No such file or directory' '$T/err'"
+check "progress into a pipe: plain lines, no carriage return, a few lines" sh -c "
+    '$VDAG' build '$T/demo.xyz' '$T/p.vdag' --color-error 0.02 2>&1 >/dev/null | tee '$T/log' >/dev/null &&
+    ! grep -q \"\$(printf '\\r')\" '$T/log' && [ \$(wc -l <'$T/log') -le 30 ]"
+check "--quiet: nothing on stderr" sh -c "'$VDAG' build '$T/demo.xyz' '$T/p.vdag' --quiet 2>'$T/err' && [ ! -s '$T/err' ] &&
+    '$VDAG' render '$T/p.vdag' '$T/p.png' --size 8x8 --quiet 2>'$T/err' && [ ! -s '$T/err' ]"
+printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 4 4 8 0 1 0\nf 1 2 3\nf 1 2 4\nf 2 3 4\nf 3 1 4\n' >"$T/tetra.obj"
+check "a small coloured mesh builds in a few MiB (builder peak < 8 MiB at 2^10)" sh -c "
+    '$VDAG' build '$T/tetra.obj' '$T/tetra.vdag' --threads 2 2>'$T/err' &&
+    awk '/ peak / { for (i = 1; i <= NF; i++) if (\$i == \"peak\") v = \$(i + 1) } END { exit !(v != \"\" && v + 0 < 8) }' '$T/err'"
+check "--chunk-levels takes 2..8, and does not change the file" sh -c "! '$VDAG' build '$T/tetra.obj' '$T/t.vdag' --chunk-levels 9 2>/dev/null &&
+    '$VDAG' build '$T/tetra.obj' '$T/t8.vdag' --chunk-levels 8 2>/dev/null && cmp -s '$T/t8.vdag' '$T/tetra.vdag'"
+check "a build estimated past the machine's memory needs --force" sh -c "
+    ! timeout 60 '$VDAG' build '$T/tetra.obj' '$T/huge.vdag' --levels 21 2>'$T/err' && grep -q -- '--force' '$T/err' && [ ! -e '$T/huge.vdag' ]"
 
 # -- vdag rays / vdag render: answers from an independent python3 oracle
 # Scene: 400 random voxels in 16^3; rays along the axes (unit and non-unit

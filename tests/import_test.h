@@ -44,7 +44,11 @@ static inline void put_le32(bytes *b, int64_t v) { put_uint(b, (uint64_t)v, 4, 0
 
 /* Imports DATA; a failure must leave a one-line message and an empty scene. */
 static inline int import(const char *ext, const bytes *data, vdag_scene *s, char *err, size_t err_size) {
-    int ok = vdag_import_memory(ext, data->p, data->n, NULL, NULL, s, err, err_size);
+    vdag_import_limits quiet;
+    int ok;
+    memset(&quiet, 0, sizeof quiet);
+    quiet.quiet = 1; /* sweeps would repeat the warnings of what is tolerated */
+    ok = vdag_import_memory(ext, data->p, data->n, NULL, &quiet, s, err, err_size);
     if (!ok) {
         CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
         CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);

@@ -117,14 +117,68 @@ static void test_xyz_roundtrip(void) {
 
 static void test_xyz_errors(void) {
     expect_error_text("xyz", "1 2 -3\n", "line 1: coordinate outside");
-    expect_error_text("xyz", "1 2 3\n1.5 2 3\n", "line 2: value 1 is not an integer");
+    expect_error_text("xyz", "1 2 3\n1.5 2 x\n", "line 2: value 3 is not a finite number");
     expect_error_text("xyz", "1 2 3\n4 5 6 7 8 9\n", "line 2: 6 values, but line 1 has 3");
     expect_error_text("xyz", "1 2 3 4 5 256\n", "colour outside 0..255");
     expect_error_text("xyz", "1 2 3 4\n", "expected \"x y z\"");
     expect_error_text("xyz", "1 2 3 4 5 6 7\n", "expected \"x y z\"");
-    expect_error_text("xyz", "nan 2 3\n", "not an integer");
+    expect_error_text("xyz", "nan 2 3\n", "value 1 is not a finite number");
+    expect_error_text("xyz", "1 2.5 3\ninf 2 3\n", "line 2: value 1 is not a finite number");
     expect_error_text("xyz", "4294967296 0 0\n", "coordinate outside");
-    expect_error_text("xyz", "99999999999999999999 0 0\n", "not an integer");
+    expect_error_text("xyz", "99999999999999999999 0 0\n", "line 1: coordinate outside");
+    expect_error_text("xyz", "1 2 3 0.5 0 0\n", "line 1: colour outside 0..255");
+    expect_error_text("xyz", "1 2 3\n1 2 3.5 4 5 6\n", "line 2: 6 values, but line 1 has 3");
+}
+
+/* Coordinates written with a point or an exponent make a point cloud (read
+   as written); the 4th-6th values are colours when every one is an integer
+   0..255, else ignored (normals). Integer files stay voxel lists. */
+static void test_xyz_points(void) {
+    uint64_t seed = 5;
+    int kind;
+    for (kind = 0; kind < 3; kind++) { /* no extra values, colours, normals */
+        bytes b = {NULL, 0, 0};
+        double v[50][6];
+        vdag_scene s;
+        char err[256];
+        size_t i, j;
+        for (i = 0; i < 50; i++) {
+            for (j = 0; j < 3; j++) v[i][j] = ((double)test_rand_below(&seed, 20001) - 10000) / 64;
+            for (j = 3; j < 6; j++)
+                v[i][j] = kind == 1 ? (double)test_rand_below(&seed, 256) : ((double)test_rand_below(&seed, 17) - 8) / 8;
+            putf(&b, i == 7 ? "%.17g %.17g %.17ge0" : "%.17g %.17g %.17g", v[i][0], v[i][1], v[i][2]);
+            if (kind == 1) putf(&b, " %d %d %d", (int)v[i][3], (int)v[i][4], (int)v[i][5]);
+            if (kind == 2) putf(&b, " %.3f %.3f %.3f", v[i][3], v[i][4], v[i][5]);
+            putf(&b, i % 3 ? "\n" : " # c\n");
+        }
+        if (!import("xyz", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            CHECK(s.points_are_voxels == 0 && s.point_count == 50 && s.triangle_count == 0);
+            CHECK((s.point_rgb != NULL) == (kind == 1));
+            for (i = 0; i < 50 && s.point_count == 50; i++)
+                for (j = 0; j < 3; j++) {
+                    CHECK(s.points[3 * i + j] == v[i][j]);
+                    if (s.point_rgb) CHECK(s.point_rgb[3 * i + j] == v[i][3 + j]);
+                }
+            vdag_scene_free(&s);
+        }
+        sweep("xyz", &b, 0);
+        free(b.p);
+    }
+    { /* one decimal point anywhere makes the whole file a point cloud */
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        putf(&b, "1 2 3\n-4 5 6\n7 8 9.0\n");
+        if (!import("xyz", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            CHECK(!s.points_are_voxels && s.point_count == 3 && s.points[3] == -4 && s.points[8] == 9);
+            vdag_scene_free(&s);
+        }
+        free(b.p);
+    }
 }
 
 // -- .ply
@@ -277,6 +331,32 @@ static void test_ply_sweep(void) {
         sweep("ply", &b, f > 0); /* an ASCII number cut short is still a number */
         free(b.p);
     }
+}
+
+/* A header line with an unknown keyword (a comment without "comment", as
+   some exporters write) is skipped; the rest reads as without it. */
+static void test_ply_unknown_header_line(void) {
+    ply_style st = {"binary_little_endian", "float", "uchar", "uchar", "int"};
+    uint64_t seed = 12;
+    mesh m;
+    bytes b = {NULL, 0, 0}, with = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256];
+    const char *end;
+    random_mesh(&m, &seed, 12, 6, 0);
+    write_ply(&b, &m, &st, 1);
+    end = strstr((const char *)b.p, "element vertex");
+    put(&with, b.p, (size_t)(end - (const char *)b.p));
+    putf(&with, "Created by an exporter 1.0\n");
+    put(&with, end, b.n - (size_t)(end - (const char *)b.p));
+    if (!import("ply", &with, &s, err, sizeof err)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        check_mesh(&s, &m, 1, 1);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+    free(with.p);
 }
 
 static void test_ply_errors(void) {
@@ -591,6 +671,168 @@ static void test_obj_file(void) {
     free(ppm.p);
 }
 
+// -- .stl
+
+/* ASCII: one facet per polygon (more than three vertices are fanned), with
+   keywords in STYLE's case, CRLF lines and a UTF-8 BOM when asked. */
+static void write_stl_ascii(bytes *b, const mesh *m, int upper, int bom) {
+    size_t i, j;
+    if (bom) put(b, "\xEF\xBB\xBF", 3);
+    putf(b, upper ? "SOLID part one\r\n" : "solid part one\n");
+    for (i = 0; i < m->npoly; i++) {
+        putf(b, upper ? "  FACET NORMAL 0 0 1\r\n    OUTER LOOP\r\n" : "facet normal 0 0 1\nouter loop\n");
+        for (j = 0; j < m->poly_size[i]; j++) {
+            const double *p = m->pos[m->poly[i][j]];
+            putf(b, upper ? "      VERTEX %.9e %.9e %.9e\r\n" : "vertex %.17g %.17g %.17g\n", p[0], p[1], p[2]);
+        }
+        putf(b, upper ? "    ENDLOOP\r\n  ENDFACET\r\n" : "endloop\nendfacet\n");
+    }
+    putf(b, upper ? "ENDSOLID part one\r\n" : "endsolid part one\n");
+}
+
+/* Binary: the fan triangles; HEADER fills the first bytes of the header. */
+static void write_stl_binary(bytes *b, const mesh *m, const char *header) {
+    uint32_t tris[32 * 4][3];
+    size_t n = fan(m, tris), t, k, a;
+    char head[80] = {0};
+    memcpy(head, header, strlen(header));
+    put(b, head, 80);
+    put_le32(b, (int64_t)n);
+    for (t = 0; t < n; t++) {
+        float f[12];
+        uint8_t raw[48];
+        f[0] = f[1] = 0, f[2] = 1;
+        for (k = 0; k < 3; k++)
+            for (a = 0; a < 3; a++) f[3 + 3 * k + a] = (float)m->pos[tris[t][k]][a];
+        for (k = 0; k < 12; k++) {
+            uint32_t w;
+            memcpy(&w, &f[k], 4);
+            for (a = 0; a < 4; a++) raw[4 * k + a] = (uint8_t)(w >> (8 * a));
+        }
+        put(b, raw, 48);
+        put(b, "\0\0", 2);
+    }
+}
+
+static void test_stl_roundtrip(void) {
+    uint64_t seed = 21;
+    int style;
+    for (style = 0; style < 4; style++) { /* ascii, ASCII with BOM and CRLF, binary, binary saying "solid" */
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256];
+        mesh m;
+        random_mesh(&m, &seed, 20, 12, 0); /* multiples of 1/8 below 126: exact in a float */
+        if (style < 2) write_stl_ascii(&b, &m, style, style);
+        else write_stl_binary(&b, &m, style == 2 ? "binary STL" : "solid by a CAD exporter");
+        if (!import("stl", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "style %d: %s", style, err);
+        } else {
+            check_mesh(&s, &m, 0, 0);
+            vdag_scene_free(&s);
+        }
+        sweep("stl", &b, style >= 2);
+        free(b.p);
+    }
+}
+
+static void test_stl_errors(void) {
+    bytes b = {NULL, 0, 0};
+    mesh m;
+    uint64_t seed = 22;
+    expect_error_text("stl", "", "not an STL file");
+    expect_error_text("stl", "hello", "not an STL file");
+    expect_error_text("stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nendloop\n",
+                      "line 6: a facet with fewer than 3 vertices");
+    expect_error_text("stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 nan 0\n",
+                      "line 5: expected \"vertex x y z\" with finite numbers");
+    expect_error_text("stl", "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 1 1 0\n"
+                             "endloop\nendfacet\n",
+                      "no \"endsolid\"");
+    expect_error_text("stl", "solid x\nvertex 0 0 0\n", "line 2: expected \"facet\" or \"endsolid\"");
+    expect_error_text("stl", "solid x\nfacet\nloop\n", "line 3: expected \"outer loop\"");
+    random_mesh(&m, &seed, 8, 3, 0);
+    write_stl_binary(&b, &m, "");
+    b.p[80] = 200; /* more triangles than the file holds */
+    expect_error("stl", &b, "binary header declares 200 triangles");
+    b.p[80] = 0; /* fewer: the rest is ignored with a warning */
+    {
+        vdag_scene s;
+        char err[256];
+        vdag_import_limits quiet;
+        memset(&quiet, 0, sizeof quiet);
+        quiet.quiet = 1;
+        CHECK(vdag_import_memory("stl", b.p, b.n, NULL, &quiet, &s, err, sizeof err) && s.triangle_count == 0);
+        vdag_scene_free(&s);
+    }
+    b.n = 84;
+    b.p[80] = 1;
+    memcpy(b.p, "solid x\n", 8);
+    expect_error("stl", &b, "line 2: expected \"facet\" or \"endsolid\""); /* not binary-sized: read as ASCII */
+    free(b.p);
+}
+
+// -- Tolerance: byte order marks, UTF-16, short palettes, directories
+
+/* A UTF-8 byte order mark before any text format changes nothing; UTF-16
+   text is refused with a message that says so. */
+static void test_text_bom(void) {
+    static const struct {
+        const char *ext, *text;
+    } files[] = {
+        {"xyz", "1 2 3 4 5 6\n7 8 9 10 11 12\n"},
+        {"ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+        {"obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
+        {"off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"},
+        {"ac", "AC3D\nMATERIAL \"m\" rgb 1 0 0\nOBJECT world\nkids 1\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n"
+               "numsurf 1\nSURF 0x0\nmat 0\nrefs 3\n0 0 0\n1 0 0\n2 0 0\nkids 0\n"},
+        {"stl", "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n"
+                "endsolid t\n"},
+        {"mtl", "newmtl a\nKd 1 0.5 0\n"},
+    };
+    size_t i, j;
+    for (i = 0; i < sizeof files / sizeof files[0]; i++) {
+        bytes plain = {NULL, 0, 0}, bom = {NULL, 0, 0}, wide = {NULL, 0, 0};
+        vdag_scene a, b;
+        char err[256];
+        put(&plain, files[i].text, strlen(files[i].text));
+        put(&bom, "\xEF\xBB\xBF", 3);
+        put(&bom, files[i].text, strlen(files[i].text));
+        if (!import(files[i].ext, &plain, &a, err, sizeof err)) {
+            CHECK_MSG(0, "%s: %s", files[i].ext, err);
+        } else {
+            if (!import(files[i].ext, &bom, &b, err, sizeof err)) {
+                CHECK_MSG(0, "%s with a BOM: %s", files[i].ext, err);
+            } else {
+                CHECK(a.point_count == b.point_count && a.vertex_count == b.vertex_count &&
+                      a.triangle_count == b.triangle_count && a.material_count == b.material_count);
+                CHECK(a.triangle_count || a.point_count || a.material_count);
+                for (j = 0; j < 3 * a.vertex_count && a.vertex_count == b.vertex_count; j++)
+                    CHECK(a.positions[j] == b.positions[j]);
+                vdag_scene_free(&b);
+            }
+            vdag_scene_free(&a);
+        }
+        /* The same text in UTF-16, little-endian with a BOM, and without one. */
+        put(&wide, "\xFF\xFE", 2);
+        for (j = 0; files[i].text[j]; j++) {
+            put(&wide, &files[i].text[j], 1);
+            put(&wide, "", 1);
+        }
+        if (strcmp(files[i].ext, "stl")) {
+            bytes no_bom = {NULL, 0, 0};
+            put(&no_bom, wide.p + 2, wide.n - 2);
+            expect_error(files[i].ext, &wide, "UTF-16");
+            expect_error(files[i].ext, &no_bom, "UTF-16");
+            free(no_bom.p);
+        }
+        free(plain.p);
+        free(bom.p);
+        free(wide.p);
+    }
+}
+
 static void test_file_errors(void) {
     vdag_scene s;
     char err[256];
@@ -598,8 +840,11 @@ static void test_file_errors(void) {
     CHECK_MSG(strstr(err, "/nonexistent/scene.ply: cannot open") == err, "%s", err);
     CHECK(!vdag_import_file("tests/test_import.c", NULL, &s, err, sizeof err));
     CHECK_MSG(strstr(err, "unknown format") != NULL, "%s", err);
-    CHECK(!vdag_import_memory("stl", "", 0, NULL, NULL, &s, err, sizeof err));
-    CHECK_MSG(!strcmp(err, "stl: unknown format (expected .xyz, .ply, .obj, .off, .vox, .mtl, .spm or .ac)"), "%s", err);
+    CHECK(!vdag_import_memory("stp", "", 0, NULL, NULL, &s, err, sizeof err));
+    CHECK_MSG(!strcmp(err, "stp: unknown format (expected .xyz, .ply, .obj, .off, .stl, .vox, .mtl, .spm or .ac)"),
+              "%s", err);
+    CHECK(!vdag_import_file("tests", NULL, &s, err, sizeof err)); /* a directory */
+    CHECK_MSG(strstr(err, "tests: is a directory") == err, "%s", err);
     CHECK(!vdag_import_memory("ply", "", 0, NULL, NULL, &s, err, 8)); /* the message is cut, not overflowed */
     CHECK(strlen(err) == 7);
     CHECK(!vdag_import_memory("ply", "", 0, NULL, NULL, &s, NULL, 0));
@@ -892,6 +1137,60 @@ static void test_vox_default_palette(void) {
     free(file.p);
 }
 
+/* An RGBA chunk shorter than 1024 bytes (1020, as some tools write, or
+   fewer) gives its whole entries; the missing ones are the default
+   palette's (the same table as above). */
+static void test_vox_short_palette(void) {
+    static const size_t lengths[] = {1020, 8, 6, 0};
+    size_t li;
+    for (li = 0; li < sizeof lengths / sizeof lengths[0]; li++) {
+        vox_model m;
+        voxel want[3];
+        bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
+        vdag_import_limits quiet;
+        vdag_scene s;
+        char err[256];
+        size_t i;
+        static const uint8_t colour_index[3] = {1, 2, 255};
+        static const uint8_t defaults[3][3] = {{0xff, 0xff, 0xff}, {0xff, 0xff, 0xcc}, {0x11, 0x11, 0x11}};
+        memset(&quiet, 0, sizeof quiet);
+        quiet.quiet = 1;
+        m.size[0] = 3;
+        m.size[1] = m.size[2] = 1;
+        m.n = 3;
+        for (i = 0; i < lengths[li]; i++) {
+            uint8_t byte = (uint8_t)(i * 7 + 1);
+            put(&c, &byte, 1);
+        }
+        for (i = 0; i < 3; i++) {
+            size_t entry = (size_t)colour_index[i] - 1;
+            m.v[i][0] = (uint8_t)i;
+            m.v[i][1] = m.v[i][2] = 0;
+            m.v[i][3] = colour_index[i];
+            want[i].p[0] = (int64_t)i;
+            want[i].p[1] = want[i].p[2] = 0;
+            if (4 * entry + 4 <= lengths[li]) {
+                size_t k;
+                for (k = 0; k < 3; k++) want[i].rgb[k] = (uint8_t)((4 * entry + k) * 7 + 1);
+            } else {
+                memcpy(want[i].rgb, defaults[i], 3);
+            }
+        }
+        vox_models(&body, &m, 1);
+        vox_chunk(&body, "RGBA", &c, 0);
+        vox_file(&file, &body, 150);
+        if (!vdag_import_memory("vox", file.p, file.n, NULL, &quiet, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%zu-byte palette: %s", lengths[li], err);
+        } else {
+            check_voxels(&s, want, 3);
+            vdag_scene_free(&s);
+        }
+        free(body.p);
+        free(file.p);
+        free(c.p);
+    }
+}
+
 /* A rotation byte: rows 0 and 1 take their non-zero entry from columns C0
    and C1, row 2 from the third; SIGNS bits 0-2 negate rows 0-2. */
 static int rotation_byte(int c0, int c1, int signs) { return c0 | c1 << 2 | signs << 4; }
@@ -1042,12 +1341,6 @@ static void graph_xyzi_only(bytes *b) {
     vox_chunk(b, "XYZI", &c, 0);
     free(c.p);
 }
-static void graph_short_palette(bytes *b) {
-    bytes c = {NULL, 0, 0};
-    put(&c, "\x01\x02\x03\x04", 4);
-    vox_chunk(b, "RGBA", &c, 0);
-    free(c.p);
-}
 static void graph_bad_layer(bytes *b) {
     bytes c = {NULL, 0, 0};
     put(&c, "\0\0", 2);
@@ -1079,7 +1372,6 @@ static void test_vox_errors(void) {
     vox_error(graph_outside, "outside its model's size");
     vox_error(graph_xyzi_only, "XYZI chunk without a SIZE chunk");
     vox_error(graph_xyzi_short, "fewer voxels than it declares");
-    vox_error(graph_short_palette, "RGBA chunk too short");
     vox_error(graph_chunk_overrun, "chunk runs past the end of MAIN");
     vox_error(graph_bad_layer, "malformed LAYR chunk");
     free(b.p);
@@ -1088,6 +1380,12 @@ static void test_vox_errors(void) {
 const test_case test_import_cases[] = {
     {"import/xyz roundtrip", test_xyz_roundtrip},
     {"import/xyz errors", test_xyz_errors},
+    {"import/xyz point cloud", test_xyz_points},
+    {"import/ply unknown header line", test_ply_unknown_header_line},
+    {"import/stl roundtrip", test_stl_roundtrip},
+    {"import/stl errors", test_stl_errors},
+    {"import/text with a BOM, UTF-16 refused", test_text_bom},
+    {"import/vox short palette", test_vox_short_palette},
     {"import/ply roundtrip", test_ply_roundtrip},
     {"import/ply points", test_ply_points},
     {"import/ply sweep", test_ply_sweep},

@@ -13,6 +13,7 @@ extern const test_case test_import_scene_cases[];
 extern const test_case test_format_cases[];
 extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
+extern const test_case test_image_cases[];
 
 static const test_case *const suites[] = {
     test_core_cases,
@@ -22,6 +23,7 @@ static const test_case *const suites[] = {
     test_format_cases,
     test_voxelize_cases,
     test_raytrace_cases,
+    test_image_cases,
 };
 
 const char *test_data_dir(void) {
