@@ -324,17 +324,18 @@ int main(int argc, char **argv) {
     printf("\n### Node counts per structure (SSVDAG Table 2 shape)\n\n");
     printf("Total nodes over all levels. SVO: every non-empty octree node of levels 0..L-1 "
            "(level L-1 = 2^3 cells). SVDAG / SSVDAG: unique nodes of levels 0..L-3 plus unique 4^3 bricks "
-           "(level L-2), from one build with `compare_structures`; SSVDAG = exact reflective merging (ours).\n\n");
-    printf("| scene | L | voxels | SVO nodes | SVDAG nodes | SSVDAG nodes | SSVDAG / SVDAG | compare build s |\n");
-    printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+           "(level L-2), from one build with `compare_structures`; SSVDAG = exact merging up to the 8 reflections; "
+           "full = exact merging up to all 48 cube symmetries (the default).\n\n");
+    printf("| scene | L | voxels | SVO nodes | SVDAG nodes | SSVDAG nodes | full-symmetry nodes | SSVDAG / SVDAG | full / SSVDAG | compare build s |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     for (k = 0; k < ns; k++) {
         const voxdag_build_stats *st = &res[k].cmp.st;
         uint32_t L = st->levels;
         uint64_t svo = sum(st->svo_nodes, L - 1) + res[k].cells2;
-        uint64_t a = sum(st->svdag_nodes, L - 1), b = sum(st->ssvdag_nodes, L - 1);
-        printf("| %s | %u | %zu | %llu | %llu | %llu | %.3f | %.2f |\n", res[k].s->name, L, res[k].s->n,
-               (unsigned long long)svo, (unsigned long long)a, (unsigned long long)b, (double)b / (double)a,
-               res[k].cmp.total);
+        uint64_t a = sum(st->svdag_nodes, L - 1), b = sum(st->reflect_nodes, L - 1), c = sum(st->full_nodes, L - 1);
+        printf("| %s | %u | %zu | %llu | %llu | %llu | %llu | %.3f | %.3f | %.2f |\n", res[k].s->name, L, res[k].s->n,
+               (unsigned long long)svo, (unsigned long long)a, (unsigned long long)b, (unsigned long long)c,
+               (double)b / (double)a, (double)c / (double)b, res[k].cmp.total);
     }
     for (k = 0; k < ns; k++) {
         const voxdag_build_stats *st = &res[k].cmp.st;
@@ -345,12 +346,13 @@ int main(int argc, char **argv) {
         if (!strncmp(res[k].s->name, "liver", 5) && k + 1 < ns && !strncmp(res[k + 1].s->name, "liver", 5))
             continue; /* per-level table only for the finest liver */
         printf("\nPer level, %s at L = %u (level L-2 = 4^3 bricks, L-1 = 2^3 cells, SVO only):\n\n", res[k].s->name, L);
-        printf("| level | SVO | SVDAG | SSVDAG | SSVDAG / SVDAG |\n|---:|---:|---:|---:|---:|\n");
+        printf("| level | SVO | SVDAG | SSVDAG | full | SSVDAG / SVDAG |\n|---:|---:|---:|---:|---:|---:|\n");
         for (l = 0; l + 1 < L; l++)
-            printf("| %u | %llu | %llu | %llu | %.3f |\n", l, (unsigned long long)st->svo_nodes[l],
-                   (unsigned long long)st->svdag_nodes[l], (unsigned long long)st->ssvdag_nodes[l],
-                   st->svdag_nodes[l] ? (double)st->ssvdag_nodes[l] / (double)st->svdag_nodes[l] : 0.0);
-        printf("| %u | %llu | - | - | - |\n", L - 1, (unsigned long long)res[k].cells2);
+            printf("| %u | %llu | %llu | %llu | %llu | %.3f |\n", l, (unsigned long long)st->svo_nodes[l],
+                   (unsigned long long)st->svdag_nodes[l], (unsigned long long)st->reflect_nodes[l],
+                   (unsigned long long)st->full_nodes[l],
+                   st->svdag_nodes[l] ? (double)st->reflect_nodes[l] / (double)st->svdag_nodes[l] : 0.0);
+        printf("| %u | %llu | - | - | - | - |\n", L - 1, (unsigned long long)res[k].cells2);
     }
     printf("\nInputs:\n\n");
     for (k = 0; k < ns; k++) printf("- %s (L = %u): %s\n", res[k].s->name, res[k].s->levels, res[k].s->input);
