@@ -103,6 +103,7 @@ typedef struct voxdag_error {
     const char *message;  /* static storage; never freed */
     uint64_t byte_offset; /* offset in the input, UINT64_MAX when not input-related */
     uint64_t node;        /* node ordinal within its level, UINT64_MAX when none */
+    int os_error;         /* errno of the failed file operation (VOXDAG_ERR_IO), else 0 */
 } voxdag_error;
 
 /* Returns a static, human-readable name of a status. */
@@ -278,8 +279,13 @@ VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size);
 VOXDAG_API void voxdag_free(voxdag *dag);
 
 #ifndef VOXDAG_NO_STDIO
+/* Reads and validates the file at PATH (as voxdag_load_memory with a copy). */
 VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_opts *opts,
                                           voxdag **out, voxdag_error *err);
+/* Writes the DAG's image to PATH atomically: to a temporary file beside it
+   (PATH.tmpN), then renamed over PATH, so a failed save (full disk, no
+   permission) leaves an existing file intact and no temporary file behind.
+   On VOXDAG_ERR_IO, err->os_error holds errno. */
 VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path,
                                           voxdag_error *err);
 #endif
@@ -348,7 +354,8 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 /* A ray in grid units (the grid spans [0, 2^L)^3, voxel (x, y, z) occupies
    [x, x+1) x [y, y+1) x [z, z+1)). Points are origin + t * dir for t in
    [t_min, t_max]; dir need not be normalized (t is in units of |dir|), and
-   t_max may be HUGE_VAL. A ray that starts on a face between two voxels
+   t_max may be HUGE_VAL; t_max = 0 also means no limit, so a zeroed ray with
+   only origin and dir set traces the whole ray. A ray that starts on a face between two voxels
    starts in the one it moves into; a zero direction component keeps that
    coordinate fixed (a ray lying in a face plane belongs to the voxels above
    it). Ties between axes (rays through edges and corners) are broken towards
@@ -457,6 +464,7 @@ enum {
 #define VOXDAG_ASSERT(x) assert(x)
 #endif
 #ifndef VOXDAG_NO_STDIO
+#include <errno.h>
 #include <stdio.h>
 #endif
 #ifndef VOXDAG_NO_THREADS
@@ -474,9 +482,20 @@ static voxdag_status voxdagi_fail(voxdag_error *err, voxdag_status status,
         err->message = message;
         err->byte_offset = offset;
         err->node = node;
+        err->os_error = 0;
     }
     return status;
 }
+
+#ifndef VOXDAG_NO_STDIO
+/* A failed file operation: the message, and errno for the caller. */
+static voxdag_status voxdagi_fail_io(voxdag_error *err, const char *message) {
+    int e = errno;
+    voxdagi_fail(err, VOXDAG_ERR_IO, message, UINT64_MAX, UINT64_MAX);
+    if (err) err->os_error = e;
+    return VOXDAG_ERR_IO;
+}
+#endif
 
 static voxdag_status voxdagi_ok(voxdag_error *err) {
     if (err) {
@@ -484,6 +503,7 @@ static voxdag_status voxdagi_ok(voxdag_error *err) {
         err->message = "ok";
         err->byte_offset = UINT64_MAX;
         err->node = UINT64_MAX;
+        err->os_error = 0;
     }
     return VOXDAG_OK;
 }
@@ -3839,7 +3859,8 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
 
-    if (!d->voxels || !(ray->t_min <= ray->t_max)) return 0;
+    double t_max = ray->t_max == 0 ? HUGE_VAL : ray->t_max; /* 0: a zeroed ray has no limit */
+    if (!d->voxels || !(ray->t_min <= t_max)) return 0;
     for (a = 0; a < 3; a++) { /* the grid's entry and exit events */
         double o = ray->origin[a], dir = ray->dir[a], lo, hi;
         if (o - o != 0 || dir - dir != 0) return 0; /* NaN or infinite */
@@ -3856,8 +3877,8 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
     if (ray->t_min >= te) te = ray->t_min, ae = 3;
-    if (tx < te || (tx == te && ax < ae) || te > ray->t_max) return 0;
-    t_stop = tx == HUGE_VAL ? te : ray->t_max < tx ? ray->t_max : tx;
+    if (tx < te || (tx == te && ax < ae) || te > t_max) return 0;
+    t_stop = tx == HUGE_VAL ? te : t_max < tx ? t_max : tx;
     /* Level of detail may stop at a 2^3 cell of a brick before t_stop: then
        bricks are walked as two levels (l = B: 2^3 cells, l = B + 1: voxels),
        else as one level of 4^3 voxels. */
@@ -3980,10 +4001,11 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     st = voxdagi_load_opts(opts, &o, err);
     if (st != VOXDAG_OK) return st;
     f = fopen(path, "rb");
-    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot open the file");
-    if (fseek(f, 0, SEEK_END) || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
+    if (!f) return voxdagi_fail_io(err, "cannot open the file");
+    if ((fgetc(f) == EOF && ferror(f)) || fseek(f, 0, SEEK_END) || (len = ftell(f)) < 0 || fseek(f, 0, SEEK_SET)) {
+        st = voxdagi_fail_io(err, "cannot read the file"); /* e.g. a directory */
         fclose(f);
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot size the file");
+        return st;
     }
     if (o.max_input_bytes && (uint64_t)len > o.max_input_bytes) {
         fclose(f);
@@ -4000,7 +4022,7 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
         fclose(f);
         voxdagi_free(&m, buf, (size_t)len);
         voxdagi_mem_destroy(&m);
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot read the file");
+        return voxdagi_fail_io(err, "cannot read the file");
     }
     fclose(f);
     o.copy = 0;
@@ -4017,15 +4039,46 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     return st;
 }
 
+/* Writes the image to PATH + ".tmp" + a number beside the target (the first
+   name not taken), then renames it over PATH: a failed save leaves an
+   existing file as it was and removes its temporary file. Where rename does
+   not replace (Windows), the old file is removed just before the rename. */
 VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path, voxdag_error *err) {
-    FILE *f;
-    int ok;
+    char tmp[4096];
+    size_t n;
+    unsigned k;
+    FILE *f = NULL;
+    voxdag_status st = VOXDAG_OK;
     if (!dag || !path) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "dag or path is NULL");
-    f = fopen(path, "wb");
-    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot create the file");
-    ok = fwrite(dag->image, 1, dag->image_size, f) == dag->image_size;
-    ok = (fclose(f) == 0) && ok;
-    if (!ok) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "cannot write the file");
+    n = strlen(path);
+    if (n + 16 > sizeof tmp) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "path longer than 4080 bytes");
+    for (k = 0; k < 1000 && !f; k++) {
+        FILE *probe;
+        sprintf(tmp, "%s.tmp%u", path, k);
+        probe = fopen(tmp, "rb");
+        if (probe) { /* taken */
+            fclose(probe);
+            continue;
+        }
+        f = fopen(tmp, "wb");
+        if (!f) return voxdagi_fail_io(err, "cannot create a temporary file beside the target");
+    }
+    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "no free temporary file name beside the target");
+    if (fwrite(dag->image, 1, dag->image_size, f) != dag->image_size || fflush(f))
+        st = voxdagi_fail_io(err, "cannot write the file");
+    if (fclose(f) && st == VOXDAG_OK) st = voxdagi_fail_io(err, "cannot write the file");
+    if (st == VOXDAG_OK && rename(tmp, path)) {
+        int e = errno;
+        /* where rename does not replace an existing file */
+        if (remove(path) || rename(tmp, path)) {
+            errno = e;
+            st = voxdagi_fail_io(err, "cannot move the temporary file over the target");
+        }
+    }
+    if (st != VOXDAG_OK) {
+        remove(tmp);
+        return st;
+    }
     return voxdagi_ok(err);
 }
 #endif

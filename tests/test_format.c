@@ -12,6 +12,19 @@
    few seconds under --full). FORMAT_VERBOSE=1 prints the message each
    hostile file is refused with. */
 
+#if defined(__unix__) && !defined(_POSIX_C_SOURCE)
+#define _POSIX_C_SOURCE 200809L /* fork, setrlimit, waitpid for the failed-save test */
+#endif
+#include <errno.h>
+#include <time.h>
+#ifdef __unix__
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+#endif
+
 /* This unit carries its own static copy of the implementation, for the file
    layout macros (VOXDAG_FILE_*) that only the implementation part defines. */
 #define VOXDAG_STATIC
@@ -1036,6 +1049,95 @@ static void test_version3_fields(void) {
     free(f);
 }
 
+/* voxdag_save_file writes atomically: a save that fails part way (here: a
+   file-size limit in a child process) or cannot start leaves the old file
+   as it was and no temporary file; errors carry errno. */
+static int file_equals(const char *path, const void *data, size_t size) {
+    FILE *f = fopen(path, "rb");
+    size_t n;
+    uint8_t *buf = (uint8_t *)malloc(size + 1);
+    int same;
+    if (!f) {
+        free(buf);
+        return 0;
+    }
+    n = fread(buf, 1, size + 1, f);
+    fclose(f);
+    same = n == size && !memcmp(buf, data, size);
+    free(buf);
+    return same;
+}
+
+static void test_save_file(void) {
+    size_t size = 0, small_size;
+    uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size);
+    const void *small;
+    voxdag *d = NULL, *e = NULL;
+    voxdag_error err;
+    char path[256], tmp[300];
+    FILE *fp;
+    if (!f) {
+        CHECK_MSG(0, "mirrored blob golden missing");
+        return;
+    }
+    snprintf(path, sizeof path, "build/test_save_%u.vdag", (unsigned)time(NULL) % 100000u);
+    CHECK(voxdag_load_memory(f, size, NULL, &d, NULL) == VOXDAG_OK);
+    if (!d) goto done;
+    CHECK(voxdag_save_file(d, path, &err) == VOXDAG_OK && err.os_error == 0);
+    CHECK(file_equals(path, f, size));
+    CHECK(voxdag_load_file(path, NULL, &e, NULL) == VOXDAG_OK);
+    voxdag_free(e);
+    /* a failure before writing: a missing directory */
+    CHECK(voxdag_save_file(d, "build/no such directory/x.vdag", &err) == VOXDAG_ERR_IO && err.os_error == ENOENT);
+    CHECK(voxdag_load_file("build/no such file.vdag", NULL, &e, &err) == VOXDAG_ERR_IO && err.os_error == ENOENT && !e);
+    CHECK(voxdag_load_file("build", NULL, &e, &err) == VOXDAG_ERR_IO && err.os_error != 0 && !e); /* a directory */
+    /* a failure while writing, over an existing smaller file */
+    {
+        voxdag *one = NULL;
+        size_t one_size = 0;
+        uint8_t *g = read_golden(GOLDEN_ONE_VOXEL, &one_size);
+        CHECK(g && voxdag_load_memory(g, one_size, NULL, &one, NULL) == VOXDAG_OK);
+        if (one) {
+            CHECK(voxdag_save_file(one, path, NULL) == VOXDAG_OK);
+            small = voxdag_image(one, &small_size);
+#ifdef __unix__
+            {
+                pid_t pid = fork();
+                int status = 0;
+                if (pid == 0) { /* the child may write at most 100 bytes per file */
+                    struct rlimit rl;
+                    signal(SIGXFSZ, SIG_IGN);
+                    rl.rlim_cur = rl.rlim_max = 100;
+                    setrlimit(RLIMIT_FSIZE, &rl);
+                    _exit(voxdag_save_file(d, path, &err) == VOXDAG_ERR_IO && err.os_error == EFBIG ? 0 : 1);
+                }
+                CHECK(pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
+                CHECK_MSG(file_equals(path, small, small_size), "a failed save changed the existing file");
+            }
+#endif
+            voxdag_free(one);
+        }
+        free(g);
+    }
+    snprintf(tmp, sizeof tmp, "%s.tmp0", path);
+    fp = fopen(tmp, "rb");
+    CHECK_MSG(!fp, "a temporary file was left behind");
+    if (fp) fclose(fp);
+    /* a taken temporary name is skipped, not overwritten */
+    fp = fopen(tmp, "wb");
+    if (fp) {
+        fputs("someone else's", fp);
+        fclose(fp);
+    }
+    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && file_equals(path, f, size));
+    CHECK(file_equals(tmp, "someone else's", 14));
+    remove(tmp);
+    remove(path);
+done:
+    voxdag_free(d);
+    free(f);
+}
+
 const test_case test_format_cases[] = {
     {"format/golden_identical", test_golden_identical},
     {"format/offsets_documented", test_offsets_documented},
@@ -1046,5 +1148,6 @@ const test_case test_format_cases[] = {
     {"format/limits", test_limits},
     {"format/hostile_files", test_hostile_files},
     {"format/version3_fields", test_version3_fields},
+    {"format/save_file", test_save_file},
     {NULL, NULL},
 };

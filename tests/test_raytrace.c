@@ -120,7 +120,7 @@ static int event_before(double t1, int a1, double t2, int a2) { return t1 < t2 |
 static int oracle_walk(const rscene *s, const voxdag_ray *ray, uint32_t q,
                        int (*stop)(const rscene *, uint32_t, const visit *, void *), void *user, visit *v) {
     uint32_t n = 1u << q, size = s->n >> q, b, k;
-    double inv[3], ts = -HUGE_VAL, tx = HUGE_VAL;
+    double inv[3], ts = -HUGE_VAL, tx = HUGE_VAL, t_max = ray->t_max == 0 ? HUGE_VAL : ray->t_max; /* 0: no limit */
     int as = 0, ax = 0;
     for (b = 0; b < 3; b++) {
         double o = ray->origin[b], d = ray->dir[b], lo, hi;
@@ -135,7 +135,7 @@ static int oracle_walk(const rscene *s, const voxdag_ray *ray, uint32_t q,
         if (event_before(hi, (int)b, tx, ax)) tx = hi, ax = (int)b;
     }
     if (!event_before(ray->t_min, 3, ts, as)) ts = ray->t_min, as = 3;
-    if (event_before(tx, ax, ts, as) || ts > ray->t_max) return 0;
+    if (event_before(tx, ax, ts, as) || ts > t_max) return 0;
     /* Start cell: count the interior planes crossed before the start event. */
     for (b = 0; b < 3; b++) {
         double d = ray->dir[b];
@@ -161,7 +161,7 @@ static int oracle_walk(const rscene *s, const voxdag_ray *ray, uint32_t q,
             t = ((double)((v->c[b] + (ray->dir[b] > 0)) * size) - ray->origin[b]) * inv[b];
             if (t < best) best = t, a = (int)b;
         }
-        if (a < 0 || best > ray->t_max) return 0;
+        if (a < 0 || best > t_max) return 0;
         if (ray->dir[a] > 0 ? ++v->c[a] == n : v->c[a]-- == 0) return 0;
         v->edge = 0;
         for (b = 0; b < 3; b++)
@@ -314,6 +314,16 @@ static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count
         CHECK_MSG(got == want, "scene %d L=%u sym=%d ray %u: hit %d, oracle %d", kind, levels, symmetric, i,
                   got, want);
         CHECK(voxdag_occluded(d, &ray) == want);
+        if (ray.t_min == 0 && ray.t_max == HUGE_VAL) { /* a zeroed ray with origin and dir: the same answer */
+            voxdag_ray z;
+            voxdag_hit zh;
+            memset(&z, 0, sizeof z);
+            memcpy(z.origin, ray.origin, sizeof z.origin);
+            memcpy(z.dir, ray.dir, sizeof z.dir);
+            memset(&zh, 0, sizeof zh);
+            CHECK(voxdag_raycast(d, &z, &opts, &zh) == got && !memcmp(&zh, &hit, sizeof zh));
+            CHECK(voxdag_occluded(d, &z) == want);
+        }
         if (got && want) {
             int normal[3] = {0, 0, 0};
             if (v.axis < 3) normal[v.axis] = ray.dir[v.axis] > 0 ? -1 : 1;
