@@ -2509,24 +2509,29 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) 
     best->O[1] = best->O[2] = best->O[3] = 57 - 6;
     best->K[1] = best->K[2] = best->K[3] = 6;
     for (a = 0; a < nc; a++)
-        for (b = a; b < nc; b++)
+        for (b = a; b < nc; b++) {
+            unsigned char pair[58 * 7]; /* per cell: the narrower of classes a and b that holds it, 255 none */
+            for (i = 0; i < ncell; i++) {
+                unsigned wa = cand[a][0] >= cell[i][0] && cand[a][1] >= cell[i][1] ? cand[a][0] + cand[a][1] : 255;
+                unsigned wb = cand[b][0] >= cell[i][0] && cand[b][1] >= cell[i][1] ? cand[b][0] + cand[b][1] : 255;
+                pair[i] = (unsigned char)(wa < wb ? wa : wb);
+            }
             for (c = b; c < nc; c++) {
-                voxdagi_classes t;
                 uint64_t cost = 0;
-                int ok = 1;
-                const unsigned *pick[3];
-                pick[0] = cand[a], pick[1] = cand[b], pick[2] = cand[c];
-                for (i = 0; i < 3; i++) t.O[i + 1] = (unsigned char)pick[i][0], t.K[i + 1] = (unsigned char)pick[i][1];
-                for (i = 0; i < ncell && ok; i++) {
-                    unsigned k = voxdagi_class_for(&t, cell[i][0], cell[i][1]);
-                    if (!k) ok = 0;
-                    else cost += hist[cell[i][0]][cell[i][1]] * (t.O[k] + t.K[k]);
+                for (i = 0; i < ncell; i++) {
+                    unsigned w = cand[c][0] >= cell[i][0] && cand[c][1] >= cell[i][1] ? cand[c][0] + cand[c][1] : 255;
+                    if (pair[i] < w) w = pair[i];
+                    if (w == 255) break;
+                    cost += hist[cell[i][0]][cell[i][1]] * w;
                 }
-                if (ok && cost < best_cost) {
+                if (i == ncell && cost < best_cost) {
                     best_cost = cost;
-                    *best = t;
+                    best->O[1] = (unsigned char)cand[a][0], best->K[1] = (unsigned char)cand[a][1];
+                    best->O[2] = (unsigned char)cand[b][0], best->K[2] = (unsigned char)cand[b][1];
+                    best->O[3] = (unsigned char)cand[c][0], best->K[3] = (unsigned char)cand[c][1];
                 }
             }
+        }
 }
 
 typedef struct voxdagi_encoder {
