@@ -195,7 +195,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
    chunks (e.g. aligned subtrees), keeping only unique nodes. */
 VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *err);
 
-/* A triangle mesh to voxelize (DESIGN 3.1). Vertices are in grid units: the
+/* A triangle mesh to voxelize. Vertices are in grid units: the
    grid spans [0, 2^L)^3 and voxel (x, y, z) is the closed box
    [x, x+1] x [y, y+1] x [z, z+1]. */
 typedef struct voxdag_mesh {
@@ -838,11 +838,6 @@ static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsig
     return voxdagi_reflect_brick(x, T & 7);
 }
 
-/* Morton position T(p) inside a brick: T on each coordinate-bit triple. */
-static unsigned voxdagi_transform_pos(const voxdagi_cube *c, unsigned p, unsigned T) {
-    return (unsigned)(c->act[T][p & 7] | c->act[T][p >> 3] << 3);
-}
-
 // -- Unique node stores (one per level) with hash-consing
 
 #define VOXDAGI_NONE 0xFFFFFFFFu    /* an absent child reference */
@@ -1091,7 +1086,7 @@ static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_ch
     return r;
 }
 
-// -- Streaming bottom-up reduction (DESIGN 3.1)
+// -- Streaming bottom-up reduction (hash-consed, one open node per level)
 
 /* Consumes voxels (or finished subtrees) in Morton order, keeping one open
    brick and one partially filled node per level; a node is reduced as soon as
@@ -1595,7 +1590,7 @@ static void voxdagi_reducer_close_below(voxdagi_reducer *r, uint32_t level) {
         if (r->part_open[l]) voxdagi_reducer_close(r, l);
 }
 
-/* Parallel reduction (DESIGN 3.1): complete subtrees of level SPLIT are
+/* Parallel reduction: complete subtrees of level SPLIT are
    reduced by workers into stores of their own, then merged into the builder's
    stores in Morton order with the same interning (so the result does not
    depend on how the work was split). */
@@ -3401,9 +3396,9 @@ static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const vox
     if (r->root == VOXDAGI_NONE) return 1;
     for (l = B + 1; l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
-        cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur + 1);
+        cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur);
         if (!cur) {
-            voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+            voxdagi_free(m, below, 6 * below_n * sizeof *below);
             return 0;
         }
         for (i = 0; i < s->n; i++) {
@@ -3431,12 +3426,12 @@ static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const vox
                 }
             }
         }
-        voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+        voxdagi_free(m, below, 6 * below_n * sizeof *below);
         below = cur, below_n = s->n;
     }
     memcpy(box, below + 6 * (size_t)(r->root >> 6), 6 * sizeof *box);
     voxdagi_box_transform(c, box, r->root & 63, 1u << r->levels);
-    voxdagi_free(m, below, 6 * below_n * sizeof *below + 1);
+    voxdagi_free(m, below, 6 * below_n * sizeof *below);
     return 1;
 }
 
@@ -3700,10 +3695,6 @@ static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *re
     return idx;
 }
 
-static uint64_t voxdagi_brick_preceding(const voxdag *d, uint64_t mask, unsigned MI, unsigned p) {
-    return (uint64_t)voxdagi_popcount64(voxdagi_brick_to_world(d, mask, MI) & ((1ull << p) - 1));
-}
-
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z, uint64_t *index) {
     uint32_t L = dag->levels, B = L - 2, l;
     unsigned MI = dag->cube.inv[dag->root_transform], p;
@@ -3722,10 +3713,10 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
         MI = dag->cube.comp[ref & 63][MI];
         at = ref >> 6;
     }
-    mask = voxdagi_brick(dag, at);
+    mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, at), MI);
     p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
-    if (!(mask >> voxdagi_transform_pos(&dag->cube, p, MI) & 1)) return 0;
-    if (index) *index = idx + voxdagi_brick_preceding(dag, mask, MI, p);
+    if (!(mask >> p & 1)) return 0;
+    if (index) *index = idx + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
     return 1;
 }
 
@@ -3833,7 +3824,7 @@ static unsigned voxdagi_brick_pos(const uint32_t c[3]) {
 }
 
 /* Index of the first voxel of cell C at cell level Q: the voxels of all
-   preceding siblings on the path (DESIGN 3.5), read from the frames. */
+   preceding siblings on the path (FORMAT.md, Voxel index), read from the frames. */
 static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint64_t mask,
                                   const uint32_t c[3], uint32_t q) {
     uint32_t B = d->levels - 2, top = q < B ? q : B, k;

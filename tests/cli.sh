@@ -1,6 +1,6 @@
 #!/bin/sh
-# Command-line contract tests for the vdag tool (the forms of DESIGN section 7
-# as documented in README.md). Expected answers are computed here by an
+# Command-line contract tests for the vdag tool (the command forms documented
+# in README.md). Expected answers are computed here by an
 # independent script (python3), never taken from vdag itself.
 # Usage: tests/cli.sh VDAG
 set -u
@@ -384,7 +384,7 @@ import json
 json.dump(want, open(t + "/rays.json", "w"))
 EOF
 check "build the ray scene" "$VDAG" build "$T/r.xyz" "$T/r.vdag" --levels 4 2>/dev/null
-check "rays: format and answers of DESIGN 7" sh -c "'$VDAG' rays '$T/r.vdag' <'$T/rays.txt' >'$T/rays.out' && python3 - '$T' <<'EOF'
+check "rays: format and answers (README, the vdag tool)" sh -c "'$VDAG' rays '$T/r.vdag' <'$T/rays.txt' >'$T/rays.out' && python3 - '$T' <<'EOF'
 import json, re, sys
 t = sys.argv[1]
 want = json.load(open(t + '/rays.json'))

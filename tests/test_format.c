@@ -953,68 +953,74 @@ static void test_version3_fields(void) {
         expect(&q, VOXDAG_ERR_CORRUPT, "empty voxel box", NULL);
         parts_free(&q);
     }
-    { /* level entries: table length, table entries, classes, reserved bytes */
+    { /* level entries: table length, table entries, classes, count width, reserved bytes */
+        static const struct {
+            unsigned at, value;
+            const char *what;
+        } bad[] = {{21, 0, "transform table length 0"}, {21, 49, "transform table length 49"},
+                   {32, 48, "table entry 48"},           {25, 7, "7 code bits"},
+                   {29, 1, "reserved level bytes"},      {20, 65, "count width 65"}};
         parts q;
         uint8_t *e;
+        size_t k;
+        for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
+            parts_read(&q, f, size);
+            e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE; /* level 1 of 0..2 */
+            e[bad[k].at] = (uint8_t)bad[k].value;
+            expect(&q, VOXDAG_ERR_CORRUPT, bad[k].what, NULL);
+            parts_free(&q);
+        }
         parts_read(&q, f, size);
         e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
         CHECK(e[21] >= 1);
-        e[21] = 0;
-        expect(&q, VOXDAG_ERR_CORRUPT, "transform table length 0", NULL);
-        e[21] = 49;
-        expect(&q, VOXDAG_ERR_CORRUPT, "transform table length 49", NULL);
-        parts_free(&q);
-        parts_read(&q, f, size);
-        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
-        e[32] = 48;
-        expect(&q, VOXDAG_ERR_CORRUPT, "table entry 48", NULL);
-        parts_free(&q);
-        parts_read(&q, f, size);
-        e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
         e[32 + e[21]] = 1;
         expect(&q, VOXDAG_ERR_CORRUPT, "table entry past the length", NULL);
         parts_free(&q);
         parts_read(&q, f, size);
         e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
-        e[25] = 7;
-        expect(&q, VOXDAG_ERR_CORRUPT, "7 code bits", NULL);
         e[25] = 6, e[22] = 52;
         expect(&q, VOXDAG_ERR_CORRUPT, "58-bit pointer class", NULL);
         parts_free(&q);
-        parts_read(&q, f, size);
-        q.data[levels][29] = 1;
-        expect(&q, VOXDAG_ERR_CORRUPT, "reserved level bytes", NULL);
-        q.data[levels][29] = 0;
-        q.data[levels][20] = 65;
-        expect(&q, VOXDAG_ERR_CORRUPT, "count width 65", NULL);
-        parts_free(&q);
     }
-    { /* a pointer code at or past the table length; a padding bit */
+    { /* a pointer code at or past the table length: the level's table cut
+         to end just before the code of a pointer that has a non-zero one */
         parts q;
         level_view v;
-        unsigned width, code_bits, t, found = 0;
-        uint64_t at, k;
+        unsigned found = 0;
+        uint32_t l;
         parts_read(&q, f, size);
-        v = level_of(&q, 1);
-        for (k = 0; k < n1 && !found; k++) { /* a pointer with code bits */
-            uint8_t *rec = q.data[parts_find(&q, 2)] + v.offset + starts1[k];
-            unsigned header = (unsigned)golden_le(rec, 2), s;
-            at = 8 * (v.offset + starts1[k]) + 16 + v.count_bits;
-            for (s = 0; s < 8 && !found; s++) {
-                t = header >> (2 * s) & 3;
-                if (t && v.code_bits[t]) {
-                    width = v.width[t], code_bits = v.code_bits[t], found = 1;
-                    bits_put(q.data[parts_find(&q, 2)], at, (bits_get(q.data[parts_find(&q, 2)], at, width) | ((1ull << code_bits) - 1)), width);
-                    q.data[levels][GOLDEN_LEVEL_ENTRY_SIZE + 21] = (uint8_t)((1u << code_bits) - 1);
-                    memset(q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE + 32 + ((1u << code_bits) - 1), 0, 48 - ((1u << code_bits) - 1));
+        for (l = 0; l < 3 && !found; l++) {
+            uint64_t st[512];
+            size_t m = record_starts(&q, l, st, 512), k;
+            v = level_of(&q, l);
+            for (k = 0; k < m && !found; k++) {
+                const uint8_t *nodes = q.data[parts_find(&q, 2)];
+                unsigned header = (unsigned)golden_le(nodes + v.offset + st[k], 2), s;
+                uint64_t at = 8 * (v.offset + st[k]) + 16 + v.count_bits;
+                for (s = 0; s < 8 && !found; s++) {
+                    unsigned t = header >> (2 * s) & 3;
+                    unsigned code = (unsigned)(bits_get(nodes, at, v.width[t]) & ((1ull << v.code_bits[t]) - 1));
+                    if (t && code) {
+                        uint8_t *e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE * l;
+                        e[21] = (uint8_t)code;
+                        memset(e + 32 + code, 0, 48 - code);
+                        found = 1;
+                    }
+                    at += v.width[t];
                 }
-                at += v.width[t];
             }
         }
+        CHECK_MSG(found, "no pointer with a non-zero transform code in the golden");
         if (found) expect(&q, VOXDAG_ERR_CORRUPT, "code past the table", NULL);
         parts_free(&q);
+    }
+    { /* a padding bit set at the end of a level-1 record */
+        parts q;
+        level_view v;
+        size_t k;
         parts_read(&q, f, size);
-        for (k = 0; k < n1; k++) { /* a record with padding bits */
+        v = level_of(&q, 1);
+        for (k = 0; k < n1; k++) {
             uint8_t *rec = q.data[parts_find(&q, 2)] + v.offset + starts1[k];
             unsigned header = (unsigned)golden_le(rec, 2), s, bits = 16 + v.count_bits;
             for (s = 0; s < 8; s++) bits += v.width[header >> (2 * s) & 3];
@@ -1024,6 +1030,7 @@ static void test_version3_fields(void) {
                 break;
             }
         }
+        CHECK_MSG(k < n1, "no level-1 record with padding bits in the golden");
         parts_free(&q);
     }
     { /* a version-2 file: refused by its version, the message naming it */
