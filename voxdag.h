@@ -2408,8 +2408,14 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, const v
 // pointers in octant order, bit-packed. A pointer of class t has W_t = O_t +
 // K_t bits: the target (byte offset in the next level, or brick index) above
 // a K_t-bit code into the level's transform table (sorted by frequency, so
-// code 0 is the most common transform). Each level picks its classes for the
-// fewest bits.
+// code 0 is the most common transform).
+// Private children (Lefebvre & Hoppe 4: implicit addressing): a node
+// referenced once is stored, in its referrer's frame, right after the other
+// private children of the same parent, at the end of its level. A level that
+// uses them gives tag 3 to private children: such a pointer has no bits, and
+// the record holds one base field of P bits (after the count) with the offset
+// of its first private child; the next ones follow it record by record. Each
+// level picks this or a third class, and its classes, for the fewest bytes.
 
 /* The number of bits of V (0 for 0). */
 static unsigned voxdagi_bit_length(uint64_t v) {
@@ -2467,25 +2473,27 @@ static int voxdagi_storage_order(voxdagi_mem *m, const voxdagi_store *s, const u
     return ok;
 }
 
-/* A level's pointer classes: tag t (1..3) holds O[t] target bits above K[t]
-   code bits. */
+/* A level's pointer classes: tag t (1..N) holds O[t] target bits above K[t]
+   code bits; N = 2 when tag 3 marks private children (then O[3] = K[3] = 0
+   and P is the width of the base field). */
 typedef struct voxdagi_classes {
-    unsigned char O[4], K[4];
+    unsigned char O[4], K[4], N, P;
 } voxdagi_classes;
 
-/* The cheapest class (1..3) that holds a target of OB bits and a code of KB
+/* The cheapest class (1..N) that holds a target of OB bits and a code of KB
    bits, or 0 when none does. */
 static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigned kb) {
     unsigned t, best = 0;
-    for (t = 1; t <= 3; t++)
+    for (t = 1; t <= c->N; t++)
         if (c->O[t] >= ob && c->K[t] >= kb && (!best || c->O[t] + c->K[t] < c->O[best] + c->K[best])) best = t;
     return best;
 }
 
-/* Chooses three classes for the fewest pointer bits, given how many pointers
-   need OB target bits and KB code bits (HIST[ob][kb]). Candidate classes
-   take a target width that occurs and any code width up to the largest. */
-static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) {
+/* Chooses N (2 or 3) classes for the fewest pointer bits, given how many
+   pointers need OB target bits and KB code bits (HIST[ob][kb]). Candidate
+   classes take a target width that occurs and any code width up to the
+   largest. */
+static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_classes *best) {
     unsigned cand[7 * 58][2], cell[58 * 7][2], nc = 0, ncell = 0, ob, kb, kmax = 0, a, b, c, i;
     uint64_t best_cost = UINT64_MAX;
     for (ob = 0; ob < 58; ob++)
@@ -2500,9 +2508,8 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) 
         if (!any) continue;
         for (kb = 0; kb <= kmax; kb++) cand[nc][0] = ob, cand[nc][1] = kb, nc++;
     }
-    memset(best, 0, sizeof *best);
-    best->O[1] = best->O[2] = best->O[3] = 57 - 6;
-    best->K[1] = best->K[2] = best->K[3] = 6;
+    memset(best, 0, sizeof *best); /* no pointers: zero widths */
+    best->N = (unsigned char)n;
     for (a = 0; a < nc; a++)
         for (b = a; b < nc; b++) {
             unsigned char pair[58 * 7]; /* per cell: the narrower of classes a and b that holds it, 255 none */
@@ -2511,7 +2518,7 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) 
                 unsigned wb = cand[b][0] >= cell[i][0] && cand[b][1] >= cell[i][1] ? cand[b][0] + cand[b][1] : 255;
                 pair[i] = (unsigned char)(wa < wb ? wa : wb);
             }
-            for (c = b; c < nc; c++) {
+            for (c = b; c < (n == 3 ? nc : b + 1); c++) {
                 uint64_t cost = 0;
                 for (i = 0; i < ncell; i++) {
                     unsigned w = cand[c][0] >= cell[i][0] && cand[c][1] >= cell[i][1] ? cand[c][0] + cand[c][1] : 255;
@@ -2527,6 +2534,7 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], voxdagi_classes *best) 
                 }
             }
         }
+    if (n == 2) best->O[3] = best->K[3] = 0;
 }
 
 typedef struct voxdagi_encoder {
@@ -2537,6 +2545,8 @@ typedef struct voxdagi_encoder {
     uint32_t *order[VOXDAG_MAX_LEVELS];  /* ids in storage order */
     uint64_t *pos[VOXDAG_MAX_LEVELS];    /* per id: byte offset, or brick index */
     uint8_t *orient[VOXDAG_MAX_LEVELS];  /* per id: R, the node is stored as R(canonical) */
+    uint8_t *tag[VOXDAG_MAX_LEVELS];     /* per child slot of an inner level: its stored transform */
+    uint8_t *single[VOXDAG_MAX_LEVELS];  /* per id: referenced once, through the identity */
     uint64_t size[VOXDAG_MAX_LEVELS];    /* bytes of each inner level */
     unsigned count_bits[VOXDAG_MAX_LEVELS];
     voxdagi_classes cls[VOXDAG_MAX_LEVELS];
@@ -2553,6 +2563,8 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
         voxdagi_free(e->mem, e->order[l], n * sizeof(uint32_t));
         voxdagi_free(e->mem, e->pos[l], n * sizeof(uint64_t));
         voxdagi_free(e->mem, e->orient[l], n);
+        if (e->tag[l]) voxdagi_free(e->mem, e->tag[l], 8 * n);
+        voxdagi_free(e->mem, e->single[l], n);
     }
 }
 
@@ -2659,45 +2671,200 @@ static void voxdagi_count_widths(voxdagi_encoder *e) {
     if (drop < B && most >= estimate / 32) e->count_bits[drop] = 0;
 }
 
-/* The transform table of inner level L: the stored transforms of its
-   pointers by decreasing frequency (ties: the smaller transform first). */
-static void voxdagi_transform_table(voxdagi_encoder *e, uint32_t l) {
+/* Whether child reference X of a node of inner level L is a private child:
+   the level uses them and the child is referenced once, through the
+   identity. */
+static int voxdagi_is_private(const voxdagi_encoder *e, uint32_t l, uint32_t x) {
+    return e->cls[l].N == 2 && e->single[l + 1][x >> 6];
+}
+
+/* The children of node ID of inner level L in stored octant order (stored
+   octant R(j) holds canonical child j), with their stored transforms. */
+static void voxdagi_stored_children(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint32_t child[8],
+                                    unsigned tag[8]) {
+    const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
+    const uint8_t *act = e->cube->act[e->orient[l][id]];
+    unsigned j;
+    for (j = 0; j < 8; j++) child[j] = VOXDAGI_NONE, tag[j] = 0;
+    for (j = 0; j < 8; j++)
+        if (ch[j] != VOXDAGI_NONE) child[act[j]] = ch[j], tag[act[j]] = e->tag[l][8 * (size_t)id + j];
+}
+
+/* The base of a record with stored children CHILD: its first private
+   child's offset, or UINT64_MAX when it has none. */
+static uint64_t voxdagi_private_base(const voxdagi_encoder *e, uint32_t l, const uint32_t child[8]) {
+    unsigned j;
+    for (j = 0; j < 8; j++)
+        if (child[j] != VOXDAGI_NONE && voxdagi_is_private(e, l, child[j])) return e->pos[l + 1][child[j] >> 6];
+    return UINT64_MAX;
+}
+
+/* The tag of pointer X with stored transform TAG in a record of inner level
+   L, and its bits in *VALUE (target << K | code) unless it is private. */
+static unsigned voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, uint32_t x, unsigned tag, uint64_t *value) {
+    const voxdagi_classes *c = &e->cls[l];
+    uint64_t target = e->pos[l + 1][x >> 6];
+    unsigned code = e->code[l][tag], t;
+    if (voxdagi_is_private(e, l, x)) return 3;
+    t = voxdagi_class_for(c, voxdagi_bit_length(target), voxdagi_bit_length(code));
+    *value = target << c->K[t] | code;
+    return t;
+}
+
+/* The record of node ID of inner level L under the level's plan: its bits,
+   and the record itself written at P (zeroed) unless P is NULL. */
+static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint8_t *p) {
+    const voxdagi_classes *cls = &e->cls[l];
+    uint32_t child[8];
+    unsigned tag[8], header = 0, j;
+    uint64_t bits = 16 + e->count_bits[l], base, v = 0;
+    voxdagi_stored_children(e, l, id, child, tag);
+    if (p) voxdagi_put_bits(p, 16, e->r->store[l].count[id], e->count_bits[l]);
+    base = voxdagi_private_base(e, l, child);
+    if (base != UINT64_MAX) {
+        if (p) voxdagi_put_bits(p, bits, base, cls->P);
+        bits += cls->P;
+    }
+    for (j = 0; j < 8; j++) {
+        unsigned t;
+        if (child[j] == VOXDAGI_NONE) continue;
+        t = voxdagi_pointer(e, l, child[j], tag[j], &v);
+        header |= t << (2 * j);
+        if (t == 3 && cls->N == 2) continue;
+        if (p) voxdagi_put_bits(p, bits, v, cls->O[t] + cls->K[t]);
+        bits += cls->O[t] + cls->K[t];
+    }
+    if (p) voxdagi_put_le(p, header, 2);
+    return bits;
+}
+
+/* Chooses inner level L's transform table, N pointer classes (2: private
+   children, with the base width) for the fewest bits. Returns 0 when a
+   pointer or a base needs more than 57 bits. */
+static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
     const voxdagi_store *s = &e->r->store[l];
-    uint64_t freq[VOXDAGI_TRANSFORMS];
-    unsigned T, k, n = 0;
-    size_t p;
+    voxdagi_classes *cls = &e->cls[l];
+    uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0;
+    unsigned T, k, len = 0;
+    size_t i;
+    cls->N = (unsigned char)n;
     memset(freq, 0, sizeof freq);
-    for (p = 0; p < 8 * s->n; p++)
-        if (s->child[p] != VOXDAGI_NONE) freq[voxdagi_stored_tag(e, l, e->orient[l][p >> 3], s->child[p])]++;
+    for (i = 0; i < 8 * s->n; i++) /* the table: stored transforms by decreasing frequency, ties by value */
+        if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) freq[e->tag[l][i]]++;
     for (T = 0; T < VOXDAGI_TRANSFORMS; T++) {
         if (!freq[T]) continue;
-        for (k = n; k > 0 && freq[e->table[l][k - 1]] < freq[T]; k--) e->table[l][k] = e->table[l][k - 1];
+        for (k = len; k > 0 && freq[e->table[l][k - 1]] < freq[T]; k--) e->table[l][k] = e->table[l][k - 1];
         e->table[l][k] = (uint8_t)T;
-        n++;
+        len++;
     }
-    for (k = 0; k < n; k++) e->code[l][e->table[l][k]] = (uint8_t)k;
-    e->table_len[l] = n;
+    if (!len) e->table[l][len++] = 0; /* only private children: a table is never empty */
+    for (k = 0; k < len; k++) e->code[l][e->table[l][k]] = (uint8_t)k;
+    e->table_len[l] = len;
+    memset(hist, 0, sizeof hist);
+    for (i = 0; i < 8 * s->n; i++) {
+        uint32_t x = s->child[i];
+        unsigned ob, kb;
+        if (x == VOXDAGI_NONE || voxdagi_is_private(e, l, x)) continue;
+        ob = voxdagi_bit_length(e->pos[l + 1][x >> 6]);
+        kb = voxdagi_bit_length(e->code[l][e->tag[l][i]]);
+        if (ob + kb > 57) return 0;
+        hist[ob][kb]++;
+    }
+    voxdagi_choose_classes(hist, n, cls);
+    cls->N = (unsigned char)n;
+    for (i = 0; n == 2 && i < s->n; i++) {
+        uint32_t child[8];
+        unsigned tag[8];
+        uint64_t base;
+        voxdagi_stored_children(e, l, (uint32_t)i, child, tag);
+        base = voxdagi_private_base(e, l, child);
+        if (base != UINT64_MAX && base > max_base) max_base = base;
+    }
+    cls->P = (unsigned char)voxdagi_bit_length(max_base);
+    return cls->P <= 57;
 }
 
-/* Bits of the pointer X of a node of level L (stored as RP): target and code
-   widths, and its value. */
-static uint64_t voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, unsigned rp, uint32_t x, unsigned *ob,
-                                unsigned *kb) {
-    uint64_t target = e->pos[l + 1][x >> 6];
-    unsigned code = e->code[l][voxdagi_stored_tag(e, l, rp, x)];
-    *ob = voxdagi_bit_length(target);
-    *kb = voxdagi_bit_length(code);
-    return target << e->cls[l].K[voxdagi_class_for(&e->cls[l], *ob, *kb)] | code;
+/* Record offsets of inner level L in storage order; returns its bytes. */
+static uint64_t voxdagi_level_offsets(voxdagi_encoder *e, uint32_t l) {
+    uint64_t at = 0;
+    size_t i;
+    for (i = 0; i < e->r->store[l].n; i++) {
+        uint32_t id = e->order[l][i];
+        e->pos[l][id] = at;
+        at += (voxdagi_record(e, l, id, NULL) + 7) / 8;
+    }
+    return at;
 }
 
-/* Orders every level and computes record offsets, bottom-up (pointer widths
-   depend on where the next level put its nodes). Returns 0 when out of
-   memory or when a level needs pointers wider than 57 bits. */
+/* Plans inner level L bottom-up (pointer widths depend on where the next
+   level put its nodes): with private children when the next level has
+   candidates and they make the level smaller, else with three classes. */
+static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
+    voxdagi_classes three;
+    uint8_t code[VOXDAGI_TRANSFORMS], table[VOXDAGI_TRANSFORMS];
+    unsigned table_len;
+    uint64_t size3 = 0;
+    int ok3 = voxdagi_choose_level(e, l, 3);
+    if (ok3) size3 = voxdagi_level_offsets(e, l);
+    e->size[l] = size3;
+    if (!candidates) return ok3;
+    three = e->cls[l], table_len = e->table_len[l];
+    memcpy(code, e->code[l], sizeof code);
+    memcpy(table, e->table[l], sizeof table);
+    if (voxdagi_choose_level(e, l, 2)) {
+        uint64_t size2 = voxdagi_level_offsets(e, l);
+        if (!ok3 || size2 < size3) {
+            e->size[l] = size2;
+            return 1;
+        }
+    }
+    if (!ok3) return 0;
+    e->cls[l] = three, e->table_len[l] = table_len;
+    memcpy(e->code[l], code, sizeof code);
+    memcpy(e->table[l], table, sizeof table);
+    e->size[l] = voxdagi_level_offsets(e, l);
+    return 1;
+}
+
+/* Stored transforms of every pointer, the private-child candidates (nodes
+   referenced once through the identity: their orientation is their one
+   referrer's), and each level's order of them: after the shared nodes, by
+   parent in storage order, then by stored octant, so that the private
+   children of a record follow each other. Top-down. */
+static void voxdagi_private_order(voxdagi_encoder *e, uint32_t *const *refs, int *candidates) {
+    const voxdagi_reducer *r = e->r;
+    uint32_t B = e->levels - 2, l;
+    for (l = 0; l < B; l++) {
+        const voxdagi_store *s = &r->store[l];
+        uint32_t *o = e->order[l + 1];
+        size_t i, k = 0, n1 = r->store[l + 1].n;
+        memset(e->single[l + 1], 0, n1);
+        candidates[l] = 0;
+        for (i = 0; i < 8 * s->n; i++) {
+            uint32_t x = s->child[i];
+            if (x == VOXDAGI_NONE) continue;
+            e->tag[l][i] = (uint8_t)voxdagi_stored_tag(e, l, e->orient[l][i >> 3], x);
+            if (refs[l + 1][x >> 6] == 1 && e->tag[l][i] == 0) e->single[l + 1][x >> 6] = 1, candidates[l] = 1;
+        }
+        for (i = 0; i < n1; i++)
+            if (!e->single[l + 1][o[i]]) o[k++] = o[i];
+        for (i = 0; i < s->n; i++) {
+            uint32_t child[8];
+            unsigned tag[8], j;
+            voxdagi_stored_children(e, l, e->order[l][i], child, tag);
+            for (j = 0; j < 8; j++)
+                if (child[j] != VOXDAGI_NONE && e->single[l + 1][child[j] >> 6]) o[k++] = child[j] >> 6;
+        }
+    }
+}
+
+/* Orders every level and plans record offsets. Returns 0 when out of memory
+   or when a level needs pointers wider than 57 bits. */
 static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     uint32_t B = e->levels - 2, l;
     uint32_t *refs[VOXDAG_MAX_LEVELS];
-    int ok = 1;
+    int ok = 1, candidates[VOXDAG_MAX_LEVELS];
     memset(refs, 0, sizeof refs);
     for (l = 0; l <= B; l++) {
         size_t n = r->store[l].n;
@@ -2705,7 +2872,9 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         e->order[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
         e->pos[l] = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof(uint64_t));
         e->orient[l] = (uint8_t *)voxdagi_alloc(e->mem, n);
-        if (!refs[l] || !e->order[l] || !e->pos[l] || !e->orient[l]) ok = 0;
+        e->tag[l] = l < B ? (uint8_t *)voxdagi_alloc(e->mem, 8 * n) : NULL;
+        e->single[l] = (uint8_t *)voxdagi_alloc(e->mem, n);
+        if (!refs[l] || !e->order[l] || !e->pos[l] || !e->orient[l] || (l < B && !e->tag[l]) || !e->single[l]) ok = 0;
         else memset(refs[l], 0, n * sizeof(uint32_t));
     }
     if (ok) {
@@ -2733,45 +2902,13 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         }
         e->root_transform = best;
     }
+    for (l = 0; ok && l <= B; l++) ok = voxdagi_storage_order(e->mem, &r->store[l], refs[l], e->order[l]);
+    if (ok) voxdagi_private_order(e, refs, candidates);
     for (l = B + 1; ok && l-- > 0;) {
-        const voxdagi_store *s = &r->store[l];
-        size_t n = s->n, i;
-        uint64_t at = 0;
-        if (!voxdagi_storage_order(e->mem, s, refs[l], e->order[l])) {
-            ok = 0;
-            break;
-        }
-        if (l < B) {
-            uint64_t hist[58][7];
-            unsigned j, ob, kb;
-            voxdagi_transform_table(e, l);
-            memset(hist, 0, sizeof hist);
-            for (i = 0; i < 8 * n && ok; i++) {
-                if (s->child[i] == VOXDAGI_NONE) continue;
-                voxdagi_pointer(e, l, e->orient[l][i >> 3], s->child[i], &ob, &kb);
-                if (ob > 57 - kb) ok = 0;
-                else hist[ob][kb]++;
-            }
-            if (!ok) break;
-            voxdagi_choose_classes(hist, &e->cls[l]);
-            for (i = 0; i < n; i++) {
-                uint32_t id = e->order[l][i];
-                uint64_t bits = 16 + e->count_bits[l];
-                e->pos[l][id] = at;
-                for (j = 0; j < 8; j++) {
-                    uint32_t x = s->child[8 * (size_t)id + j];
-                    unsigned t;
-                    if (x == VOXDAGI_NONE) continue;
-                    voxdagi_pointer(e, l, e->orient[l][id], x, &ob, &kb);
-                    t = voxdagi_class_for(&e->cls[l], ob, kb);
-                    bits += e->cls[l].O[t] + e->cls[l].K[t];
-                }
-                at += (bits + 7) / 8;
-            }
-        } else {
-            for (i = 0; i < n; i++) e->pos[l][e->order[l][i]] = i;
-        }
-        e->size[l] = at;
+        size_t i;
+        if (l < B) ok = voxdagi_plan_level(e, l, candidates[l]);
+        else
+            for (i = 0; i < r->store[l].n; i++) e->pos[l][e->order[l][i]] = i;
     }
     for (l = 0; l <= B; l++) voxdagi_free(e->mem, refs[l], r->store[l].n * sizeof(uint32_t));
     return ok;
@@ -2782,52 +2919,31 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
 static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_table, uint8_t *nodes,
                                   uint8_t *bricks) {
     const voxdagi_reducer *r = e->r;
-    const voxdagi_cube *c = e->cube;
     uint32_t B = e->levels - 2, l;
     uint64_t level_at = 0;
     size_t i;
     for (l = 0; l < B; l++) {
-        const voxdagi_store *s = &r->store[l];
         const voxdagi_classes *cls = &e->cls[l];
         uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
         unsigned t;
         voxdagi_put_le(te, level_at, 8);
         voxdagi_put_le(te + 8, e->size[l], 8);
-        voxdagi_put_le(te + 16, s->n, 4);
+        voxdagi_put_le(te + 16, r->store[l].n, 4);
         te[20] = (uint8_t)e->count_bits[l];
         te[21] = (uint8_t)e->table_len[l];
         for (t = 1; t <= 3; t++) {
             te[21 + t] = cls->O[t];
             te[24 + t] = cls->K[t];
         }
+        te[28] = cls->N == 2;
+        te[29] = cls->P;
         memcpy(te + 32, e->table[l], e->table_len[l]);
-        for (i = 0; i < s->n; i++) {
-            uint32_t id = e->order[l][i];
-            unsigned rp = e->orient[l][id], header = 0, j, ob, kb;
-            const uint32_t *ch = s->child + 8 * (size_t)id;
-            uint64_t bits = 16 + e->count_bits[l];
-            uint32_t stored[8];
-            for (j = 0; j < 8; j++) stored[j] = VOXDAGI_NONE;
-            for (j = 0; j < 8; j++) /* canonical octant j is stored octant R(j) */
-                if (ch[j] != VOXDAGI_NONE) stored[c->act[rp][j]] = ch[j];
-            voxdagi_put_bits(p, 16, s->count[id], e->count_bits[l]);
-            for (j = 0; j < 8; j++) {
-                uint64_t v;
-                if (stored[j] == VOXDAGI_NONE) continue;
-                v = voxdagi_pointer(e, l, rp, stored[j], &ob, &kb);
-                t = voxdagi_class_for(cls, ob, kb);
-                header |= t << (2 * j);
-                voxdagi_put_bits(p, bits, v, cls->O[t] + cls->K[t]);
-                bits += cls->O[t] + cls->K[t];
-            }
-            voxdagi_put_le(p, header, 2);
-            p += (bits + 7) / 8;
-        }
+        for (i = 0; i < r->store[l].n; i++) p += (voxdagi_record(e, l, e->order[l][i], p) + 7) / 8;
         level_at += e->size[l];
     }
     for (i = 0; i < r->store[B].n; i++) {
         uint32_t id = e->order[B][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(c, r->store[B].key[id], e->orient[B][id]), 8);
+        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[B].key[id], e->orient[B][id]), 8);
     }
 }
 
@@ -2837,7 +2953,9 @@ typedef struct voxdagi_level {
     const uint8_t *data;
     uint64_t size, nodes;
     unsigned count_bits;
-    unsigned char width[4];    /* pointer bits of tags 1..3 ([0] = 0) */
+    unsigned char width[4];    /* pointer bits of tags 1..3 ([0] = 0; [3] = 0 with private children) */
+    unsigned private_children; /* tag 3 marks a private child */
+    unsigned base_bits;        /* P: the base field of a record with private children */
     unsigned char code_bits[4];
     uint64_t code_mask[4];
     uint8_t table_inv[64];     /* code -> inverse of its transform */
@@ -2920,12 +3038,18 @@ static void voxdagi_occupancy_init(voxdag *d) {
         }
 }
 
+/* Whether a record with HEADER has private children (then its base field
+   follows the count); never on a level without them, whose P is 0. */
+VOXDAGI_INLINE unsigned voxdagi_has_private(unsigned header) { return (header & header >> 1 & 0x5555) != 0; }
+
 /* Bit offset of child octant S's pointer inside a record with HEADER: the
-   widths of the lower octants' pointers (popcounts over the tags). */
+   base field, then the widths of the lower octants' pointers (popcounts
+   over the tags). */
 VOXDAGI_INLINE unsigned voxdagi_child_bit(const voxdagi_level *lv, unsigned header, unsigned s) {
     unsigned h = header & ((1u << (2 * s)) - 1);
     unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
-    return 16 + lv->count_bits + lv->width[1] * (unsigned)voxdagi_popcount64(lo & ~hi) +
+    return 16 + lv->count_bits + lv->base_bits * voxdagi_has_private(header) +
+           lv->width[1] * (unsigned)voxdagi_popcount64(lo & ~hi) +
            lv->width[2] * (unsigned)voxdagi_popcount64(hi & ~lo) + lv->width[3] * (unsigned)voxdagi_popcount64(lo & hi);
 }
 
@@ -2933,12 +3057,33 @@ static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
     return voxdagi_child_bit(lv, header, 8);
 }
 
-/* The pointer of stored octant S (which must be present): its target << 6
-   | the code's transform, inverted when INVERSE (what traversals compose). */
-VOXDAGI_INLINE uint64_t voxdagi_child_ref(const voxdagi_level *lv, const uint8_t *rec, unsigned header, unsigned s,
-                                  int inverse) {
+/* Units from the node at OFFSET of level L to the next one: its record's
+   bytes, or 1 on the brick level. */
+static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset) {
+    if (l == d->levels - 2) return 1;
+    return (voxdagi_record_bits(&d->level[l], (unsigned)voxdagi_le(d->level[l].data + offset, 2)) + 7) / 8;
+}
+
+/* The offset of the private child of stored octant S of record REC of
+   inner level L: the base, then one node further per lower private child. */
+static uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
+    const voxdagi_level *lv = &d->level[l];
+    unsigned h = header & ((1u << (2 * s)) - 1), k = (unsigned)voxdagi_popcount64(h & h >> 1 & 0x5555);
+    uint64_t at = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits);
+    while (k--) at += voxdagi_node_units(d, l + 1, at);
+    return at;
+}
+
+/* The child of stored octant S (which must be present) of record REC of
+   inner level L: its offset << 6 | the pointer's transform, inverted when
+   INVERSE (what traversals compose). */
+VOXDAGI_INLINE uint64_t voxdagi_child_ref(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header,
+                                          unsigned s, int inverse) {
+    const voxdagi_level *lv = &d->level[l];
     unsigned t = header >> (2 * s) & 3;
-    uint64_t v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
+    uint64_t v;
+    if (t == 3 && lv->private_children) return voxdagi_private_child(d, l, rec, header, s) << 6;
+    v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
     return (v >> lv->code_bits[t]) << 6 | (inverse ? lv->table_inv : lv->table)[v & lv->code_mask[t]];
 }
 
@@ -2966,41 +3111,50 @@ static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset)
     rec = lv->data + offset;
     header = (unsigned)voxdagi_le(rec, 2);
     for (s = 0; s < 8; s++)
-        if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(lv, rec, header, s, 0) >> 6);
+        if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, s, 0) >> 6);
     return sum;
 }
 
 // -- Loading: header, sections and full structural validation (FORMAT.md)
 
-/* Bitmap helpers for validation: which byte offsets start a record, and which
-   records some parent points to. */
+/* Bitmap helpers for validation: which byte offsets start a record, which
+   records some parent points to, and which of them as a private child. */
 static int voxdagi_bit(const uint8_t *bits, uint64_t i) { return bits[i >> 3] >> (i & 7) & 1; }
 static void voxdagi_set_bit(uint8_t *bits, uint64_t i) { bits[i >> 3] = (uint8_t)(bits[i >> 3] | 1u << (i & 7)); }
 
 typedef struct voxdagi_bitmaps {
-    uint8_t *start, *ref;
+    uint8_t *map[3]; /* start, ref, private */
     size_t bytes;
 } voxdagi_bitmaps;
 
+enum { VOXDAGI_START, VOXDAGI_REF, VOXDAGI_PRIVATE };
+
 static int voxdagi_bitmaps_alloc(voxdagi_mem *m, voxdagi_bitmaps *b, uint64_t bits) {
+    unsigned k;
+    int ok = 1;
     b->bytes = (size_t)((bits + 7) / 8);
-    b->start = (uint8_t *)voxdagi_alloc(m, b->bytes);
-    b->ref = (uint8_t *)voxdagi_alloc(m, b->bytes);
-    if (b->start) memset(b->start, 0, b->bytes);
-    if (b->ref) memset(b->ref, 0, b->bytes);
-    return b->start && b->ref;
+    for (k = 0; k < 3; k++) {
+        b->map[k] = (uint8_t *)voxdagi_alloc(m, b->bytes);
+        if (b->map[k]) memset(b->map[k], 0, b->bytes);
+        else ok = 0;
+    }
+    return ok;
 }
 
 static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
-    voxdagi_free(m, b->start, b->bytes);
-    voxdagi_free(m, b->ref, b->bytes);
-    b->start = b->ref = NULL;
+    unsigned k;
+    for (k = 0; k < 3; k++) {
+        voxdagi_free(m, b->map[k], b->bytes);
+        b->map[k] = NULL;
+    }
 }
 
 /* Every record of every inner level, bottom-up: sizes, zero padding, pointer
    codes (inside the level's transform table), targets (a record start of
-   the next level, or a brick), counts (the sum of the children's), every
-   node and brick referenced, one root holding every voxel. */
+   the next level, or a brick; private children: from the base, one node
+   after the other, inside the level, each referenced by nothing else),
+   counts (the sum of the children's), every node and brick referenced, one
+   root holding every voxel. */
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
     uint32_t B = d->levels - 2, l;
     uint64_t base = B ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
@@ -3028,7 +3182,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         voxdagi_bitmaps_free(m, &child); /* one of the two may have been allocated */
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
     }
-    for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.start, i); /* every brick starts a record */
+    for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.map[VOXDAGI_START], i); /* every brick starts a record */
     for (l = B; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
         uint64_t at = 0, records = 0, child_units = l + 1 == B ? d->brick_count : d->level[l + 1].size;
@@ -3040,7 +3194,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         while (at < lv->size) {
             const uint8_t *rec = lv->data + at;
             unsigned header, s;
-            uint64_t sum = 0, bits, bytes;
+            uint64_t sum = 0, bits, bytes, next_private;
             where = base + (uint64_t)(rec - d->level[0].data);
             node = records;
             if (lv->size - at < 2) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
@@ -3052,19 +3206,31 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) {
                 st = VOXDAG_ERR_CORRUPT; msg = "record padding bits not zero"; break;
             }
+            next_private = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits * voxdagi_has_private(header));
             for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
-                unsigned t = header >> (2 * s) & 3;
+                unsigned t = header >> (2 * s) & 3, private_child = t == 3 && lv->private_children;
                 uint64_t v, target, c;
                 if (!t) continue;
-                v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
-                if ((v & lv->code_mask[t]) >= lv->table_len) {
-                    st = VOXDAG_ERR_CORRUPT; msg = "transform code outside the level's table"; break;
+                if (private_child) {
+                    target = next_private;
+                } else {
+                    v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
+                    if ((v & lv->code_mask[t]) >= lv->table_len) {
+                        st = VOXDAG_ERR_CORRUPT; msg = "transform code outside the level's table"; break;
+                    }
+                    target = v >> lv->code_bits[t];
                 }
-                target = v >> lv->code_bits[t];
-                if (target >= child_units || !voxdagi_bit(child.start, target)) {
+                if (target >= child_units || !voxdagi_bit(child.map[VOXDAGI_START], target)) {
                     st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
                 }
-                voxdagi_set_bit(child.ref, target);
+                if (voxdagi_bit(child.map[private_child ? VOXDAGI_REF : VOXDAGI_PRIVATE], target)) {
+                    st = VOXDAG_ERR_CORRUPT; msg = "private child referenced twice"; break;
+                }
+                if (private_child) {
+                    voxdagi_set_bit(child.map[VOXDAGI_PRIVATE], target);
+                    next_private = target + voxdagi_node_units(d, l + 1, target);
+                }
+                voxdagi_set_bit(child.map[VOXDAGI_REF], target);
                 c = voxdagi_node_count(d, l + 1, target);
                 if (sum + c < sum) { st = VOXDAG_ERR_CORRUPT; msg = "voxel count overflows"; break; }
                 sum += c;
@@ -3073,7 +3239,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             if (lv->count_bits && voxdagi_get_bits_wide(rec, 16, lv->count_bits) != sum) {
                 st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
             }
-            voxdagi_set_bit(cur.start, at);
+            voxdagi_set_bit(cur.map[VOXDAGI_START], at);
             at += bytes;
             records++;
         }
@@ -3081,7 +3247,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records"; where = UINT64_MAX; node = UINT64_MAX;
         }
         for (i = 0; st == VOXDAG_OK && i < child.bytes; i++)
-            if (child.start[i] & ~child.ref[i]) {
+            if (child.map[VOXDAGI_START][i] & ~child.map[VOXDAGI_REF][i]) {
                 st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; where = UINT64_MAX; node = UINT64_MAX;
             }
         voxdagi_bitmaps_free(m, &child);
@@ -3123,7 +3289,13 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
     if (l + 3 == d->levels ? lv->count_bits != 0 : lv->count_bits > 64) return "bad level count width";
     if (l && !lv->count_bits && !d->level[l - 1].count_bits) /* derived counts sum stored ones */
         return "two levels in a row without counts";
-    if (!lv->table_len || lv->table_len > VOXDAGI_TRANSFORMS || !voxdagi_all_zero(e + 28, 4) ||
+    lv->private_children = e[28];
+    lv->base_bits = e[29];
+    if (lv->private_children > 1 || lv->base_bits > 57 || (!lv->private_children && lv->base_bits) ||
+        (lv->private_children && (e[24] || e[27])))
+        return "bad private child fields";
+    if (e[30] || e[31]) return "reserved level bytes not zero";
+    if (!lv->table_len || lv->table_len > VOXDAGI_TRANSFORMS ||
         !voxdagi_all_zero(e + 32 + lv->table_len, VOXDAGI_TRANSFORMS - lv->table_len))
         return "bad level transform table";
     memset(lv->table, 0, sizeof lv->table);
@@ -3453,6 +3625,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     for (l = 0; l < B; l++) { /* what an empty scene's level table says */
         unsigned t;
         for (t = 1; t <= 3; t++) e.cls[l].O[t] = (unsigned char)(8 * t);
+        e.cls[l].N = 3;
         e.count_bits[l] = l + 1 < B;
         e.table_len[l] = 1;
     }
@@ -3691,7 +3864,7 @@ static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *re
     unsigned j;
     for (j = 0; j < 8; j++)
         if ((header >> (2 * j) & 3) && to_world[j] < w)
-            idx += voxdagi_node_count(d, l + 1, voxdagi_child_ref(&d->level[l], rec, header, j, 0) >> 6);
+            idx += voxdagi_node_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, j, 0) >> 6);
     return idx;
 }
 
@@ -3709,7 +3882,7 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
         if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w);
         v = dag->cube.act[MI][w];
         if (!(header >> (2 * v) & 3)) return 0;
-        ref = voxdagi_child_ref(lv, rec, header, v, 1);
+        ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
         MI = dag->cube.comp[ref & 63][MI];
         at = ref >> 6;
     }
@@ -3764,7 +3937,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
             }
             {
                 unsigned w = f->next++;
-                uint64_t ref = voxdagi_child_ref(lv, rec, header, to_stored[w], 1);
+                uint64_t ref = voxdagi_child_ref(dag, (uint32_t)depth, rec, header, to_stored[w], 1);
                 struct frame *c = &stack[depth + 1];
                 c->at = ref >> 6;
                 c->MI = dag->cube.comp[ref & 63][f->MI];
@@ -3958,7 +4131,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             return 1;
         }
         if (l < B) {
-            uint64_t ref = voxdagi_child_ref(&d->level[l], rec, header,
+            uint64_t ref = voxdagi_child_ref(d, l, rec, header,
                                              d->cube.act[MI][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
             MI = d->cube.comp[ref & 63][MI];
             at = ref >> 6;

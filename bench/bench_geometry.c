@@ -238,7 +238,8 @@ static uint64_t count_bytes(const voxdag *d) {
 }
 
 /* Bits of the encoded inner levels of D by component: [0] headers, [1]
-   counts, [2] pointer targets, [3] transform codes, [4] record padding. */
+   counts, [2] pointer targets (with the base fields of private children),
+   [3] transform codes, [4] record padding. */
 static void components(const voxdag *d, uint64_t bits[5]) {
     uint32_t l;
     memset(bits, 0, 5 * sizeof *bits);
@@ -250,6 +251,7 @@ static void components(const voxdag *d, uint64_t bits[5]) {
             uint64_t rec = voxdagi_record_bits(lv, header);
             bits[0] += 16;
             bits[1] += lv->count_bits;
+            bits[2] += lv->base_bits * voxdagi_has_private(header);
             for (s = 0; s < 8; s++) {
                 unsigned t = header >> (2 * s) & 3;
                 bits[2] += (unsigned)lv->width[t] - lv->code_bits[t];

@@ -101,11 +101,12 @@ enum {
     GOLDEN_BRICK_ROOT_L2,
     GOLDEN_MIRRORED_BLOB,
     GOLDEN_SVDAG,
+    GOLDEN_PRIVATE,
     GOLDEN_COUNT
 };
 
 static const char *const golden_names[GOLDEN_COUNT] = {
-    "empty_l2", "empty_l5", "one_voxel", "brick_root_l2", "mirrored_blob_l5", "svdag_l5",
+    "empty_l2", "empty_l5", "one_voxel", "brick_root_l2", "mirrored_blob_l5", "svdag_l5", "private_l6",
 };
 
 static inline uint64_t golden_rand(uint64_t *state) { /* splitmix64 */
@@ -168,6 +169,19 @@ static inline voxdag_status golden_build(int kind, const voxdag_allocator *alloc
                 for (z = 0; z < h; z += 1 + (x & 1))
                     if (n < 4096) xyz[3 * n] = x, xyz[3 * n + 1] = y, xyz[3 * n + 2] = z, n++;
             }
+        break;
+    case GOLDEN_PRIVATE: /* sparse random clumps: nodes referenced once (private children) */
+        o.levels = 6;
+        for (i = 0; i < 12; i++) {
+            uint32_t cx = (uint32_t)(golden_rand(&r) % 56), cy = (uint32_t)(golden_rand(&r) % 56);
+            uint32_t cz = (uint32_t)(golden_rand(&r) % 56);
+            for (m = 0; m < 40; m++) {
+                uint64_t v = golden_rand(&r);
+                xyz[3 * n] = cx + (uint32_t)(v & 7), xyz[3 * n + 1] = cy + (uint32_t)(v >> 3 & 7);
+                xyz[3 * n + 2] = cz + (uint32_t)(v >> 6 & 7);
+                n++;
+            }
+        }
         break;
     default: return VOXDAG_ERR_INVALID_ARGUMENT;
     }

@@ -162,7 +162,7 @@ static void test_offsets_documented(void) {
 
 static void test_header_fields(void) {
     static const uint8_t magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
-    static const uint64_t voxels[GOLDEN_COUNT] = {0, 0, 1, 24, 184, 0}; /* 0: not pinned here */
+    static const uint64_t voxels[GOLDEN_COUNT] = {0, 0, 1, 24, 184, 0, 0}; /* 0: not pinned here */
     int kind;
     for (kind = 0; kind < GOLDEN_COUNT; kind++) {
         size_t size = 0;
@@ -193,7 +193,7 @@ static void test_header_fields(void) {
         CHECK(!voxels[kind] || info.voxels == voxels[kind]);
         CHECK((info.voxels == 0) == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_EMPTY_L5));
         CHECK(f[VOXDAG_FILE_OFF_LEVELS] == info.levels);
-        CHECK(info.levels == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_BRICK_ROOT_L2 ? 2u : 5u));
+        CHECK(info.levels == (kind == GOLDEN_EMPTY_L2 || kind == GOLDEN_BRICK_ROOT_L2 ? 2u : kind == GOLDEN_PRIVATE ? 6u : 5u));
         CHECK(f[VOXDAG_FILE_OFF_ROOT_TRANSFORM] < 48 && !f[43]);
         for (i = 0; i < 6; i++) CHECK(golden_le(f + VOXDAG_FILE_OFF_VOXEL_BOX + 4 * i, 4) == info.voxel_box[i]);
         for (i = VOXDAG_FILE_OFF_RESERVED; i < VOXDAG_FILE_HEADER_SIZE; i++) CHECK(f[i] == 0);
@@ -231,7 +231,8 @@ static void test_header_fields(void) {
                     for (t = 1; t <= 3; t++) CHECK(le[24 + t] <= 6 && le[21 + t] + le[24 + t] <= 57);
                     for (k = 0; k < 48; k++) /* the transform table: used entries distinct, the rest zero */
                         CHECK(k < le[21] ? le[32 + k] < 48 && (!k || le[32 + k] != le[31 + k]) : le[32 + k] == 0);
-                    CHECK(golden_le(le + 28, 4) == 0);
+                    CHECK(le[28] <= 1 && le[29] <= 57 && (le[28] ? !le[24] && !le[27] : !le[29])); /* private children */
+                    CHECK(golden_le(le + 30, 2) == 0);
                     at += info.level_bytes[l];
                 }
                 CHECK(at == info.node_bytes);
@@ -530,6 +531,7 @@ typedef struct level_view {
     uint64_t offset, size;
     unsigned count_bits;
     unsigned width[4], code_bits[4]; /* pointer bits and code bits of tags 1..3 */
+    unsigned private_children, base_bits; /* tag 3 marks a private child; P */
 } level_view;
 
 static uint64_t bits_get(const uint8_t *p, uint64_t pos, unsigned n) {
@@ -555,6 +557,8 @@ static level_view level_of(const parts *p, uint32_t l) {
     v.offset = golden_le(e, 8);
     v.size = golden_le(e + 8, 8);
     v.count_bits = e[20];
+    v.private_children = e[28];
+    v.base_bits = e[29];
     v.width[0] = v.code_bits[0] = 0;
     for (t = 1; t <= 3; t++) {
         v.width[t] = (unsigned)e[21 + t] + e[24 + t];
@@ -563,11 +567,24 @@ static level_view level_of(const parts *p, uint32_t l) {
     return v;
 }
 
-static unsigned record_size(const uint8_t *rec, const level_view *v) {
-    unsigned header = (unsigned)golden_le(rec, 2), s, n = 16 + v->count_bits;
-    for (s = 0; s < 8; s++) n += v->width[header >> (2 * s) & 3];
-    return (n + 7) / 8;
+static int is_private(const level_view *v, unsigned tag) { return tag == 3 && v->private_children; }
+
+/* Bits before the first pointer of a record with HEADER: the header, the
+   count, and the base field when some child is private. */
+static unsigned pointers_bit(const level_view *v, unsigned header) {
+    unsigned s, n = 16 + v->count_bits;
+    for (s = 0; s < 8; s++)
+        if (is_private(v, header >> (2 * s) & 3)) return n + v->base_bits;
+    return n;
 }
+
+static unsigned record_bits(const uint8_t *rec, const level_view *v) {
+    unsigned header = (unsigned)golden_le(rec, 2), s, n = pointers_bit(v, header);
+    for (s = 0; s < 8; s++) n += v->width[header >> (2 * s) & 3];
+    return n;
+}
+
+static unsigned record_size(const uint8_t *rec, const level_view *v) { return (record_bits(rec, v) + 7) / 8; }
 
 static size_t record_starts(const parts *p, uint32_t l, uint64_t *starts, size_t cap) {
     level_view v = level_of(p, l);
@@ -579,6 +596,14 @@ static size_t record_starts(const parts *p, uint32_t l, uint64_t *starts, size_t
         at += record_size(nodes + at, &v);
     }
     return n;
+}
+
+/* A record offset of the next level where it moved to (others unchanged). */
+static uint64_t moved_offset(uint64_t at, const uint64_t *starts, const uint64_t *moved, size_t n) {
+    size_t j;
+    for (j = 0; j < n; j++)
+        if (starts[j] == at) return moved[j];
+    return at;
 }
 
 /* Writes NODES again with every pointer class EXTRA target bits wider (an
@@ -600,7 +625,8 @@ static void parts_widen(parts *p, unsigned extra) {
     for (l = 0; l < B; l++) { /* the new classes, record offsets and sizes */
         uint8_t *e = p->data[li] + GOLDEN_LEVEL_ENTRY_SIZE * l;
         unsigned t;
-        for (t = 1; t <= 3; t++) e[21 + t] = (uint8_t)(e[21 + t] + extra > 57u - e[24 + t] ? 57u - e[24 + t] : e[21 + t] + extra);
+        for (t = 1; t <= (e[28] ? 2u : 3u); t++) e[21 + t] = (uint8_t)(e[21 + t] + extra > 57u - e[24 + t] ? 57u - e[24 + t] : e[21 + t] + extra);
+        if (e[28]) e[29] = (uint8_t)(e[29] + extra > 57u ? 57u : e[29] + extra);
         {
             level_view v = level_of(p, l);
             uint64_t size = 0;
@@ -621,19 +647,21 @@ static void parts_widen(parts *p, unsigned extra) {
             const uint8_t *rec = p->data[ni] + old[l].offset + starts[l][k];
             uint8_t *w = out + v.offset + moved[l][k];
             unsigned header = (unsigned)golden_le(rec, 2), s;
-            uint64_t from = 16 + old[l].count_bits, to = 16 + v.count_bits;
+            uint64_t from = pointers_bit(&old[l], header), to = pointers_bit(&v, header);
             memcpy(w, rec, 2);
             bits_put(w, 16, bits_get(rec, 16, v.count_bits), v.count_bits);
+            if (to > 16 + v.count_bits) { /* the base field */
+                uint64_t base = bits_get(rec, 16 + v.count_bits, old[l].base_bits);
+                if (l + 1 < B) base = moved_offset(base, starts[l + 1], moved[l + 1], n[l + 1]);
+                bits_put(w, 16 + v.count_bits, base, v.base_bits);
+            }
             for (s = 0; s < 8; s++) {
                 unsigned t = header >> (2 * s) & 3, kb = v.code_bits[t];
                 uint64_t val, target;
-                size_t j;
-                if (!t) continue;
+                if (!t || is_private(&v, t)) continue;
                 val = bits_get(rec, from, old[l].width[t]);
                 target = val >> kb;
-                if (l + 1 < B) /* a record offset of the next level moves with it */
-                    for (j = 0; j < n[l + 1]; j++)
-                        if (starts[l + 1][j] == target) target = moved[l + 1][j], j = n[l + 1];
+                if (l + 1 < B) target = moved_offset(target, starts[l + 1], moved[l + 1], n[l + 1]);
                 bits_put(w, to, target << kb | (val & ((1ull << kb) - 1)), v.width[t]);
                 from += old[l].width[t], to += v.width[t];
             }
@@ -647,17 +675,26 @@ static void parts_widen(parts *p, unsigned extra) {
 
 /* Sets the target of a pointer of the record at START of level L (keeping
    its transform code) to TARGET, or to its own target + 1 when PLUS_ONE:
-   the first pointer of the record whose class holds the new target. Returns
-   0 (changing nothing) when none does. */
+   the first pointer of the record whose class holds the new target, else
+   its base field (the first private child) if it has one that holds it.
+   Returns 0 (changing nothing) when none does. */
 static int set_target(parts *p, uint32_t l, uint64_t start, int plus_one, uint64_t target) {
     level_view v = level_of(p, l);
     uint8_t *nodes = p->data[parts_find(p, 2)];
     unsigned header = (unsigned)golden_le(nodes + v.offset + start, 2), s;
-    uint64_t at = 8 * (v.offset + start) + 16 + v.count_bits;
-    for (s = 0; s < 8; s++) {
-        unsigned t = header >> (2 * s) & 3, o = v.width[t] - v.code_bits[t];
+    uint64_t rec = 8 * (v.offset + start), at = rec + pointers_bit(&v, header);
+    for (s = 0; s <= 8; s++) {
+        unsigned t = s < 8 ? header >> (2 * s) & 3 : 0, o = v.width[t] - v.code_bits[t];
         uint64_t cur, want;
-        if (!t) continue;
+        if (s == 8 && pointers_bit(&v, header) > 16 + v.count_bits) { /* the base field */
+            at = rec + 16 + v.count_bits;
+            cur = bits_get(nodes, at, v.base_bits);
+            want = plus_one ? cur + 1 : target;
+            if (want >> v.base_bits) return 0;
+            bits_put(nodes, at, want, v.base_bits);
+            return 1;
+        }
+        if (s == 8 || !t || is_private(&v, t)) continue;
         cur = bits_get(nodes, at, v.width[t]);
         want = plus_one ? (cur >> v.code_bits[t]) + 1 : target;
         if (!(want >> o)) {
@@ -959,10 +996,14 @@ static void test_version3_fields(void) {
             const char *what;
         } bad[] = {{21, 0, "transform table length 0"}, {21, 49, "transform table length 49"},
                    {32, 48, "table entry 48"},           {25, 7, "7 code bits"},
-                   {29, 1, "reserved level bytes"},      {20, 65, "count width 65"}};
+                   {30, 1, "reserved level bytes"},      {20, 65, "count width 65"},
+                   {28, 2, "private child flag 2"},      {29, 58, "58-bit base field"},
+                   {24, 1, "a third class beside private children"}};
         parts q;
         uint8_t *e;
         size_t k;
+        e = p.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE;
+        CHECK_MSG(e[28] == 1 && e[24] == 0, "level 1 of the golden has no private children");
         for (k = 0; k < sizeof bad / sizeof bad[0]; k++) {
             parts_read(&q, f, size);
             e = q.data[levels] + GOLDEN_LEVEL_ENTRY_SIZE; /* level 1 of 0..2 */
@@ -982,6 +1023,37 @@ static void test_version3_fields(void) {
         expect(&q, VOXDAG_ERR_CORRUPT, "58-bit pointer class", NULL);
         parts_free(&q);
     }
+    { /* private children (on the golden made of them): two records with the
+         same base (one private group twice, another not at all); a base
+         one record further (the group runs past its parent's, or off the
+         level); and a private flag on a level that has none */
+        size_t psize = 0, m;
+        uint8_t *pf = read_golden(GOLDEN_PRIVATE, &psize);
+        parts q;
+        uint64_t st[512];
+        int ok = pf && parts_read(&q, pf, psize);
+        CHECK_MSG(ok, "private golden missing or unreadable");
+        if (ok) {
+            level_view v = level_of(&q, 1);
+            const uint8_t *nodes = q.data[parts_find(&q, 2)];
+            uint64_t base0;
+            m = record_starts(&q, 1, st, 512);
+            CHECK(m >= 2 && v.private_children && pointers_bit(&v, (unsigned)golden_le(nodes + v.offset, 2)) > 16 + v.count_bits);
+            base0 = bits_get(nodes, 8 * v.offset + 16 + v.count_bits, v.base_bits);
+            CHECK_MSG(m >= 2 && set_target(&q, 1, st[1], 0, base0), "no second level-1 record with a base field");
+            expect(&q, VOXDAG_ERR_CORRUPT, "a private group referenced twice", NULL);
+            parts_free(&q);
+            parts_read(&q, pf, psize);
+            CHECK(set_target(&q, 1, st[m - 1], 1, 0));
+            expect(&q, VOXDAG_ERR_CORRUPT, "the last private group one record further", NULL);
+            parts_free(&q);
+        }
+        free(pf);
+        parts_read(&q, f, size);
+        q.data[levels][28] = 1; /* the blob's level 0: tag 3 now private, its pointers misread */
+        expect(&q, VOXDAG_ERR_CORRUPT, "private flag on a level without private children", NULL);
+        parts_free(&q);
+    }
     { /* a pointer code at or past the table length: the level's table cut
          to end just before the code of a pointer that has a non-zero one */
         parts q;
@@ -996,7 +1068,7 @@ static void test_version3_fields(void) {
             for (k = 0; k < m && !found; k++) {
                 const uint8_t *nodes = q.data[parts_find(&q, 2)];
                 unsigned header = (unsigned)golden_le(nodes + v.offset + st[k], 2), s;
-                uint64_t at = 8 * (v.offset + st[k]) + 16 + v.count_bits;
+                uint64_t at = 8 * (v.offset + st[k]) + pointers_bit(&v, header);
                 for (s = 0; s < 8 && !found; s++) {
                     unsigned t = header >> (2 * s) & 3;
                     unsigned code = (unsigned)(bits_get(nodes, at, v.width[t]) & ((1ull << v.code_bits[t]) - 1));
@@ -1022,8 +1094,7 @@ static void test_version3_fields(void) {
         v = level_of(&q, 1);
         for (k = 0; k < n1; k++) {
             uint8_t *rec = q.data[parts_find(&q, 2)] + v.offset + starts1[k];
-            unsigned header = (unsigned)golden_le(rec, 2), s, bits = 16 + v.count_bits;
-            for (s = 0; s < 8; s++) bits += v.width[header >> (2 * s) & 3];
+            unsigned bits = record_bits(rec, &v);
             if (bits % 8) {
                 rec[bits / 8] |= (uint8_t)(0x80u);
                 expect(&q, VOXDAG_ERR_CORRUPT, "padding bit", NULL);
