@@ -97,7 +97,7 @@ static void graph_from_dag(const voxdag *d, graph *g) {
             for (s = 0; s < 8; s++) {
                 uint64_t p, t;
                 if (!(header >> (2 * s) & 3)) continue;
-                p = voxdagi_child_ref(lv, rec, header, s, 0);
+                p = voxdagi_child_ref(d, l, rec, header, s, 0);
                 t = p >> 6;
                 if (l + 1 < B) t = find_offset(off[l + 1], g->lv[l + 1].n, t);
                 gl->kid[k++] = t << 6 | (p & 63);
