@@ -1004,21 +1004,29 @@ typedef struct voxdagi_canon {
     unsigned tag;
 } voxdagi_canon;
 
-/* Bricks: the canonical form is the transform with the smallest mask. */
+/* Bricks: the canonical form is the transform with the smallest occupancy
+   of its eight 2^3 cells (a table lookup per transform), then the smallest
+   mask; only the transforms that tie on occupancy move the 64 bits. */
 static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
     voxdagi_canon c;
-    uint64_t r[VOXDAGI_TRANSFORMS];
-    unsigned T, best = 0;
-    r[0] = mask;
-    for (T = 1; T < g->count; T++) {
-        r[T] = voxdagi_transform_brick(&g->cube, mask, T);
-        if (r[T] < r[best]) best = T;
+    uint64_t r[VOXDAGI_TRANSFORMS], tie = 0;
+    unsigned T, best = 64, occ = 0, k, low = 256;
+    for (k = 0; k < 8; k++) occ |= (unsigned)((mask >> 8 * k & 0xFF) != 0) << k;
+    for (T = 0; T < g->count; T++) {
+        unsigned o = g->mask8[T][occ];
+        if (o < low) low = o, tie = 0;
+        if (o == low) tie |= 1ull << T;
+    }
+    for (T = 0; T < g->count; T++) {
+        if (!(tie >> T & 1)) continue;
+        r[T] = T ? voxdagi_transform_brick(&g->cube, mask, T) : mask;
+        if (best == 64 || r[T] < r[best]) best = T;
     }
     c.key = r[best];
     c.tag = g->cube.inv[best];
     c.stab = 0;
     for (T = 0; T < g->count; T++)
-        if (r[T] == r[best]) c.stab |= 1ull << g->cube.comp[T][c.tag];
+        if ((tie >> T & 1) && r[T] == r[best]) c.stab |= 1ull << g->cube.comp[T][c.tag];
     return c;
 }
 
