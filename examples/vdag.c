@@ -2,8 +2,9 @@
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
-              [--color-effort smallest|fast] [--no-colors] [--chunk-levels C]
-              [--threads T] [--force] [--stats] [--quiet]
+              [--color-effort smallest|fast] [--no-colors] [--no-alpha-test]
+              [--chunk-levels C] [--threads T] [--max-memory MIB] [--force] [--stats]
+              [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -141,6 +142,8 @@ static const struct {
      "  --chunk-levels C   voxelize meshes in chunks of 2^C voxels per axis, 2..8 (default:\n"
      "                     chosen from the mesh: 5 for coloured meshes under 65536 triangles, else 8)\n"
      "  --threads T        worker threads, >= 1 (default: the processors online)\n"
+     "  --max-memory MIB   the most memory the builder may hold, in MiB (2^20 bytes), >= 1;\n"
+     "                     a build that needs more stops with a limit error (default: no limit)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
      "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
      "  --stats            also count the nodes per level under all three symmetry groups\n"
@@ -235,6 +238,7 @@ typedef struct build_args {
     int quiet;              /* --quiet: warnings and errors only */
     int force;              /* --force: build even past the machine's memory */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
+    uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
 } build_args;
 
 /* Progress of a build: on a terminal, one line per stage updated in place
@@ -611,6 +615,7 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
     o->colors = colors;
     o->compare_structures = a->stats;
     o->threads = a->threads;
+    o->max_memory = (uint64_t)a->max_memory << 20;
     o->bounds = bounds;
     o->progress = progress;
     o->progress_user = a;
@@ -740,6 +745,9 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--chunk-levels") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.chunk_levels) || a.chunk_levels < 2 || a.chunk_levels > 8)
                 return vdag_fail("build: --chunk-levels takes 2..8");
+        } else if (!strcmp(argv[k], "--max-memory") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.max_memory) || !a.max_memory)
+                return vdag_fail("build: --max-memory takes MiB >= 1");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
         } else if (!strcmp(argv[k], "--quiet")) {
@@ -831,6 +839,8 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
     progress_end(a);
     seconds = now_seconds() - t0;
     if (!rc && a->spill->f) rc = attach_colors(&dag, a->spill, a);
+    else if (rc && err->status == VOXDAG_ERR_LIMIT && a->max_memory && strstr(err->message, "max_memory"))
+        vdag_fail("build: the builder needs more than --max-memory %u MiB (%s)", a->max_memory, err->message);
     else if (rc) vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
     if (a->spill->f) fclose(a->spill->f);
     if (rc) {
@@ -1011,7 +1021,8 @@ static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...   (vdag COMMAND --help: its options and defaults; vdag --version)\n"
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
-          "                    [--no-colors] [--chunk-levels C] [--threads T] [--force] [--stats] [--quiet]\n"
+          "                    [--no-colors] [--no-alpha-test] [--chunk-levels C] [--threads T]\n"
+          "                    [--max-memory MIB] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"
