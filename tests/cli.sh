@@ -435,5 +435,18 @@ assert b[-8:-4] == b'IEND'
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
 
+# -- README's tool section names every command and every option of --help
+check "README lists every command and option of --help" python3 -c "
+import re, subprocess, sys
+readme = open('README.md').read()
+section = readme[readme.index('## The \`vdag\` tool'):readme.index('## Robustness')]
+missing = []
+for cmd in ['build', 'info', 'validate', 'lookup', 'rays', 'render', 'export-voxels', 'gen']:
+    if 'vdag ' + cmd not in section: missing.append(cmd)
+    h = subprocess.run(['$VDAG', cmd, '--help'], capture_output=True, text=True).stdout
+    missing += [cmd + ' ' + o for o in set(re.findall(r'(?<![\w-])--[a-z][a-z-]*', h)) if o not in section]
+assert not missing, missing
+"
+
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]
