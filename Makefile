@@ -116,7 +116,11 @@ deps:
 check-all:
 	@sh tests/check_all.sh $(BUILD)
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip
+# The importers' triangles, printed for tests/third_party.sh (sanitized).
+$(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
+
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
 

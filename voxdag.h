@@ -152,7 +152,8 @@ typedef struct voxdag_build_opts {
                                     symmetry groups (3x work) */
     uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
-                                    nodes, the file image); 0: no limit */
+                                    nodes, the file image); 0: no limit; more
+                                    is VOXDAG_ERR_LIMIT */
     uint64_t max_nodes;          /* unique nodes and bricks of the result, all
                                     levels together; 0: no limit */
     uint32_t chunk_levels;       /* meshes are voxelized in chunks of 2^chunk_levels
@@ -207,19 +208,28 @@ typedef struct voxdag_mesh {
        (required when the builder has colours, else ignored). */
     void (*color)(void *user, size_t triangle, const double bary[3], uint8_t rgb[3]);
     void *user;
+    /* Optional: returns 0 when the point with barycentric coordinates BARY on
+       TRIANGLE is cut away (an alpha-tested texel, say); NULL keeps every
+       point. Called once per voxel a triangle touches. */
+    int (*keep)(void *user, size_t triangle, const double bary[3]);
 } voxdag_mesh;
 
 /* Voxelizes MESH conservatively: a voxel is full when a triangle intersects
-   its closed box (exact separating-axis test). Parts outside the grid are
+   its closed box (exact separating-axis test) and, with a keep callback,
+   keeps the voxel's point (below) on that triangle. Parts outside the grid are
    clipped. Works chunk by chunk (aligned subtrees of 2^chunk_levels voxels
    per axis, chunk_levels clamped to 2..8, in Morton order; with threads,
    one chunk per thread at a time) and reduces each chunk at once, so memory
    holds the unique nodes plus a chunk bitmap per thread.
-   A voxel's colour comes from the triangle touching it with the highest
-   index, at the point of that triangle nearest to the voxel centre; the
-   colour callback runs once per voxel, from several threads at once when
-   opts.threads > 1. Call it on a builder that holds no voxels yet; more
-   meshes need one combined call. Returns VOXDAG_ERR_INVALID_ARGUMENT for an
+   A voxel's point on a triangle is the voxel centre's projection on the
+   triangle's plane, given by its barycentric coordinates; when it falls
+   outside the triangle, negative coordinates become 0 and the others are
+   scaled to sum 1. A voxel's colour comes from the triangle with the highest
+   index that touches (and keeps) it, at the voxel's point on it. The
+   colour callback runs once per voxel, keep once per voxel and triangle
+   touching it, both from several threads at once when opts.threads > 1.
+   Call it on a builder that holds no voxels yet; more meshes need one
+   combined call. Returns VOXDAG_ERR_INVALID_ARGUMENT for an
    index >= vertex_count or a non-finite vertex. */
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
                                                  voxdag_error *err);
@@ -258,7 +268,8 @@ typedef struct voxdag_load_opts {
     uint32_t zero_begin;
     uint64_t max_input_bytes; /* 0: no limit */
     uint64_t max_nodes;       /* total nodes and bricks; 0: no limit */
-    uint64_t max_memory;      /* bytes allocated by the load; 0: no limit */
+    uint64_t max_memory;      /* bytes allocated by the load; 0: no limit;
+                                 more is VOXDAG_ERR_LIMIT */
     uint32_t max_levels;      /* 0: VOXDAG_MAX_LEVELS */
     int copy;                 /* 1: copy the bytes (else they must outlive the DAG) */
     voxdag_allocator allocator;
@@ -544,6 +555,7 @@ VOXDAG_API uint32_t voxdag_version(void) { return VOXDAG_VERSION; }
 typedef struct voxdagi_mem {
     voxdag_allocator a;
     uint64_t used, peak, limit; /* limit 0: none */
+    int over_limit;             /* an allocation was refused by the limit */
 #ifndef VOXDAG_NO_THREADS
     pthread_mutex_t lock; /* workers allocate concurrently */
 #endif
@@ -574,6 +586,7 @@ static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
     pthread_mutex_lock(&m->lock);
 #endif
     ok = !m->limit || (m->used <= m->limit && size <= m->limit - m->used);
+    if (!ok) m->over_limit = 1;
     if (ok) {
         p = m->a.alloc ? m->a.alloc(m->a.user, size) : VOXDAG_MALLOC(size);
         if (p) {
@@ -599,6 +612,15 @@ static void voxdagi_free(voxdagi_mem *m, void *p, size_t size) {
 #ifndef VOXDAG_NO_THREADS
     pthread_mutex_unlock(&m->lock);
 #endif
+}
+
+/* Reports a failure of status ST with MESSAGE, except that a failure after
+   the limit (max_memory) refused an allocation is VOXDAG_ERR_LIMIT with a
+   message that says so. Returns the status reported. */
+static voxdag_status voxdagi_mem_fail(const voxdagi_mem *m, voxdag_error *err, voxdag_status st, const char *message) {
+    if ((st == VOXDAG_ERR_OUT_OF_MEMORY || st == VOXDAG_ERR_LIMIT) && m->over_limit)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more memory needed than max_memory allows");
+    return VOXDAGI_FAIL(err, st, message);
 }
 
 /* Grows *p (holding *cap elements of ELEM bytes) to at least NEED elements,
@@ -1371,7 +1393,7 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     b = (voxdag_builder *)voxdagi_alloc(&mem, sizeof *b);
     if (!b) {
         voxdagi_mem_destroy(&mem);
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the builder");
+        return voxdagi_mem_fail(&mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the builder");
     }
     memset(b, 0, sizeof *b);
     b->mem = mem; /* the mutex is moved before any other use */
@@ -1528,7 +1550,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
     if (n > ((size_t)-1) / 16 - b->pend_n)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "too many voxels");
     if (b->pend_n + n > b->pend_cap && !voxdagi_builder_reserve(b, b->pend_n + n))
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot grow the voxel buffer");
+        return voxdagi_mem_fail(&b->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot grow the voxel buffer");
     /* Encode into the free tail of the buffer; it only counts once all pass. */
     code = b->pend_code + b->pend_n;
     {
@@ -1874,8 +1896,8 @@ VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *e
     if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
     st = voxdagi_builder_reduce(b, 0);
     if (st != VOXDAG_OK) {
-        b->failed = st;
-        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+        b->failed = voxdagi_mem_fail(&b->mem, err, st, voxdagi_reduce_message(st));
+        return b->failed;
     }
     return voxdagi_ok(err);
 }
@@ -1957,8 +1979,8 @@ static int voxdagi_voxel_range(double lo, double hi, int64_t limit, int64_t *fir
     return 1;
 }
 
-/* Barycentric coordinates of the point of T nearest to P's projection on
-   its plane, clamped into the triangle. */
+/* Barycentric coordinates of P's projection on T's plane, clamped into the
+   triangle (negative ones 0, the rest scaled to sum 1). */
 static void voxdagi_tri_bary(const voxdagi_tri *t, const double p[3], double bary[3]) {
     double nn = t->n[0] * t->n[0] + t->n[1] * t->n[1] + t->n[2] * t->n[2], sum = 0;
     unsigned i, k;
@@ -2103,6 +2125,12 @@ static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxd
                 p[w] = (double)q;
                 for (j = 0; j < 7 && voxdagi_axes_test(x, p, per_voxel[j]); j++) continue;
                 if (j < 7) continue;
+                if (c->mesh->keep) { /* the voxel centre's point on the triangle */
+                    double centre[3], bary[3];
+                    for (k = 0; k < 3; k++) centre[k] = p[k] + 0.5;
+                    voxdagi_tri_bary(t, centre, bary);
+                    if (!c->mesh->keep(c->mesh->user, tri, bary)) continue;
+                }
                 code = uv | voxdag_morton_encode((uint32_t)(q - clo[w]), 0, 0) << w;
                 c->bits[code >> 6] |= 1ull << (code & 63);
                 c->used[code >> 12] |= 1ull << ((code >> 6) & 63);
@@ -2321,8 +2349,8 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
     if (st == VOXDAG_ERR_INVALID_ARGUMENT)
         return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, (uint64_t)i);
     if (st != VOXDAG_OK) {
-        b->failed = st;
-        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+        b->failed = voxdagi_mem_fail(&b->mem, err, st, voxdagi_reduce_message(st));
+        return b->failed;
     }
     return voxdagi_ok(err);
 }
@@ -3518,14 +3546,14 @@ VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
     st = voxdagi_new_dag(&m, &d);
     if (st != VOXDAG_OK) {
         voxdagi_mem_destroy(&m);
-        return VOXDAGI_FAIL(err, st, "cannot allocate the DAG");
+        return voxdagi_mem_fail(&m, err, st, "cannot allocate the DAG");
     }
     if (o.copy) {
         d->owned = (uint8_t *)voxdagi_alloc(&m, size);
         if (!d->owned) {
             voxdag_free(d);
             voxdagi_mem_destroy(&m);
-            return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot copy the input");
+            return voxdagi_mem_fail(&m, err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot copy the input");
         }
         d->owned_size = size;
         if (size) memcpy(d->owned, data, size);
@@ -3535,7 +3563,7 @@ VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
     voxdagi_mem_destroy(&m);
     if (st != VOXDAG_OK) {
         voxdag_free(d);
-        return st;
+        return st == VOXDAG_ERR_OUT_OF_MEMORY ? voxdagi_mem_fail(&m, err, st, err ? err->message : NULL) : st;
     }
     *out = d;
     return voxdagi_ok(err);
@@ -3698,15 +3726,17 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     st = b->failed ? b->failed : voxdagi_builder_reduce(b, 1);
     if (st == VOXDAG_OK) st = voxdagi_builder_send_colors(b, (size_t)(b->voxels - b->colors_base), 0);
     if (st != VOXDAG_OK) {
+        st = voxdagi_mem_fail(&b->mem, err, st, voxdagi_reduce_message(st));
         voxdag_builder_free(b);
-        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+        return st;
     }
     if (b->opts.progress) b->opts.progress(b->opts.progress_user, "reduce", 1.0);
     for (k = 0; k < b->red_count; k++) {
         voxdagi_reducer_finish(&b->red[k]);
         if (b->red[k].failed) {
+            st = voxdagi_mem_fail(&b->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while reducing voxels");
             voxdag_builder_free(b);
-            return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while reducing voxels");
+            return st;
         }
     }
     if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) {
@@ -3743,6 +3773,7 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     /* The DAG's memory came from the builder's allocator; keep it out of the
        builder's accounting so freeing the builder balances. */
     if (*out) b->mem.used -= sizeof(voxdag) + (*out)->owned_size;
+    if (st == VOXDAG_ERR_OUT_OF_MEMORY) st = voxdagi_mem_fail(&b->mem, err, st, err ? err->message : NULL);
     voxdag_builder_free(b);
     if (st == VOXDAG_OK) voxdagi_ok(err);
     return st;
@@ -4193,7 +4224,7 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     if (!buf) {
         fclose(f);
         voxdagi_mem_destroy(&m);
-        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file buffer");
+        return voxdagi_mem_fail(&m, err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file buffer");
     }
     if (len && fread(buf, 1, (size_t)len, f) != (size_t)len) {
         fclose(f);

@@ -39,13 +39,18 @@ if [ ! -s tree.vox ]; then
     cp npm/vox-reader/package/test/tree.vox tree.vox
 fi
 # Game scenes, left in their package trees so that their textures are found:
-# x/supertuxkart-data/.../tracks/abyss/abyss_track.spm (CC-BY-SA-4.0) and
-# x/flightgear-data-models/.../CG-57-high-detail/CG-57.ac (GPL-2+); ~900 MB.
+# x/supertuxkart-data/.../tracks/abyss/abyss_track.spm (CC-BY-SA-4.0),
+# x/flightgear-data-models/.../CG-57-high-detail/CG-57.ac (GPL-2+), the DTC
+# hull x/openfoam-examples/.../resources/geometry/DTC-scaled.stl.gz (an STL,
+# GPL-3+; unpacked to DTC-scaled.stl) and assimp's Wuson rabbit
+# x/assimp-testmodels/.../models/OBJ/WusonOBJ.obj (a y-up OBJ); ~1 GB.
 if [ "${2:-}" = scenes ]; then
-    for p in supertuxkart-data flightgear-data-models; do
+    for p in supertuxkart-data flightgear-data-models openfoam-examples assimp-testmodels; do
         [ -d "x/$p" ] && continue
         ls debs/${p}_*.deb >/dev/null 2>&1 || ( cd debs && apt-get download -q "$p" ) || { echo "cannot fetch $p" >&2; continue; }
         dpkg-deb -x debs/${p}_*.deb "x/$p"
     done
+    G=x/openfoam-examples/usr/share/doc/openfoam-examples/examples/resources/geometry
+    [ -s DTC-scaled.stl ] || { [ -f "$G/DTC-scaled.stl.gz" ] && gzip -dc "$G/DTC-scaled.stl.gz" > DTC-scaled.stl; } || true
 fi
 ls -l tree.vox liver.inr bunny.off armadillo.off dragon.off

@@ -65,7 +65,7 @@ tmp=$out/BENCHMARKS.md.tmp
     echo "- Machine: $(nproc) logical CPUs, ${cpu:-unknown CPU}, $(awk '/MemTotal/ {printf "%.0f GiB RAM", $2 / 1048576}' /proc/meminfo), $(uname -sr)"
     echo "- Compiler: $(${CC:-cc} --version | head -n 1); bench programs built with \`-std=c99 -O2\` (no \`-march\`, no \`-mpopcnt\`: the library's portable popcount is used)"
     echo "- Threads: 1 and $(nproc) (all logical CPUs). Timings are wall-clock unless given per CPU-second; other processes may share the machine."
-    echo "- Data: \`bench/fetch.sh\` (Debian \`libcgal-demo\` 5.5: liver label volume and OFF meshes, CC0; npm \`vox-reader\` 4.0.1: \`tree.vox\`, MIT; for the image-quality and real scenes \`supertuxkart-data\`, CC-BY-SA-4.0, and \`flightgear-data-models\`, GPL-2+), \`bench/color_fetch.sh\` (colour arrays)."
+    echo "- Data: \`bench/fetch.sh\` (Debian \`libcgal-demo\` 5.5: liver label volume and OFF meshes, CC0; npm \`vox-reader\` 4.0.1: \`tree.vox\`, MIT; for the image-quality and real scenes \`supertuxkart-data\`, CC-BY-SA-4.0, \`flightgear-data-models\`, GPL-2+, \`openfoam-examples\`, GPL-3+, and \`assimp-testmodels\`, BSD-3-clause), \`bench/color_fetch.sh\` (colour arrays)."
     echo "- Peers and tools (Debian package versions): NanoVDB \`libnanovdb-dev\` $(version libnanovdb-dev), Embree \`libembree-dev\` $(version libembree-dev), OpenImageIO \`openimageio-tools\` $(version openimageio-tools), libjpeg-turbo \`libjpeg-turbo-progs\` $(version libjpeg-turbo-progs), \`pngquant\` $(version pngquant), \`astcenc\` $(version astcenc), gnuplot \`gnuplot-nox\` $(version gnuplot-nox)."
     echo
     sh bench/headline.sh "$docs"

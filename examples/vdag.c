@@ -2,8 +2,9 @@
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
-              [--color-effort smallest|fast] [--no-colors] [--chunk-levels C]
-              [--threads T] [--force] [--stats] [--quiet]
+              [--color-effort smallest|fast] [--no-colors] [--no-alpha-test]
+              [--chunk-levels C] [--threads T] [--max-memory MIB] [--force] [--stats]
+              [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -134,10 +135,15 @@ static const struct {
      "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
      "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
      "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
-     "  --no-colors        drop colours, decode no texture (default: keep them)\n"
+     "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
+     "                     alpha test, the voxels stay the same\n"
+     "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
+     "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
      "  --chunk-levels C   voxelize meshes in chunks of 2^C voxels per axis, 2..8 (default:\n"
      "                     chosen from the mesh: 5 for coloured meshes under 65536 triangles, else 8)\n"
      "  --threads T        worker threads, >= 1 (default: the processors online)\n"
+     "  --max-memory MIB   the most memory the builder may hold, in MiB (2^20 bytes), >= 1;\n"
+     "                     a build that needs more stops with a limit error (default: no limit)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
      "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
      "  --stats            also count the nodes per level under all three symmetry groups\n"
@@ -218,6 +224,7 @@ typedef struct build_args {
     uint32_t levels, threads;
     voxdag_symmetry symmetry;
     int no_colors, stats, compress;
+    int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
     double color_error;
     uint32_t color_bits; /* 0: auto */
     voxcolor_effort color_effort;
@@ -231,6 +238,7 @@ typedef struct build_args {
     int quiet;              /* --quiet: warnings and errors only */
     int force;              /* --force: build even past the machine's memory */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
+    uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
 } build_args;
 
 /* Progress of a build: on a terminal, one line per stage updated in place
@@ -345,32 +353,54 @@ static int scene_to_grid(const vdag_scene *sc, build_args *a, uint32_t **xyz_out
     return 0;
 }
 
-/* Colour of a point on a mesh triangle: the material's texture (nearest
-   texel, wrapping) tinted by the interpolated vertex colours; without a
-   texture, the vertex colours, else the material's Kd (white without one). */
+/* The texel of a point on a mesh triangle (nearest texel, wrapping; uv
+   origin at the bottom left, rows top down): its index in *IM, or SIZE_MAX
+   when the triangle has no texture. */
+static size_t mesh_texel(const vdag_scene *sc, size_t tri, const double bary[3], const vdag_image **im) {
+    const uint32_t *v = sc->indices + 3 * tri;
+    int32_t m = sc->triangle_material ? sc->triangle_material[tri] : -1;
+    double u = 0, w = 0;
+    long px, py;
+    int c;
+    if (!(m >= 0 && (size_t)m < sc->material_count && sc->uv && sc->materials[m].image >= 0 &&
+          (size_t)sc->materials[m].image < sc->image_count))
+        return SIZE_MAX;
+    *im = &sc->images[sc->materials[m].image];
+    for (c = 0; c < 3; c++) {
+        u += bary[c] * sc->uv[2 * (size_t)v[c]];
+        w += bary[c] * sc->uv[2 * (size_t)v[c] + 1];
+    }
+    u -= floor(u);
+    w -= floor(w);
+    px = (long)(u * (*im)->width);
+    py = (long)((1 - w) * (*im)->height);
+    if (px >= (long)(*im)->width) px = (long)(*im)->width - 1;
+    if (py >= (long)(*im)->height) py = (long)(*im)->height - 1;
+    if (px < 0) px = 0;
+    if (py < 0) py = 0;
+    return (size_t)py * (*im)->width + (size_t)px;
+}
+
+/* The alpha test: a point whose texel has alpha below one half (< 128 of
+   255) makes no voxel, as the scenes' own renderers discard it. */
+static int mesh_keep(void *user, size_t tri, const double bary[3]) {
+    const vdag_image *im = NULL;
+    size_t texel = mesh_texel((const vdag_scene *)user, tri, bary, &im);
+    return texel == SIZE_MAX || !im->alpha || im->alpha[texel] >= 128;
+}
+
+/* Colour of a point on a mesh triangle: the material's texture (mesh_texel)
+   tinted by the interpolated vertex colours; without a texture, the vertex
+   colours, else the material's Kd (white without one). */
 static void mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
     const vdag_scene *sc = (const vdag_scene *)user;
     const uint32_t *v = sc->indices + 3 * tri;
     int32_t m = sc->triangle_material ? sc->triangle_material[tri] : -1;
-    int k, c, textured = m >= 0 && (size_t)m < sc->material_count && sc->uv && sc->materials[m].image >= 0 &&
-                         (size_t)sc->materials[m].image < sc->image_count;
-    if (textured) {
-        const vdag_image *im = &sc->images[sc->materials[m].image];
-        double u = 0, w = 0;
-        long px, py;
-        for (c = 0; c < 3; c++) {
-            u += bary[c] * sc->uv[2 * (size_t)v[c]];
-            w += bary[c] * sc->uv[2 * (size_t)v[c] + 1];
-        }
-        u -= floor(u);
-        w -= floor(w);
-        px = (long)(u * im->width);
-        py = (long)((1 - w) * im->height); /* uv origin at the bottom left, rows top down */
-        if (px >= (long)im->width) px = (long)im->width - 1;
-        if (py >= (long)im->height) py = (long)im->height - 1;
-        if (px < 0) px = 0;
-        if (py < 0) py = 0;
-        memcpy(rgb, im->rgb + 3 * ((size_t)py * im->width + (size_t)px), 3);
+    const vdag_image *im = NULL;
+    size_t texel = mesh_texel(sc, tri, bary, &im);
+    int k, c;
+    if (texel != SIZE_MAX) {
+        memcpy(rgb, im->rgb + 3 * texel, 3);
     } else if (m >= 0 && (size_t)m < sc->material_count && !sc->vertex_rgb) {
         memcpy(rgb, sc->materials[m].rgb, 3);
     } else {
@@ -585,6 +615,7 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
     o->colors = colors;
     o->compare_structures = a->stats;
     o->threads = a->threads;
+    o->max_memory = (uint64_t)a->max_memory << 20;
     o->bounds = bounds;
     o->progress = progress;
     o->progress_user = a;
@@ -638,6 +669,7 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     voxdag_builder *b = NULL;
     voxdag_mesh mesh;
     voxdag_error err;
+    size_t i;
     int colors = !a->no_colors && (sc->vertex_rgb || sc->material_count), rc;
     if (!a->levels) a->levels = 10;
     if (!a->quiet)
@@ -668,6 +700,8 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     mesh.triangle_count = sc->triangle_count;
     mesh.color = colors ? mesh_color : NULL;
     mesh.user = sc;
+    for (i = 0; !a->no_alpha_test && i < sc->image_count; i++)
+        if (sc->images[i].alpha) mesh.keep = mesh_keep; /* some texel is not opaque */
     rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
     if (!rc && voxdag_builder_add_mesh(b, &mesh, &err) != VOXDAG_OK) {
         voxdag_builder_free(b);
@@ -711,12 +745,17 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--chunk-levels") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.chunk_levels) || a.chunk_levels < 2 || a.chunk_levels > 8)
                 return vdag_fail("build: --chunk-levels takes 2..8");
+        } else if (!strcmp(argv[k], "--max-memory") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.max_memory) || !a.max_memory)
+                return vdag_fail("build: --max-memory takes MiB >= 1");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
         } else if (!strcmp(argv[k], "--quiet")) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
+        } else if (!strcmp(argv[k], "--no-alpha-test")) {
+            a.no_alpha_test = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
             a.symmetry = VOXDAG_SYMMETRY_NONE;
         } else if (!strcmp(argv[k], "--symmetry") && k + 1 < argc) {
@@ -757,7 +796,8 @@ static int cmd_build(int argc, char **argv) {
     if (!vdag_check_output(a.in, a.out)) return 1;
     if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
     memset(&limits, 0, sizeof limits);
-    limits.skip_textures = a.no_colors; /* no colours kept: nothing to decode them for */
+    /* Textures give colours and the alpha test: without both, nothing to decode them for. */
+    limits.skip_textures = a.no_colors && a.no_alpha_test;
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
     if (!a.up) a.up = default_up(a.in);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
@@ -799,6 +839,8 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
     progress_end(a);
     seconds = now_seconds() - t0;
     if (!rc && a->spill->f) rc = attach_colors(&dag, a->spill, a);
+    else if (rc && err->status == VOXDAG_ERR_LIMIT && a->max_memory && strstr(err->message, "max_memory"))
+        vdag_fail("build: the builder needs more than --max-memory %u MiB (%s)", a->max_memory, err->message);
     else if (rc) vdag_fail("build: %s (%s)", voxdag_status_string(err->status), err->message);
     if (a->spill->f) fclose(a->spill->f);
     if (rc) {
@@ -979,7 +1021,8 @@ static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...   (vdag COMMAND --help: its options and defaults; vdag --version)\n"
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
-          "                    [--no-colors] [--chunk-levels C] [--threads T] [--force] [--stats] [--quiet]\n"
+          "                    [--no-colors] [--no-alpha-test] [--chunk-levels C] [--threads T]\n"
+          "                    [--max-memory MIB] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

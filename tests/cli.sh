@@ -159,7 +159,23 @@ printf 'newmtl t\nKd 1 0 0\nmap_Kd broken.png\n' >"$T/tex.mtl"
 printf 'not an image' >"$T/broken.png"
 printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl t\nf 1/1 2/2 3/3\n' >"$T/tex.obj"
 check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
-check "--no-colors skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors 2>'$T/err' && ! grep -q warning '$T/err'"
+check "--no-colors --no-alpha-test skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors --no-alpha-test 2>'$T/err' && ! grep -q warning '$T/err'"
+
+# -- alpha testing: texels with alpha below one half make no voxel (the same
+# voxels with --no-colors); --no-alpha-test voxelizes every texel. The
+# expected voxels come from a brute force in tests/cli_alpha.py.
+python3 tests/cli_alpha.py "$T" write
+for m in alpha nocolor plain; do
+    o=; [ $m = nocolor ] && o=--no-colors; [ $m = plain ] && o=--no-alpha-test
+    check "alpha test ($m): voxels (and colours) = brute force" sh -c "'$VDAG' build '$T/alpha.obj' '$T/al.vdag' --levels 4 --up z $o 2>/dev/null &&
+        '$VDAG' export-voxels '$T/al.vdag' >'$T/alpha_$m.txt' && python3 tests/cli_alpha.py '$T' $m 2>/dev/null"
+done
+
+# -- --max-memory: too little is a limit error naming the option; enough builds
+check "--max-memory 1 fails as a limit, one line naming it" sh -c "! '$VDAG' build '$T/alpha.obj' '$T/mm.vdag' --levels 8 --max-memory 1 --quiet 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && grep -q 'more than --max-memory 1 MiB' '$T/err' && [ ! -e '$T/mm.vdag' ]"
+check "--max-memory 512 builds" "$VDAG" build "$T/alpha.obj" "$T/mm.vdag" --levels 8 --max-memory 512 --quiet
+check "--max-memory 0 is refused" sh -c "! '$VDAG' build '$T/alpha.obj' '$T/mm0.vdag' --max-memory 0 2>/dev/null"
 
 # -- more formats: STL (ASCII and binary) give the same square; a float .xyz
 # is a point cloud fitted into the grid (voxel = floor((p - lo) * 2^L / extent),
@@ -418,6 +434,19 @@ assert b[-8:-4] == b'IEND'
 \""
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
+
+# -- README's tool section names every command and every option of --help
+check "README lists every command and option of --help" python3 -c "
+import re, subprocess, sys
+readme = open('README.md').read()
+section = readme[readme.index('## The \`vdag\` tool'):readme.index('## Robustness')]
+missing = []
+for cmd in ['build', 'info', 'validate', 'lookup', 'rays', 'render', 'export-voxels', 'gen']:
+    if 'vdag ' + cmd not in section: missing.append(cmd)
+    h = subprocess.run(['$VDAG', cmd, '--help'], capture_output=True, text=True).stdout
+    missing += [cmd + ' ' + o for o in set(re.findall(r'(?<![\w-])--[a-z][a-z-]*', h)) if o not in section]
+assert not missing, missing
+"
 
 echo "$pass passed, $fail failed"
 [ "$fail" = 0 ]

@@ -5,6 +5,7 @@ need=""
 command -v oiiotool >/dev/null 2>&1 || need="$need openimageio-tools"
 [ -f /usr/include/OpenImageIO/imageio.h ] || need="$need libopenimageio-dev"
 [ -f /usr/include/stb/stb_image.h ] || need="$need libstb-dev"
+command -v assimp >/dev/null 2>&1 || need="$need assimp-utils"
 command -v clang >/dev/null 2>&1 || need="$need clang"
 command -v g++ >/dev/null 2>&1 || need="$need g++"
 [ -z "$need" ] && exit 0

@@ -697,7 +697,7 @@ static voxdag_status build_limited(const uint32_t *xyz, const uint8_t *rgb, size
     if (st == VOXDAG_OK) st = voxdag_builder_finish(b, &d, stats, &err);
     else voxdag_builder_free(b);
     CHECK(st == err.status && (st == VOXDAG_OK) == (d != NULL));
-    if (st == VOXDAG_ERR_LIMIT) CHECK(strstr(err.message, "max_nodes") != NULL);
+    if (st == VOXDAG_ERR_LIMIT) CHECK(strstr(err.message, max_memory ? "max_memory" : "max_nodes") != NULL);
     voxdag_free(d);
     CHECK(ca.held == 0 && !ca.bad_free);
     return st;
@@ -726,10 +726,13 @@ static void test_build_limits(void) {
             CHECK_MSG(build_limited(xyz, rgb, n, &o, nodes - 1, 0, flush, NULL) == VOXDAG_ERR_LIMIT,
                       "max_nodes, %d threads, flush %d", threads, flush);
         }
-    /* max_memory: the measured peak passes, one byte less fails */
+    /* max_memory: the measured peak passes, one byte less is a limit (not
+       out of memory), also when the builder itself does not fit */
     o.threads = 1;
     CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory, 0, NULL) == VOXDAG_OK);
-    CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory - 1, 0, NULL) == VOXDAG_ERR_OUT_OF_MEMORY);
+    CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory - 1, 0, NULL) == VOXDAG_ERR_LIMIT);
+    CHECK(build_limited(xyz, rgb, n, &o, 0, stats.peak_memory - 1, 1, NULL) == VOXDAG_ERR_LIMIT);
+    CHECK(build_limited(xyz, rgb, n, &o, 0, 1, 0, NULL) == VOXDAG_ERR_LIMIT);
     free(xyz);
     free(rgb);
     scene_free(&s);

@@ -129,7 +129,49 @@ static void check_sink(const voxdag_build_opts *opts, const voxdag_mesh *mesh, c
     free(sink.rgb);
 }
 
-static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t count, uint64_t seed) {
+/* A cut-away pattern for the keep callback: each corner of a triangle gets
+   a weight 0 or 1, and a point is kept when its weighted barycentric sum is
+   at least one half (as an alpha test of interpolated vertex alphas). */
+static int corner_weight(size_t tri, int corner) { return (int)((tri * 7 + (size_t)corner * 5 + tri / 3) % 3 != 0); }
+
+static int tri_keep(void *user, size_t tri, const double bary[3]) {
+    (void)user;
+    return bary[0] * corner_weight(tri, 0) + bary[1] * corner_weight(tri, 1) + bary[2] * corner_weight(tri, 2) >= 0.5;
+}
+
+/* The keep rule of voxdag_builder_add_mesh for triangle T and voxel
+   (x, y, z), in exact integers: the signed areas of the voxel centre's
+   projection against each edge (along the normal), negative ones as 0.
+   Returns 1 kept, 0 cut, -1 on a tie (exactly one half: either is right). */
+static int brute_keep(const itri *t, size_t tri, int x, int y, int z) {
+    int64_t e1[3], e2[3], n[3], c[3], num[3], sum = 0, kept = 0;
+    int i, k;
+    c[0] = (int64_t)x * SCALE + SCALE / 2;
+    c[1] = (int64_t)y * SCALE + SCALE / 2;
+    c[2] = (int64_t)z * SCALE + SCALE / 2;
+    for (k = 0; k < 3; k++) {
+        e1[k] = t->v[1][k] - t->v[0][k];
+        e2[k] = t->v[2][k] - t->v[0][k];
+    }
+    cross3(e1, e2, n);
+    for (i = 0; i < 3; i++) {
+        int64_t a[3], b[3], ab[3];
+        for (k = 0; k < 3; k++) {
+            a[k] = t->v[(i + 1) % 3][k] - c[k];
+            b[k] = t->v[(i + 2) % 3][k] - c[k];
+        }
+        cross3(a, b, ab);
+        num[i] = dot3(n, ab) > 0 ? dot3(n, ab) : 0;
+        if (dot3(n, n) == 0) num[i] = 1; /* degenerate: the centroid */
+        sum += num[i];
+    }
+    if (sum == 0)
+        for (i = 0, sum = 3; i < 3; i++) num[i] = 1;
+    for (i = 0; i < 3; i++) kept += corner_weight(tri, i) * num[i];
+    return 2 * kept == sum ? -1 : 2 * kept > sum;
+}
+
+static void check_voxelization_keep(uint32_t levels, uint32_t chunk_levels, size_t count, uint64_t seed, int keep) {
     uint32_t n = 1u << levels, x, y, z;
     uint64_t r = seed;
     itri *tris = (itri *)malloc(count * sizeof *tris);
@@ -138,7 +180,7 @@ static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t co
     voxdag_builder *b;
     voxdag *d = NULL;
     voxdag_mesh mesh;
-    size_t i, bad = 0, bad_color = 0, full = 0;
+    size_t i, bad = 0, bad_color = 0, full = 0, cut = 0, ties = 0;
     random_tris(&r, n, count, tris);
     m.pos = (double *)malloc(9 * count * sizeof *m.pos);
     m.idx = (uint32_t *)malloc(3 * count * sizeof *m.idx);
@@ -160,6 +202,7 @@ static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t co
     mesh.indices = m.idx;
     mesh.triangle_count = count;
     mesh.color = tri_color;
+    if (keep) mesh.keep = tri_keep;
     CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
     CHECK(voxdag_builder_add_mesh(b, &mesh, NULL) == VOXDAG_OK);
     CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
@@ -169,9 +212,18 @@ static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t co
             for (x = 0; x < n; x++) {
                 size_t last = SIZE_MAX;
                 uint64_t index;
-                int want;
+                int want, tie = 0;
                 for (i = 0; i < count; i++)
-                    if (brute_overlap(&tris[i], (int)x, (int)y, (int)z)) last = i;
+                    if (brute_overlap(&tris[i], (int)x, (int)y, (int)z)) {
+                        int k = keep ? brute_keep(&tris[i], i, (int)x, (int)y, (int)z) : 1;
+                        if (k < 0) tie = 1;
+                        else if (k) last = i;
+                        else cut++;
+                    }
+                if (tie) { /* a point at exactly one half: not decided here */
+                    ties++;
+                    continue;
+                }
                 want = last != SIZE_MAX;
                 full += (size_t)want;
                 if (voxdag_lookup(d, x, y, z, &index) != want) {
@@ -182,13 +234,26 @@ static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t co
                     if (c[0] != (uint8_t)last || c[1] != (uint8_t)(last >> 8)) bad_color++;
                 }
             }
-    CHECK_MSG(bad == 0 && bad_color == 0, "L=%u chunks 2^%u: %zu voxels wrong, %zu colours wrong (of %zu full)",
-              levels, chunk_levels, bad, bad_color, full);
+    CHECK_MSG(bad == 0 && bad_color == 0, "L=%u chunks 2^%u keep %d: %zu voxels wrong, %zu colours wrong (of %zu full)",
+              levels, chunk_levels, keep, bad, bad_color, full);
     CHECK(full > 0);
+    CHECK_MSG(!keep || (cut > full / 4 && ties < full / 50), "keep: %zu cut, %zu ties, %zu full", cut, ties, full);
     voxdag_free(d);
     free(tris);
     free(m.pos);
     free(m.idx);
+}
+
+static void check_voxelization(uint32_t levels, uint32_t chunk_levels, size_t count, uint64_t seed) {
+    check_voxelization_keep(levels, chunk_levels, count, seed, 0);
+}
+
+/* A keep callback cuts voxels away by the documented rule (the voxel
+   centre's clamped barycentric point), and colours come from the last
+   triangle that keeps a voxel. */
+static void test_keep_callback(void) {
+    check_voxelization_keep(4, 2, 60, 12, 1);
+    check_voxelization_keep(5, 3, 80, 13, 1);
 }
 
 static void test_random_triangles(void) {
@@ -221,6 +286,51 @@ static void test_face_plane(void) {
     CHECK(info.voxels == 2 * 6 * 6); /* x, y in 1..6 (closed boxes touch 2 and 6), z in 7..8 */
     CHECK(voxdag_lookup(d, 1, 1, 7, NULL) && voxdag_lookup(d, 6, 6, 8, NULL) && !voxdag_lookup(d, 3, 3, 9, NULL));
     voxdag_free(d);
+}
+
+/* A mesh build under max_memory: its measured peak passes, one byte less
+   (or a small limit, with threads) fails as VOXDAG_ERR_LIMIT, not as out of
+   memory, with a message naming max_memory; a generous limit passes. */
+static voxdag_status mesh_build_limited(const voxdag_mesh *mesh, uint32_t threads, uint64_t max_memory,
+                                        uint64_t *peak) {
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag *d = NULL;
+    voxdag_build_stats st;
+    voxdag_error err;
+    voxdag_status s;
+    memset(&o, 0, sizeof o);
+    o.levels = 6;
+    o.colors = 1;
+    o.chunk_levels = 3;
+    o.threads = threads;
+    o.max_memory = max_memory;
+    s = voxdag_builder_create(&o, &b, &err);
+    if (s == VOXDAG_OK && (s = voxdag_builder_add_mesh(b, mesh, &err)) != VOXDAG_OK) voxdag_builder_free(b);
+    if (s == VOXDAG_OK) s = voxdag_builder_finish(b, &d, &st, &err);
+    CHECK(s == err.status && (s == VOXDAG_OK) == (d != NULL));
+    if (s == VOXDAG_ERR_LIMIT) CHECK_MSG(strstr(err.message, "max_memory") != NULL, "%s", err.message);
+    if (peak && d) *peak = st.peak_memory;
+    voxdag_free(d);
+    return s;
+}
+
+static void test_mesh_memory_limit(void) {
+    static const double pos[] = {1, 1, 1, 60, 3, 5, 7, 62, 30, 50, 40, 61};
+    static const uint32_t idx[] = {0, 1, 2, 1, 2, 3, 0, 2, 3};
+    voxdag_mesh mesh;
+    uint64_t peak = 0;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = pos;
+    mesh.vertex_count = 4;
+    mesh.indices = idx;
+    mesh.triangle_count = 3;
+    mesh.color = tri_color;
+    CHECK(mesh_build_limited(&mesh, 1, 0, &peak) == VOXDAG_OK && peak > 0);
+    CHECK(mesh_build_limited(&mesh, 1, peak, NULL) == VOXDAG_OK);
+    CHECK(mesh_build_limited(&mesh, 1, peak - 1, NULL) == VOXDAG_ERR_LIMIT);
+    CHECK(mesh_build_limited(&mesh, 2, 1 << 16, NULL) == VOXDAG_ERR_LIMIT);
+    CHECK(mesh_build_limited(&mesh, 2, 1 << 30, NULL) == VOXDAG_OK);
 }
 
 static void test_bad_meshes(void) {
@@ -264,6 +374,8 @@ static void test_bad_meshes(void) {
 const test_case test_voxelize_cases[] = {
     {"voxelize/random_triangles", test_random_triangles},
     {"voxelize/face_plane", test_face_plane},
+    {"voxelize/keep_callback", test_keep_callback},
+    {"voxelize/mesh_memory_limit", test_mesh_memory_limit},
     {"voxelize/bad_meshes", test_bad_meshes},
     {NULL, NULL},
 };
