@@ -37,6 +37,13 @@
      VOXDAG_NO_STDIO      leave out the file helpers
      VOXDAG_NO_THREADS    single-threaded build (no pthreads)
      VOXDAG_NO_RAYTRACE   leave out ray casting
+     VOXDAG_NO_BUILD      leave out the builder, the voxelizer and the encoder
+                          (load-and-query programs: loading, queries, colours,
+                          ray casting and voxdag_with_colors remain)
+     VOXDAG_WITH_VOXCOLOR include "voxcolor.h" (beside voxdag.h) so that
+                          voxdag_color decodes voxcolor colour sections; the
+                          same happens when voxcolor.h is included before
+                          the implementation
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
