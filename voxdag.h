@@ -1699,7 +1699,7 @@ static voxdag_status voxdagi_builder_send_colors(voxdag_builder *b, size_t held,
 }
 
 /* Appends the colours of N sorted, distinct voxels that follow the reduced
-   ones, packed 0xRRGGBB (RGB) or as bytes (RGB8, when RGB is NULL). With a
+   ones, as bytes (RGB8) or, when RGB8 is NULL, packed 0xRRGGBB (RGB). With a
    sink, the colours go out at once, but for the last one: a repeat of that
    voxel at the start of the next flush may still replace it. */
 static voxdag_status voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, const uint8_t *rgb8, size_t n) {
@@ -1708,7 +1708,7 @@ static voxdag_status voxdagi_builder_colors(voxdag_builder *b, const uint32_t *r
     if (!b->opts.colors) return VOXDAG_OK;
     if (!voxdagi_grow(&b->mem, (void **)&b->colors, &b->colors_cap, held + n, 3)) return VOXDAG_ERR_OUT_OF_MEMORY;
     c = b->colors + 3 * held;
-    if (!rgb) {
+    if (rgb8) {
         memcpy(c, rgb8, 3 * n);
     } else {
         for (i = 0; i < n; i++) {
