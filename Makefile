@@ -17,7 +17,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c tests/test_image.c examples/import.c examples/image_stb.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c examples/import.c examples/image_stb.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
 # libstb-dev, a header compiled into the tool: nothing at run time. `make`
@@ -63,6 +63,9 @@ $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/oiio_ref.o
 # voxcolor's option and argument checks in a release build (-DNDEBUG),
 # sanitized: they must not be asserts.
 $(BUILD)/test_voxcolor_ndebug: tests/test_voxcolor_ndebug.c voxcolor.h | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
+# The same for voxdag.h: its options and NULL arguments in a release build.
+$(BUILD)/test_voxdag_ndebug: tests/test_voxdag_ndebug.c voxdag.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
 
 # Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):
@@ -120,7 +123,7 @@ check-all:
 $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
 

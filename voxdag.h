@@ -37,6 +37,13 @@
      VOXDAG_NO_STDIO      leave out the file helpers
      VOXDAG_NO_THREADS    single-threaded build (no pthreads)
      VOXDAG_NO_RAYTRACE   leave out ray casting
+     VOXDAG_NO_BUILD      leave out the builder, the voxelizer and the encoder
+                          (load-and-query programs: loading, queries, colours,
+                          ray casting and voxdag_with_colors remain)
+     VOXDAG_WITH_VOXCOLOR include "voxcolor.h" (beside voxdag.h) so that
+                          voxdag_color decodes voxcolor colour sections; the
+                          same happens when voxcolor.h is included before
+                          the implementation
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
@@ -98,11 +105,23 @@ typedef enum voxdag_status {
     VOXDAG_STATUS_FORCE_32BIT = 0x7fffffff
 } voxdag_status;
 
+/* What went wrong. NODE is the item at fault, UINT64_MAX when there is none;
+   which item depends on the call and the status:
+     voxdag_builder_add, VOXDAG_ERR_COORDINATE / VOXDAG_ERR_ORDER:
+         the voxel's position in that call's arrays (0-based);
+     voxdag_builder_add_bricks, VOXDAG_ERR_COORDINATE / VOXDAG_ERR_ORDER:
+         the brick's position in that call's arrays;
+     voxdag_builder_add_mesh, VOXDAG_ERR_INVALID_ARGUMENT:
+         the triangle (an index >= vertex_count or a non-finite vertex);
+     loading, VOXDAG_ERR_CORRUPT: the level (0 = root) of a bad level-table
+         entry, or the ordinal of a bad node record within its level (bricks:
+         the brick's index); BYTE_OFFSET then points at the entry or record.
+   Every other failure leaves it UINT64_MAX. */
 typedef struct voxdag_error {
     voxdag_status status;
     const char *message;  /* static storage; never freed */
     uint64_t byte_offset; /* offset in the input, UINT64_MAX when not input-related */
-    uint64_t node;        /* node ordinal within its level, UINT64_MAX when none */
+    uint64_t node;        /* the item at fault (see above), UINT64_MAX when none */
     int os_error;         /* errno of the failed file operation (VOXDAG_ERR_IO), else 0 */
 } voxdag_error;
 
@@ -142,7 +161,11 @@ typedef enum voxdag_symmetry {
 
 typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
 
-/* Build options. A NULL pointer or an all-zero struct means defaults. */
+/* Build options. A NULL pointer or an all-zero struct means defaults. Every
+   field is checked, in every build (NDEBUG too): out-of-range values make
+   voxdag_builder_create fail with VOXDAG_ERR_INVALID_ARGUMENT (levels:
+   VOXDAG_ERR_LIMIT). Initialise with memset or = {0}: a nonzero zero_begin
+   or zero_end (a struct left uninitialised) is rejected. */
 typedef struct voxdag_build_opts {
     uint32_t zero_begin;         /* must be 0 */
     uint32_t levels;             /* L, 2..VOXDAG_MAX_LEVELS; 0 means 10 */
@@ -150,14 +173,15 @@ typedef struct voxdag_build_opts {
     int colors;                  /* 1: every voxel carries an RGB8 colour */
     int compare_structures;      /* 1: also count the nodes under the other two
                                     symmetry groups (3x work) */
-    uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
+    uint32_t threads;            /* worker threads; 0 or 1: the calling thread only;
+                                    at most 64 are used */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit; more
                                     is VOXDAG_ERR_LIMIT */
     uint64_t max_nodes;          /* unique nodes and bricks of the result, all
                                     levels together; 0: no limit */
     uint32_t chunk_levels;       /* meshes are voxelized in chunks of 2^chunk_levels
-                                    voxels per axis; 0 means 8 */
+                                    voxels per axis; 0 means 8, else 2..8 */
     const double *bounds;        /* optional world-space min xyz, max xyz (6) */
     voxdag_allocator allocator;
     voxdag_progress_fn progress; /* optional; called from the building thread */
@@ -166,7 +190,8 @@ typedef struct voxdag_build_opts {
        N at a time, as voxels are reduced (from the building thread); returns
        0 to go on, non-zero to fail the build with VOXDAG_ERR_IO. The DAG then
        has no colour section (voxdag_with_colors adds one), so the builder's
-       memory does not grow with the colours. */
+       memory does not grow with the colours. A sink without colors is
+       rejected. */
     int (*color_sink)(void *user, const uint8_t *rgb, size_t n);
     void *color_sink_user;
     uint32_t zero_end;           /* must be 0 */
@@ -175,6 +200,7 @@ typedef struct voxdag_build_opts {
 typedef struct voxdag_builder voxdag_builder;
 typedef struct voxdag voxdag;
 
+#ifndef VOXDAG_NO_BUILD
 /* Creates a builder. Returns VOXDAG_OK and *out, or an error (nothing allocated). */
 VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
                                                voxdag_builder **out,
@@ -195,6 +221,25 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
    the last one): this streams scenes larger than memory in Morton-ordered
    chunks (e.g. aligned subtrees), keeping only unique nodes. */
 VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *err);
+
+/* Adds N whole 4^3 bricks: the fast path of voxelizers (voxdag_builder_add_mesh
+   feeds its chunks through it; a GPU voxelizer can do the same). BRICKS holds
+   2 values per brick: its key, the Morton code of (x/4, y/4, z/4) for its
+   lowest voxel (x, y, z), i.e. its voxels' Morton codes without their low 6
+   bits; then its mask, where bit voxdag_morton_encode(x%4, y%4, z%4) is set for
+   each full voxel. Keys must increase strictly, within the call and after
+   every voxel and brick reduced before (bricks are reduced at once, in
+   order, like a flush); masks of 0 are skipped. With opts.colors, RGB holds
+   3 bytes per full voxel, brick by brick, each brick's voxels in mask bit
+   order (else RGB is ignored). The voxel buffer must be empty (call
+   voxdag_builder_flush first). The result is the same file as adding the
+   same voxels with voxdag_builder_add. Returns VOXDAG_ERR_COORDINATE for a
+   key outside the grid (>= 2^(3(L-2))), VOXDAG_ERR_ORDER for a key that does
+   not increase (err->node: the brick's position); on those errors nothing of
+   this call is added. */
+VOXDAG_API voxdag_status voxdag_builder_add_bricks(voxdag_builder *b, const uint64_t *bricks,
+                                                   const uint8_t *rgb, size_t n, voxdag_error *err);
+#endif /* VOXDAG_NO_BUILD */
 
 /* A triangle mesh to voxelize. Vertices are in grid units: the
    grid spans [0, 2^L)^3 and voxel (x, y, z) is the closed box
@@ -231,8 +276,10 @@ typedef struct voxdag_mesh {
    Call it on a builder that holds no voxels yet; more meshes need one
    combined call. Returns VOXDAG_ERR_INVALID_ARGUMENT for an
    index >= vertex_count or a non-finite vertex. */
+#ifndef VOXDAG_NO_BUILD
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
                                                  voxdag_error *err);
+#endif
 
 /* Per-level node counts of a build, filled by voxdag_builder_finish. Arrays
    are indexed by level 0..levels-2; the last entry counts 4^3 bricks. With
@@ -249,6 +296,7 @@ typedef struct voxdag_build_stats {
     uint64_t peak_memory;                          /* bytes held by the builder at most */
 } voxdag_build_stats;
 
+#ifndef VOXDAG_NO_BUILD
 /* Finishes the build: encodes the DAG and frees the builder (also on error).
    STATS may be NULL. Returns the DAG in *out; free it with voxdag_free. */
 VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
@@ -257,6 +305,7 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
 
 /* Frees a builder that will not be finished. NULL is allowed. */
 VOXDAG_API void voxdag_builder_free(voxdag_builder *b);
+#endif /* VOXDAG_NO_BUILD */
 
 /* Morton code of (x, y, z) with 21 bits per axis. */
 VOXDAG_API uint64_t voxdag_morton_encode(uint32_t x, uint32_t y, uint32_t z);
@@ -264,21 +313,31 @@ VOXDAG_API void voxdag_morton_decode(uint64_t code, uint32_t *x, uint32_t *y, ui
 
 // -- Loading and saving
 
+/* Load options. A NULL pointer or an all-zero struct means defaults; nonzero
+   zero_begin / zero_end (an uninitialised struct) and an allocator with only
+   one of alloc and free are rejected with VOXDAG_ERR_INVALID_ARGUMENT. */
 typedef struct voxdag_load_opts {
-    uint32_t zero_begin;
+    uint32_t zero_begin;      /* must be 0 */
     uint64_t max_input_bytes; /* 0: no limit */
     uint64_t max_nodes;       /* total nodes and bricks; 0: no limit */
     uint64_t max_memory;      /* bytes allocated by the load; 0: no limit;
                                  more is VOXDAG_ERR_LIMIT */
-    uint32_t max_levels;      /* 0: VOXDAG_MAX_LEVELS */
+    uint32_t max_levels;      /* 0 or more than VOXDAG_MAX_LEVELS: VOXDAG_MAX_LEVELS */
     int copy;                 /* 1: copy the bytes (else they must outlive the DAG) */
     voxdag_allocator allocator;
-    uint32_t zero_end;
+    int skip_checksums;       /* 1: do not compute the sections' CRC-32C, for bytes
+                                 known to be intact (e.g. written by this process).
+                                 Every structural check still runs, so queries stay
+                                 safe on any bytes; only corruption that keeps the
+                                 structure valid (e.g. a flipped voxel) goes unseen.
+                                 The header and section table are always checked. */
+    uint32_t zero_end;        /* must be 0 */
 } voxdag_load_opts;
 
 /* Validates a .vdag image in memory completely (structure, every pointer,
-   every count, checksums) and returns a DAG that queries it in place. Unless
-   opts->copy is set, DATA must stay valid and unchanged until voxdag_free. */
+   every count, checksums unless opts->skip_checksums) and returns a DAG that
+   queries it in place. Unless opts->copy is set, DATA must stay valid and
+   unchanged until voxdag_free. */
 VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
                                             const voxdag_load_opts *opts,
                                             voxdag **out, voxdag_error *err);
@@ -307,7 +366,8 @@ VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path,
 typedef enum voxdag_color_kind {
     VOXDAG_COLORS_NONE = 0,
     VOXDAG_COLORS_RGB8 = 1,     /* 3 bytes per voxel, in voxel-index order */
-    VOXDAG_COLORS_VOXCOLOR = 2, /* a voxcolor.h stream (decoded by the caller) */
+    VOXDAG_COLORS_VOXCOLOR = 2, /* a voxcolor.h stream (decoded by voxdag_color
+                                   when voxcolor.h is compiled in, see there) */
     VOXDAG_COLORS_FORCE_32BIT = 0x7fffffff
 } voxdag_color_kind;
 
@@ -341,19 +401,41 @@ typedef struct voxdag_info {
     double bounds[6];           /* world-space min xyz, max xyz */
 } voxdag_info;
 
+/* Fills *INFO (nothing happens when DAG or INFO is NULL). */
 VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info);
 
+/* World space. A file built with opts.bounds stores the world box of its grid
+   (voxdag_info.bounds: min x y z, max x y z): grid point g (voxel (x, y, z)
+   spans [x, x+1) ... in grid units, the grid [0, 2^L)^3) is the world point
+   min + g * (max - min) / 2^L, per axis. Without bounds, world space is grid
+   space. These map points both ways with that affine map (exact up to
+   rounding: a round trip is within a few ulps). IN and OUT may be the same
+   array. Returns VOXDAG_OK, or VOXDAG_ERR_INVALID_ARGUMENT for a NULL
+   argument. Thread-safe. */
+VOXDAG_API voxdag_status voxdag_world_to_grid(const voxdag *dag, const double world[3], double grid[3]);
+VOXDAG_API voxdag_status voxdag_grid_to_world(const voxdag *dag, const double grid[3], double world[3]);
+
 /* Returns 1 when voxel (x, y, z) is full (and its index in *index, which may be
-   NULL), 0 when it is empty or outside the grid. */
+   NULL), 0 when it is empty, outside the grid, or DAG is NULL. */
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z,
                              uint64_t *index);
 
-/* Colour of voxel INDEX from an RGB8 colour section. Returns 0 (and leaves rgb)
-   when the DAG has no RGB8 colours or INDEX is out of range. */
+/* Colour (RGB8) of voxel INDEX, whatever the colour section's kind: raw RGB8,
+   or a voxcolor stream when the implementation was compiled with voxcolor.h
+   (include voxcolor.h before the unit that defines VOXDAG_IMPLEMENTATION, or
+   define VOXDAG_WITH_VOXCOLOR there: voxdag.h then includes "voxcolor.h"
+   from its own directory; voxcolor.h itself does not depend on voxdag.h).
+   Then loading also validates the stream (VOXDAG_ERR_CORRUPT for a bad one,
+   err->byte_offset in the file) and each call decodes one colour in place,
+   with no allocation. From a ray hit: voxdag_color(dag, hit.index, rgb) with
+   ray opts.want_index set. Returns 1, or 0 (RGB untouched) when the DAG has
+   no colours, a voxcolor stream without voxcolor.h compiled in, INDEX >=
+   the voxel count, or DAG or RGB is NULL. Thread-safe. */
 VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]);
 
-/* Calls FN for every full voxel in voxel-index order; stops early when FN
-   returns nonzero. Returns the number of voxels visited. */
+/* Calls FN (may be NULL: counts) for every full voxel in voxel-index order;
+   stops early when FN returns nonzero. Returns the number of voxels visited
+   (0 when DAG is NULL). */
 typedef int (*voxdag_voxel_fn)(void *user, uint32_t x, uint32_t y, uint32_t z,
                                uint64_t index);
 VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
@@ -378,14 +460,18 @@ typedef struct voxdag_ray {
 } voxdag_ray;
 
 /* Ray options. A NULL pointer or an all-zero struct means defaults: no level
-   of detail and no voxel index. */
+   of detail and no voxel index. Checked on every call, in every build:
+   nonzero zero_begin / zero_end (an uninitialised struct), or a negative,
+   NaN or infinite lod_factor or lod_pixels make voxdag_raycast return -1. */
 typedef struct voxdag_ray_opts {
+    uint32_t zero_begin; /* must be 0 */
     int want_index;    /* 1: fill hit.index (one extra descent at the hit) */
     double lod_factor; /* size of one pixel at distance t = 1, in grid units */
     double lod_pixels; /* stop at a full cell whose projected size, cell side /
                           (t * lod_factor), is below this; 0 = full detail. Cells
                           are nodes (4^3 bricks and coarser) and the 2^3 cells
                           of a brick (full when any of their 8 voxels is) */
+    uint32_t zero_end; /* must be 0 */
 } voxdag_ray_opts;
 
 typedef struct voxdag_hit {
@@ -399,16 +485,30 @@ typedef struct voxdag_hit {
 } voxdag_hit;
 
 /* Finds the first full voxel (or level-of-detail cell) along RAY and fills
-   *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched). OPTS may be NULL.
-   Thread-safe on a shared DAG; no allocation; stack use bounded by
-   VOXDAG_MAX_LEVELS. NaN inputs miss. */
+   *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched), -1 (HIT untouched)
+   when DAG, RAY or HIT is NULL or OPTS is invalid (see voxdag_ray_opts), in
+   every build: test `> 0` for a hit. OPTS may be NULL. Thread-safe on a
+   shared DAG; no allocation; stack use bounded by VOXDAG_MAX_LEVELS. NaN
+   inputs miss. */
 VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray,
                               const voxdag_ray_opts *opts, voxdag_hit *hit);
 
 /* Shadow query: returns 1 when any full voxel lies along RAY within
-   [t_min, t_max], else 0. Same answer as voxdag_raycast without level of
-   detail, with less bookkeeping. Thread-safe; no allocation. */
+   [t_min, t_max], else 0; -1 when DAG or RAY is NULL. Same answer as
+   voxdag_raycast without level of detail, with less bookkeeping.
+   Thread-safe; no allocation. */
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
+
+/* Maps a world-space ray (origin and direction in the units of the file's
+   bounds, see voxdag_world_to_grid) to grid units: the origin as a point, the
+   direction divided per axis by the voxel's world size (max - min) / 2^L. t_min and t_max are copied
+   unchanged, because the map is affine: the point at t on the world ray is
+   the point at t on the grid ray, so a hit's t is also its world-space
+   parameter (world hit point = world origin + t * world dir; normals keep
+   their signs). IN and OUT may be the same. Returns VOXDAG_OK, or
+   VOXDAG_ERR_INVALID_ARGUMENT for a NULL argument. Thread-safe. */
+VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *world_ray,
+                                          voxdag_ray *grid_ray);
 
 #endif /* VOXDAG_NO_RAYTRACE */
 
@@ -480,6 +580,14 @@ enum {
 #endif
 #ifndef VOXDAG_NO_THREADS
 #include <pthread.h>
+#endif
+/* voxdag_color decodes voxcolor streams when voxcolor.h's declarations are
+   here (included before this implementation, or by VOXDAG_WITH_VOXCOLOR). */
+#if defined(VOXDAG_WITH_VOXCOLOR) && !defined(VOXCOLOR_H)
+#include "voxcolor.h"
+#endif
+#ifdef VOXCOLOR_H
+#define VOXDAGI_VOXCOLOR 1
 #endif
 
 static const uint8_t voxdagi_magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
@@ -623,6 +731,7 @@ static voxdag_status voxdagi_mem_fail(const voxdagi_mem *m, voxdag_error *err, v
     return VOXDAGI_FAIL(err, st, message);
 }
 
+#ifndef VOXDAG_NO_BUILD
 /* Grows *p (holding *cap elements of ELEM bytes) to at least NEED elements,
    doubling. Returns 0 when out of memory (the old block is kept). */
 static int voxdagi_grow(voxdagi_mem *m, void **p, size_t *cap, size_t need, size_t elem) {
@@ -641,6 +750,7 @@ static int voxdagi_grow(voxdagi_mem *m, void **p, size_t *cap, size_t need, size
     *cap = n;
     return 1;
 }
+#endif
 
 // -- Bits: popcount, Morton codes, little-endian access, hashing
 
@@ -686,9 +796,9 @@ VOXDAG_API uint64_t voxdag_morton_encode(uint32_t x, uint32_t y, uint32_t z) {
 }
 
 VOXDAG_API void voxdag_morton_decode(uint64_t code, uint32_t *x, uint32_t *y, uint32_t *z) {
-    *x = voxdagi_compact3(code);
-    *y = voxdagi_compact3(code >> 1);
-    *z = voxdagi_compact3(code >> 2);
+    if (x) *x = voxdagi_compact3(code);
+    if (y) *y = voxdagi_compact3(code >> 1);
+    if (z) *z = voxdagi_compact3(code >> 2);
 }
 
 static uint64_t voxdagi_le(const uint8_t *p, unsigned n) { /* n <= 8 bytes */
@@ -714,31 +824,48 @@ static void voxdagi_put_le(uint8_t *p, uint64_t v, unsigned n) {
     for (i = 0; i < n; i++) p[i] = (uint8_t)(v >> (8 * i));
 }
 
+#ifndef VOXDAG_NO_BUILD
 static uint64_t voxdagi_mix64(uint64_t z) { /* a strong 64-bit finalizer */
     z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
     z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
     return z ^ (z >> 31);
 }
+#endif
 
-/* CRC-32C (Castagnoli), bitwise table built per call: sections are large and
-   few, so the 256-entry table costs nothing next to the data. */
+/* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing by 8: eight
+   bytes per step through eight 256-entry tables, T[k][b] being the CRC
+   register after byte b followed by k zero bytes. The tables (8 KiB) are
+   built per call in about 2,000 steps (the CRC is linear, so T[0] is XORs of
+   its 8 power-of-two entries); calls are few (a header, a table, a few
+   sections per file) and sections large. The data is read byte by byte, so
+   the result does not depend on alignment or byte order. */
 static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
-    uint32_t table[256], crc = 0xFFFFFFFFu;
+    uint32_t t[8][256], crc = 0xFFFFFFFFu;
     uint32_t i, k;
-    for (i = 0; i < 256; i++) {
+    t[0][0] = 0;
+    for (i = 1; i < 256; i <<= 1) {
         uint32_t c = i;
         for (k = 0; k < 8; k++) c = (c >> 1) ^ (0x82F63B78u & (0u - (c & 1)));
-        table[i] = c;
+        for (k = 0; k < i; k++) t[0][i + k] = c ^ t[0][k];
     }
-    while (n--) crc = table[(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+    for (k = 1; k < 8; k++)
+        for (i = 0; i < 256; i++) t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xFF];
+    for (; n >= 8; n -= 8, p += 8) {
+        uint32_t lo = crc ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
+        crc = t[7][lo & 0xFF] ^ t[6][lo >> 8 & 0xFF] ^ t[5][lo >> 16 & 0xFF] ^ t[4][lo >> 24] ^ t[3][p[4]] ^
+              t[2][p[5]] ^ t[1][p[6]] ^ t[0][p[7]];
+    }
+    while (n--) crc = t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
     return ~crc;
 }
 
+#ifndef VOXDAG_NO_BUILD
 static unsigned voxdagi_bytes_for(uint64_t v) { /* bytes to hold v, >= 1 */
     unsigned n = 1;
     while (n < 8 && (v >> (8 * n))) n++;
     return n;
 }
+#endif
 
 // -- The cube group: the 48 symmetries of a cube (SSVDAG 3, extended)
 //
@@ -829,6 +956,7 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
     }
 }
 
+#ifndef VOXDAG_NO_BUILD
 /* Reflecting a 4^3 brick by m moves Morton position p to p ^ (m | m << 3):
    one swap stage per set bit. */
 static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
@@ -859,6 +987,9 @@ static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsig
     }
     return voxdagi_reflect_brick(x, T & 7);
 }
+#endif
+
+#ifndef VOXDAG_NO_BUILD /* the builder, the voxelizer (up to the file image assembly) */
 
 // -- Unique node stores (one per level) with hash-consing
 
@@ -1382,6 +1513,10 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
                             "allocator needs both alloc and free");
+    if (o.chunk_levels == 1 || o.chunk_levels > 8)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "chunk_levels is not 0 or 2..8");
+    if (o.color_sink && !o.colors)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "color_sink without colors");
     if (o.bounds) {
         for (k = 0; k < 3; k++)
             if (!(o.bounds[k] < o.bounds[k + 3]) || o.bounds[k] != o.bounds[k] ||
@@ -1594,18 +1729,23 @@ static voxdag_status voxdagi_builder_send_colors(voxdag_builder *b, size_t held,
 }
 
 /* Appends the colours of N sorted, distinct voxels that follow the reduced
-   ones. With a sink, the colours go out at once, but for the last one: a
-   repeat of that voxel at the start of the next flush may still replace it. */
-static voxdag_status voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, size_t n) {
+   ones, as bytes (RGB8) or, when RGB8 is NULL, packed 0xRRGGBB (RGB). With a
+   sink, the colours go out at once, but for the last one: a repeat of that
+   voxel at the start of the next flush may still replace it. */
+static voxdag_status voxdagi_builder_colors(voxdag_builder *b, const uint32_t *rgb, const uint8_t *rgb8, size_t n) {
     size_t i, held = (size_t)(b->voxels - b->colors_base);
     uint8_t *c;
     if (!b->opts.colors) return VOXDAG_OK;
     if (!voxdagi_grow(&b->mem, (void **)&b->colors, &b->colors_cap, held + n, 3)) return VOXDAG_ERR_OUT_OF_MEMORY;
     c = b->colors + 3 * held;
-    for (i = 0; i < n; i++) {
-        c[3 * i] = (uint8_t)(rgb[i] >> 16);
-        c[3 * i + 1] = (uint8_t)(rgb[i] >> 8);
-        c[3 * i + 2] = (uint8_t)rgb[i];
+    if (rgb8) {
+        memcpy(c, rgb8, 3 * n);
+    } else {
+        for (i = 0; i < n; i++) {
+            c[3 * i] = (uint8_t)(rgb[i] >> 16);
+            c[3 * i + 1] = (uint8_t)(rgb[i] >> 8);
+            c[3 * i + 2] = (uint8_t)rgb[i];
+        }
     }
     return voxdagi_builder_send_colors(b, held + n, 1);
 }
@@ -1872,7 +2012,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
     if (rgb) rgb += i;
     b->pend_n = 0;
     if (!n) return VOXDAG_OK;
-    if ((st = voxdagi_builder_colors(b, rgb, n)) != VOXDAG_OK) return st;
+    if ((st = voxdagi_builder_colors(b, rgb, NULL, n)) != VOXDAG_OK) return st;
 #ifndef VOXDAG_NO_THREADS
     if ((st = voxdagi_reduce_parallel(b, code, n, final, &done)) != VOXDAG_OK) return st;
 #else
@@ -1898,6 +2038,82 @@ VOXDAG_API voxdag_status voxdag_builder_flush(voxdag_builder *b, voxdag_error *e
     if (st != VOXDAG_OK) {
         b->failed = voxdagi_mem_fail(&b->mem, err, st, voxdagi_reduce_message(st));
         return b->failed;
+    }
+    return voxdagi_ok(err);
+}
+
+/* Checks N bricks (key, mask pairs) for voxdag_builder_add_bricks: keys in
+   the grid and increasing after the last reduced voxel. Returns the status
+   and in *BAD the first brick at fault; *VOXELS: their voxel count. */
+static voxdag_status voxdagi_check_bricks(const voxdag_builder *b, const uint64_t *bricks, size_t n, size_t *bad,
+                                          uint64_t *voxels) {
+    uint64_t limit = 1ull << (3 * (b->levels - 2)), last = b->last_code >> 6;
+    int any = b->any_reduced;
+    size_t i;
+    *voxels = 0;
+    for (i = 0; i < n; i++) {
+        uint64_t key = bricks[2 * i], mask = bricks[2 * i + 1];
+        *bad = i;
+        if (!mask) continue;
+        if (key >= limit) return VOXDAG_ERR_COORDINATE;
+        if (any && key <= last) return VOXDAG_ERR_ORDER;
+        any = 1;
+        last = key;
+        *voxels += (uint64_t)voxdagi_popcount64(mask);
+    }
+    return VOXDAG_OK;
+}
+
+/* Reduces N checked bricks and takes their colours (RGB8, one per voxel, or
+   packed 0xRRGGBB in RGB32 when not NULL): the voxelizer's path and
+   voxdag_builder_add_bricks'. */
+static voxdag_status voxdagi_builder_bricks(voxdag_builder *b, const uint64_t *bricks, const uint8_t *rgb8,
+                                            const uint32_t *rgb32, size_t n, uint64_t voxels) {
+    voxdag_status st;
+    uint64_t m = 0, key = 0;
+    size_t i;
+    unsigned k;
+    if (!voxels) return VOXDAG_OK;
+    if ((st = voxdagi_builder_colors(b, rgb32, rgb8, (size_t)voxels)) != VOXDAG_OK) return st;
+    for (k = 0; k < b->red_count; k++) {
+        for (i = 0; i < n; i++)
+            if (bricks[2 * i + 1]) voxdagi_reducer_brick(&b->red[k], bricks[2 * i], bricks[2 * i + 1]);
+        if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
+    }
+    for (i = n; i-- > 0;)
+        if (bricks[2 * i + 1]) {
+            key = bricks[2 * i];
+            m = bricks[2 * i + 1];
+            break;
+        }
+    b->voxels += voxels;
+    for (k = 1; k < 64; k *= 2) m |= m >> k; /* the last voxel: the mask's highest bit */
+    b->last_code = key << 6 | (uint64_t)(voxdagi_popcount64(m) - 1);
+    b->any_reduced = 1;
+    if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) return VOXDAG_ERR_LIMIT;
+    return VOXDAG_OK;
+}
+
+VOXDAG_API voxdag_status voxdag_builder_add_bricks(voxdag_builder *b, const uint64_t *bricks, const uint8_t *rgb,
+                                                   size_t n, voxdag_error *err) {
+    voxdag_status st;
+    uint64_t voxels;
+    size_t bad = 0;
+    if (!b || (n && !bricks) || (n && b->opts.colors && !rgb))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "builder, bricks or colours missing");
+    if (b->failed) return VOXDAGI_FAIL(err, b->failed, "the builder failed earlier");
+    if (b->pend_n)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "voxels are buffered: flush before adding bricks");
+    st = voxdagi_check_bricks(b, bricks, n, &bad, &voxels);
+    if (st == VOXDAG_ERR_COORDINATE)
+        return voxdagi_fail(err, st, "brick key outside the grid", UINT64_MAX, (uint64_t)bad);
+    if (st == VOXDAG_ERR_ORDER)
+        return voxdagi_fail(err, st, "brick key does not follow the bricks and voxels before it", UINT64_MAX,
+                            (uint64_t)bad);
+    st = voxdagi_builder_bricks(b, bricks, rgb, NULL, n, voxels);
+    if (st != VOXDAG_OK) {
+        b->failed = st;
+        return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
     }
     return voxdagi_ok(err);
 }
@@ -2217,26 +2433,14 @@ static unsigned voxdagi_chunk_assign(voxdagi_chunk *c, unsigned count, const uin
     return t;
 }
 
-/* Reduces a voxelized chunk's bricks and takes its colours. */
+/* Reduces a voxelized chunk's bricks and takes its colours, through the
+   brick feed of voxdag_builder_add_bricks. */
 static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk *c) {
-    voxdag_status st;
-    uint64_t m;
-    size_t i;
-    unsigned k;
+    uint64_t voxels;
+    size_t bad;
     if (c->failed) return VOXDAG_ERR_OUT_OF_MEMORY;
-    if (!c->bricks) return VOXDAG_OK;
-    if ((st = voxdagi_builder_colors(b, c->rgb, c->voxels)) != VOXDAG_OK) return st;
-    for (k = 0; k < b->red_count; k++) {
-        for (i = 0; i < c->bricks; i++) voxdagi_reducer_brick(&b->red[k], c->brick[2 * i], c->brick[2 * i + 1]);
-        if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
-    }
-    b->voxels += c->voxels;
-    m = c->brick[2 * c->bricks - 1];
-    for (k = 1; k < 64; k *= 2) m |= m >> k; /* the last voxel: the mask's highest bit */
-    b->last_code = c->brick[2 * c->bricks - 2] << 6 | (uint64_t)(voxdagi_popcount64(m) - 1);
-    b->any_reduced = 1;
-    if (b->opts.max_nodes && voxdagi_builder_nodes(b) > b->opts.max_nodes) return VOXDAG_ERR_LIMIT;
-    return VOXDAG_OK;
+    if (voxdagi_check_bricks(b, c->brick, c->bricks, &bad, &voxels) != VOXDAG_OK) return VOXDAG_ERR_ORDER;
+    return voxdagi_builder_bricks(b, c->brick, NULL, c->rgb, c->bricks, voxels);
 }
 
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
@@ -2355,6 +2559,8 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
     return voxdagi_ok(err);
 }
 
+#endif /* VOXDAG_NO_BUILD */
+
 // -- File image assembly (FORMAT.md: header, section table, sections)
 
 typedef struct voxdagi_layout {
@@ -2453,6 +2659,7 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, const v
 // of its first private child; the next ones follow it record by record. Each
 // level picks this or a third class, and its classes, for the fewest bytes.
 
+#ifndef VOXDAG_NO_BUILD
 /* The number of bits of V (0 for 0). */
 static unsigned voxdagi_bit_length(uint64_t v) {
     unsigned n = 0;
@@ -2468,6 +2675,7 @@ static void voxdagi_put_bits(uint8_t *p, uint64_t pos, uint64_t v, unsigned n) {
         v >>= take, pos += take, n -= take;
     }
 }
+#endif
 
 /* N <= 57 bits at bit POS of P; 8 bytes from byte POS / 8 must be readable. */
 VOXDAGI_INLINE uint64_t voxdagi_get_bits(const uint8_t *p, uint64_t pos, unsigned n) {
@@ -2481,6 +2689,8 @@ static uint64_t voxdagi_get_bits_wide(const uint8_t *p, uint64_t pos, unsigned n
     if (sh + n > 64) v |= (uint64_t)p[(pos >> 3) + 8] << (64 - sh);
     return n < 64 ? v & ((1ull << n) - 1) : v;
 }
+
+#ifndef VOXDAG_NO_BUILD /* the encoder */
 
 /* Storage order of a level: most referenced first, ties by fingerprint (or
    mask), then by id; two stable radix sorts. Fills ORDER with ids. Returns 0
@@ -2983,6 +3193,8 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
     }
 }
 
+#endif /* VOXDAG_NO_BUILD */
+
 // -- The DAG: a parsed view of a file image
 
 typedef struct voxdagi_level {
@@ -3020,6 +3232,9 @@ struct voxdag {
     double bounds[6];
     voxdagi_cube cube;
     uint8_t occupancy[VOXDAGI_TRANSFORMS][256]; /* [MI][stored presence]: world presence */
+#ifdef VOXDAGI_VOXCOLOR
+    voxcolor_view color_view; /* the voxcolor colour section, validated */
+#endif
 };
 
 static void voxdagi_release(const voxdag_allocator *a, void *p, size_t size) {
@@ -3037,8 +3252,8 @@ VOXDAG_API void voxdag_free(voxdag *dag) {
 }
 
 VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size) {
-    if (size) *size = dag->image_size;
-    return dag->image;
+    if (size) *size = dag ? dag->image_size : 0;
+    return dag ? dag->image : NULL;
 }
 
 // -- Node access on the encoded form
@@ -3149,6 +3364,26 @@ static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset)
     for (s = 0; s < 8; s++)
         if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, s, 0) >> 6);
     return sum;
+}
+
+// -- Colours through voxcolor.h (when compiled in)
+
+/* Validates a voxcolor colour section and keeps its view for voxdag_color. */
+static voxdag_status voxdagi_open_colors(voxdag *d, voxdag_error *err) {
+#ifdef VOXDAGI_VOXCOLOR
+    voxcolor_error ve;
+    uint64_t at = d->color ? (uint64_t)(d->color - d->image) : 0;
+    if (d->color_kind != VOXDAG_COLORS_VOXCOLOR) return VOXDAG_OK;
+    if (voxcolor_view_init(&d->color_view, d->color, (size_t)d->color_size, &ve) != VOXCOLOR_OK)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxcolor colour section does not validate",
+                            ve.byte_offset == UINT64_MAX ? at : at + ve.byte_offset, UINT64_MAX);
+    if (d->color_view.count != d->voxels)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxcolor colour count differs from the voxel count",
+                            at + VOXCOLOR_OFF_COUNT, UINT64_MAX);
+#else
+    (void)d, (void)err;
+#endif
+    return VOXDAG_OK;
 }
 
 // -- Loading: header, sections and full structural validation (FORMAT.md)
@@ -3442,7 +3677,7 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         } else if (!(flags & VOXDAG_FILE_SECTION_OPTIONAL)) {
             return voxdagi_fail(err, VOXDAG_ERR_VERSION, "unknown required section", at, UINT64_MAX);
         }
-        if (deep && voxdagi_crc32c(img + off, sz) != voxdagi_le(e + 24, 4))
+        if (deep == 1 && voxdagi_crc32c(img + off, sz) != voxdagi_le(e + 24, 4)) /* 2: skip_checksums */
             return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "section checksum mismatch", at + 24, UINT64_MAX);
         end = off + sz;
         p = img + off;
@@ -3504,6 +3739,7 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     d->node_bytes = level_at;
     if (max_nodes && (node_sum > max_nodes || d->brick_count > max_nodes - node_sum))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more nodes than max_nodes");
+    if (voxdagi_open_colors(d, err) != VOXDAG_OK) return VOXDAG_ERR_CORRUPT;
     if (!deep) return VOXDAG_OK;
     return voxdagi_validate_nodes(d, m, err);
 }
@@ -3559,7 +3795,7 @@ VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
         if (size) memcpy(d->owned, data, size);
         data = d->owned;
     }
-    st = voxdagi_open(d, (const uint8_t *)data, size, 1, o.max_levels, o.max_nodes, &m, err);
+    st = voxdagi_open(d, (const uint8_t *)data, size, o.skip_checksums ? 2 : 1, o.max_levels, o.max_nodes, &m, err);
     voxdagi_mem_destroy(&m);
     if (st != VOXDAG_OK) {
         voxdag_free(d);
@@ -3579,6 +3815,8 @@ static void voxdagi_write_bounds(uint8_t *p, const double *bounds) {
         voxdagi_put_le(p + 8 * k, bits, 8);
     }
 }
+
+#ifndef VOXDAG_NO_BUILD /* the rest of this section */
 
 /* Transforms the box B (min xyz, max xyz, half-open) of a cube of side SIDE
    by T: axis a moves to axis perm[a], then mirrored axes flip. */
@@ -3779,18 +4017,29 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     return st;
 }
 
+#endif /* VOXDAG_NO_BUILD */
+
 // -- Colours
 
 VOXDAG_API voxdag_color_kind voxdag_colors(const voxdag *dag, const void **payload, size_t *size) {
-    if (payload) *payload = dag->color;
-    if (size) *size = (size_t)dag->color_size;
-    return dag->color_kind;
+    if (payload) *payload = dag ? dag->color : NULL;
+    if (size) *size = dag ? (size_t)dag->color_size : 0;
+    return dag ? dag->color_kind : VOXDAG_COLORS_NONE;
 }
 
 VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]) {
-    if (dag->color_kind != VOXDAG_COLORS_RGB8 || index >= dag->voxels) return 0;
-    memcpy(rgb, dag->color + 3 * index, 3);
-    return 1;
+    if (!dag || !rgb || index >= dag->voxels) return 0;
+    if (dag->color_kind == VOXDAG_COLORS_RGB8) {
+        memcpy(rgb, dag->color + 3 * index, 3);
+        return 1;
+    }
+#ifdef VOXDAGI_VOXCOLOR
+    if (dag->color_kind == VOXDAG_COLORS_VOXCOLOR) { /* count = voxels: checked by voxdagi_open_colors */
+        voxcolor_view_get(&dag->color_view, index, rgb);
+        return 1;
+    }
+#endif
+    return 0;
 }
 
 VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind kind,
@@ -3868,7 +4117,9 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
 // -- Queries
 
 VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
-    uint32_t l, B = dag->levels - 2;
+    uint32_t l, B;
+    if (!dag || !info) return;
+    B = dag->levels - 2;
     memset(info, 0, sizeof *info);
     info->levels = dag->levels;
     info->symmetry = dag->symmetry;
@@ -3908,10 +4159,11 @@ static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *re
 }
 
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z, uint64_t *index) {
-    uint32_t L = dag->levels, B = L - 2, l;
-    unsigned MI = dag->cube.inv[dag->root_transform], p;
+    uint32_t L, B, l;
+    unsigned MI, p;
     uint64_t at = 0, idx = 0, mask;
-    if (!dag->voxels || (x | y | z) >> L) return 0;
+    if (!dag || !dag->voxels || (x | y | z) >> dag->levels) return 0;
+    L = dag->levels, B = L - 2, MI = dag->cube.inv[dag->root_transform];
     for (l = 0; l < B; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
@@ -3939,10 +4191,11 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         uint32_t x, y, z;
         unsigned MI, next;
     } stack[VOXDAG_MAX_LEVELS];
-    uint32_t L = dag->levels, B = L - 2;
+    uint32_t L, B;
     uint64_t index = 0;
     int depth = 0;
-    if (!dag->voxels) return 0;
+    if (!dag || !dag->voxels) return 0;
+    L = dag->levels, B = L - 2;
     stack[0].at = 0;
     stack[0].x = stack[0].y = stack[0].z = 0;
     stack[0].MI = dag->cube.inv[dag->root_transform];
@@ -3989,6 +4242,36 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         }
     }
     return index;
+}
+
+// -- World space
+
+/* The grid's world origin LO and a voxel's world size CELL per axis (world =
+   LO + grid * CELL; the division by 2^L is exact). */
+static void voxdagi_grid_map(const voxdag *d, double lo[3], double cell[3]) {
+    unsigned k;
+    for (k = 0; k < 3; k++) {
+        lo[k] = d->has_bounds ? d->bounds[k] : 0;
+        cell[k] = d->has_bounds ? (d->bounds[k + 3] - d->bounds[k]) / (double)(1u << d->levels) : 1;
+    }
+}
+
+VOXDAG_API voxdag_status voxdag_world_to_grid(const voxdag *dag, const double world[3], double grid[3]) {
+    double lo[3], cell[3];
+    unsigned k;
+    if (!dag || !world || !grid) return VOXDAG_ERR_INVALID_ARGUMENT;
+    voxdagi_grid_map(dag, lo, cell);
+    for (k = 0; k < 3; k++) grid[k] = (world[k] - lo[k]) / cell[k];
+    return VOXDAG_OK;
+}
+
+VOXDAG_API voxdag_status voxdag_grid_to_world(const voxdag *dag, const double grid[3], double world[3]) {
+    double lo[3], cell[3];
+    unsigned k;
+    if (!dag || !grid || !world) return VOXDAG_ERR_INVALID_ARGUMENT;
+    voxdagi_grid_map(dag, lo, cell);
+    for (k = 0; k < 3; k++) world[k] = lo[k] + grid[k] * cell[k];
+    return VOXDAG_OK;
 }
 
 // -- Ray casting
@@ -4179,16 +4462,41 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     }
 }
 
+/* A finite value >= 0 (not NaN). */
+static int voxdagi_finite_nonneg(double v) { return v >= 0 && v <= 1.7976931348623157e308; }
+
 VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
                               voxdag_hit *hit) {
-    double lod = opts && opts->lod_pixels > 0 ? opts->lod_factor * opts->lod_pixels : 0;
-    VOXDAG_ASSERT(dag && ray && hit);
+    double lod = 0;
+    if (!dag || !ray || !hit) return -1;
+    if (opts) {
+        if (opts->zero_begin || opts->zero_end || !voxdagi_finite_nonneg(opts->lod_factor) ||
+            !voxdagi_finite_nonneg(opts->lod_pixels))
+            return -1;
+        if (opts->lod_pixels > 0) lod = opts->lod_factor * opts->lod_pixels;
+    }
     return voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
 }
 
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
-    VOXDAG_ASSERT(dag && ray);
+    if (!dag || !ray) return -1;
     return voxdagi_trace(dag, ray, 0, 0, NULL);
+}
+
+VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *world_ray, voxdag_ray *grid_ray) {
+    double o[3], d[3], lo[3], cell[3];
+    unsigned k;
+    if (!dag || !world_ray || !grid_ray) return VOXDAG_ERR_INVALID_ARGUMENT;
+    voxdagi_grid_map(dag, lo, cell);
+    for (k = 0; k < 3; k++) {
+        o[k] = (world_ray->origin[k] - lo[k]) / cell[k];
+        d[k] = world_ray->dir[k] / cell[k];
+    }
+    grid_ray->t_min = world_ray->t_min;
+    grid_ray->t_max = world_ray->t_max;
+    memcpy(grid_ray->origin, o, sizeof o);
+    memcpy(grid_ray->dir, d, sizeof d);
+    return VOXDAG_OK;
 }
 
 #endif /* VOXDAG_NO_RAYTRACE */

@@ -77,7 +77,10 @@ fi
 # -- Compile matrix
 
 # The configurations of voxdag.h: the three NO_ switches in all 8 combinations,
-# each with the default and with custom MALLOC+FREE+ASSERT and MAX_LEVELS=12.
+# each with the default and with custom MALLOC+FREE+ASSERT and MAX_LEVELS=12;
+# then VOXDAG_NO_BUILD (load-and-query programs) alone and with every other
+# switch, and the voxcolor bridge (VOXDAG_WITH_VOXCOLOR: voxdag_color decodes
+# voxcolor sections) alone and with NO_BUILD.
 VOXDAG_CONFIGS=""
 for s in "" -DVOXDAG_NO_STDIO; do
     for t in "" -DVOXDAG_NO_THREADS; do
@@ -88,6 +91,8 @@ for s in "" -DVOXDAG_NO_STDIO; do
         done
     done
 done
+VOXDAG_CONFIGS="$VOXDAG_CONFIGS -DVOXDAG_NO_BUILD -DVOXDAG_NO_BUILD,-DVOXDAG_NO_STDIO,-DVOXDAG_NO_THREADS,-DVOXDAG_NO_RAYTRACE,-DCHECK_CUSTOM"
+VOXDAG_CONFIGS="$VOXDAG_CONFIGS -DVOXDAG_WITH_VOXCOLOR -DVOXDAG_WITH_VOXCOLOR,-DVOXDAG_NO_BUILD"
 
 # voxdag.h's conversion warnings: counted against a ceiling until there are none.
 conv_count=0
@@ -200,6 +205,9 @@ for cc in $CCS; do
         "$cc $f -O0 -c -o $O/$cc-impl_both.o -I. $L/impl_both.c
          $cc $f -O0 -o $B/$cc-use-both -I. $L/use.c $O/$cc-impl_both.o $LIBS
          $B/$cc-use-both"
+    job "link $cc: a load-and-query program built with VOXDAG_NO_BUILD, run on a golden file" ok \
+        "$cc $f -O2 -o $B/$cc-load_query -I. $L/load_query.c $LIBS
+         $B/$cc-load_query tests/data/golden/mirrored_blob_l5.vdag"
     job "link $cc: VOXDAG_STATIC and VOXCOLOR_STATIC in two units" ok \
         "$cc $f -O2 -c -o $O/$cc-static_a.o -I. -DSTATIC_UNIT=static_unit_a $L/static_unit.c
          $cc $f -O2 -c -o $O/$cc-static_b.o -I. -DSTATIC_UNIT=static_unit_b $L/static_unit.c
@@ -231,9 +239,17 @@ if [ -n "$M32" ]; then
          $B/m32-use"
 fi
 
-# -- README: every ```c block, preprocessor lines first, the rest in main().
-job "readme: README.md's C code compiled and run" ok \
-    "awk '/^\`\`\`c\$/ { c = 1; next } /^\`\`\`/ { c = 0 } c' README.md >$out/readme/blocks.txt
+# -- README: every ```c block, preprocessor lines first, the rest in main(),
+# run where build/demo.vdag is a scene built as `make demo` does (colours in a
+# voxcolor stream, vdag build --color-error): its colour lookup must print.
+VDAG_SRC="$(sed -n 's/^VDAG_SRC *:= *//p' Makefile | sed 's|examples/image_stb.c|examples/image_none.c|')" # no texture read
+job "readme: README.md's C code compiled and run on a voxcolor-coloured file" ok \
+    "mkdir -p $out/readme/build
+     $cc1 -std=c99 -O2 -pthread -I. -o $out/readme/vdag $VDAG_SRC -lm
+     $out/readme/vdag gen demo $out/readme/build/demo.xyz --levels 7 >/dev/null
+     $out/readme/vdag build $out/readme/build/demo.xyz $out/readme/build/demo.vdag --color-error 0.02 --quiet
+     $out/readme/vdag info $out/readme/build/demo.vdag --json | grep -q voxcolor
+     awk '/^\`\`\`c\$/ { c = 1; next } /^\`\`\`/ { c = 0 } c' README.md >$out/readme/blocks.txt
      test -s $out/readme/blocks.txt
      { echo '#include <stdio.h>'; echo '#include <stdlib.h>'; echo '#include <string.h>'
        grep '^#' $out/readme/blocks.txt
@@ -241,13 +257,14 @@ job "readme: README.md's C code compiled and run" ok \
        grep -v '^#' $out/readme/blocks.txt
        echo 'return 0;'; echo '}'; } >$out/readme/readme.c
      $cc1 $C99 -Wno-unused -O1 -o $out/readme/readme -I. $out/readme/readme.c $LIBS
-     (cd $out/readme && ./readme)"
+     (cd $out/readme && ./readme) >$out/readme/out.txt
+     cat $out/readme/out.txt
+     grep -q '^hit voxel .* colour [0-9]* [0-9]* [0-9]*\$' $out/readme/out.txt"
 
 # -- Determinism: vdag built by each C compiler at -O0 and -O2 and in other
 # floating-point models, one scene built with 1 and 3 threads (colour error
 # 0.03) and with colour errors 0.01 and 0.1; each setting's .vdag files must
 # be byte-identical.
-VDAG_SRC="$(sed -n 's/^VDAG_SRC *:= *//p' Makefile | sed 's|examples/image_stb.c|examples/image_none.c|')" # no texture read
 DET_RUNS="1 3 e0.01 e0.1"
 D=$out/det
 DET_BUILDS=""
