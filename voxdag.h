@@ -35,13 +35,16 @@
      VOXDAG_MALLOC(sz) / VOXDAG_FREE(p)  default allocator (define both or none)
      VOXDAG_ASSERT(x)     caller-contract checks (default: assert)
      VOXDAG_NO_STDIO      leave out the file helpers
-     VOXDAG_NO_THREADS    single-threaded build (no pthreads)
+     VOXDAG_NO_THREADS    single-threaded build (no threads, no thread pool)
      VOXDAG_NO_RAYTRACE   leave out ray casting
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
    THREADS: no global state. A voxdag is immutable: any number of threads may
-   query one at a time. A builder belongs to one thread at a time.
+   query one at a time. A builder belongs to one thread at a time; with
+   opts.threads > 1 it spreads its work over a pool of its own (pthreads, or
+   Win32 threads on Windows; workers started once and reused) or over the
+   host's (opts.thread_pool: run a batch of jobs, wait), with the same bytes.
 
    FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
 */
@@ -142,6 +145,22 @@ typedef enum voxdag_symmetry {
 
 typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
 
+/* A job of the builder's parallel work: run once for each INDEX of a batch. */
+typedef void (*voxdag_job_fn)(void *job_user, uint32_t index);
+
+/* The host's thread pool (optional; voxdag_build_opts.thread_pool). RUN
+   starts a batch: JOB(JOB_USER, i) must be called once for every i in
+   [0, COUNT), on any threads (the calling one too), in any order, before RUN
+   returns or before WAIT returns. WAIT returns when every job of the batch
+   has returned. The builder calls both from the thread that called it, one
+   batch at a time, never from inside a job, and may do its own work between
+   RUN and WAIT. Files are the same bytes whatever the pool does. */
+typedef struct voxdag_thread_pool {
+    void (*run)(void *user, voxdag_job_fn job, void *job_user, uint32_t count);
+    void (*wait)(void *user);
+    void *user;
+} voxdag_thread_pool;
+
 /* Build options. A NULL pointer or an all-zero struct means defaults. */
 typedef struct voxdag_build_opts {
     uint32_t zero_begin;         /* must be 0 */
@@ -150,7 +169,11 @@ typedef struct voxdag_build_opts {
     int colors;                  /* 1: every voxel carries an RGB8 colour */
     int compare_structures;      /* 1: also count the nodes under the other two
                                     symmetry groups (3x work) */
-    uint32_t threads;            /* worker threads; 0 or 1: the calling thread only */
+    uint32_t threads;            /* T > 1: work split in T jobs per batch, run on the
+                                    built-in pool (T - 1 workers, pthreads or Win32
+                                    threads, started once per builder) or on
+                                    thread_pool; 0 or 1: the calling thread only.
+                                    The file is the same bytes whatever T. */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit */
     uint64_t max_nodes;          /* unique nodes and bricks of the result, all
@@ -168,6 +191,9 @@ typedef struct voxdag_build_opts {
        memory does not grow with the colours. */
     int (*color_sink)(void *user, const uint8_t *rgb, size_t n);
     void *color_sink_user;
+    voxdag_thread_pool thread_pool; /* run and wait NULL: the built-in pool; both
+                                    or neither. Ignored under VOXDAG_NO_THREADS,
+                                    which builds on the calling thread only */
     uint32_t zero_end;           /* must be 0 */
 } voxdag_build_opts;
 
@@ -468,7 +494,33 @@ enum {
 #include <stdio.h>
 #endif
 #ifndef VOXDAG_NO_THREADS
+#if defined(_WIN32)
+#include <windows.h> /* Win32 threads (Vista and later): SRW locks, condition variables */
+typedef SRWLOCK voxdagi_lock_t;
+typedef CONDITION_VARIABLE voxdagi_cond_t;
+typedef HANDLE voxdagi_thread_t;
+#define voxdagi_lock_init(m) InitializeSRWLock(m)
+#define voxdagi_lock_destroy(m) ((void)(m))
+#define voxdagi_lock(m) AcquireSRWLockExclusive(m)
+#define voxdagi_unlock(m) ReleaseSRWLockExclusive(m)
+#define voxdagi_cond_init(c) InitializeConditionVariable(c)
+#define voxdagi_cond_destroy(c) ((void)(c))
+#define voxdagi_cond_wait(c, m) SleepConditionVariableSRW(c, m, INFINITE, 0)
+#define voxdagi_cond_wake_all(c) WakeAllConditionVariable(c)
+#else
 #include <pthread.h>
+typedef pthread_mutex_t voxdagi_lock_t;
+typedef pthread_cond_t voxdagi_cond_t;
+typedef pthread_t voxdagi_thread_t;
+#define voxdagi_lock_init(m) pthread_mutex_init(m, NULL)
+#define voxdagi_lock_destroy(m) pthread_mutex_destroy(m)
+#define voxdagi_lock(m) pthread_mutex_lock(m)
+#define voxdagi_unlock(m) pthread_mutex_unlock(m)
+#define voxdagi_cond_init(c) pthread_cond_init(c, NULL)
+#define voxdagi_cond_destroy(c) pthread_cond_destroy(c)
+#define voxdagi_cond_wait(c, m) pthread_cond_wait(c, m)
+#define voxdagi_cond_wake_all(c) pthread_cond_broadcast(c)
+#endif
 #endif
 
 static const uint8_t voxdagi_magic[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
@@ -545,7 +597,7 @@ typedef struct voxdagi_mem {
     voxdag_allocator a;
     uint64_t used, peak, limit; /* limit 0: none */
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_t lock; /* workers allocate concurrently */
+    voxdagi_lock_t lock; /* workers allocate concurrently */
 #endif
 } voxdagi_mem;
 
@@ -554,13 +606,13 @@ static void voxdagi_mem_init(voxdagi_mem *m, const voxdag_allocator *a, uint64_t
     if (a) m->a = *a;
     m->limit = limit;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_init(&m->lock, NULL);
+    voxdagi_lock_init(&m->lock);
 #endif
 }
 
 static void voxdagi_mem_destroy(voxdagi_mem *m) {
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_destroy(&m->lock);
+    voxdagi_lock_destroy(&m->lock);
 #else
     (void)m;
 #endif
@@ -571,7 +623,7 @@ static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
     int ok;
     if (size == 0) size = 1;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_lock(&m->lock);
+    voxdagi_lock(&m->lock);
 #endif
     ok = !m->limit || (m->used <= m->limit && size <= m->limit - m->used);
     if (ok) {
@@ -582,7 +634,7 @@ static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
         }
     }
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_unlock(&m->lock);
+    voxdagi_unlock(&m->lock);
 #endif
     return p;
 }
@@ -591,13 +643,13 @@ static void voxdagi_free(voxdagi_mem *m, void *p, size_t size) {
     if (!p) return;
     if (size == 0) size = 1;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_lock(&m->lock);
+    voxdagi_lock(&m->lock);
 #endif
     if (m->a.free) m->a.free(m->a.user, p, size);
     else if (!m->a.alloc) VOXDAG_FREE(p);
     m->used -= size;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_unlock(&m->lock);
+    voxdagi_unlock(&m->lock);
 #endif
 }
 
@@ -1308,6 +1360,129 @@ static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code
 
 #define VOXDAGI_MAX_THREADS 64
 
+/* A batch of jobs: FN on each of the COUNT SIZE-byte elements of JOBS (the
+   JOB_USER of voxdag_job_fn). */
+typedef struct voxdagi_batch {
+    void *(*fn)(void *);
+    char *jobs;
+    size_t size;
+    uint32_t count;
+    int pooled; /* running on a pool (else the wait runs it) */
+} voxdagi_batch;
+
+static void voxdagi_batch_job(void *user, uint32_t index) {
+    voxdagi_batch *bt = (voxdagi_batch *)user;
+    bt->fn(bt->jobs + (size_t)index * bt->size);
+}
+
+#ifndef VOXDAG_NO_THREADS
+/* The built-in pool: THREADS - 1 workers started on the first batch and kept
+   until the builder is freed. RUN hands a batch to the workers; WAIT takes the
+   jobs no worker has taken yet, then waits for the rest. */
+typedef struct voxdagi_pool {
+    voxdagi_lock_t lock;
+    voxdagi_cond_t wake, done;
+    voxdag_job_fn job;
+    void *job_user;
+    uint32_t count, next, finished, batch, workers;
+    int quit;
+    voxdagi_thread_t tid[VOXDAGI_MAX_THREADS - 1];
+} voxdagi_pool;
+
+/* Runs jobs of the current batch until none is left; called and returns with
+   the lock held. */
+static void voxdagi_pool_take(voxdagi_pool *p) {
+    while (p->next < p->count) {
+        uint32_t i = p->next++;
+        voxdagi_unlock(&p->lock);
+        p->job(p->job_user, i);
+        voxdagi_lock(&p->lock);
+        if (++p->finished == p->count) voxdagi_cond_wake_all(&p->done);
+    }
+}
+
+static void voxdagi_pool_worker(voxdagi_pool *p) {
+    uint32_t seen = 0;
+    voxdagi_lock(&p->lock);
+    while (!p->quit) {
+        if (p->batch == seen) {
+            voxdagi_cond_wait(&p->wake, &p->lock);
+            continue;
+        }
+        seen = p->batch;
+        voxdagi_pool_take(p);
+    }
+    voxdagi_unlock(&p->lock);
+}
+
+#if defined(_WIN32)
+static DWORD WINAPI voxdagi_pool_main(LPVOID p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return 0;
+}
+#else
+static void *voxdagi_pool_main(void *p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return NULL;
+}
+#endif
+
+/* Starts up to WORKERS threads (those the system refuses are left to WAIT). */
+static void voxdagi_pool_start(voxdagi_pool *p, uint32_t workers) {
+    memset(p, 0, sizeof *p);
+    voxdagi_lock_init(&p->lock);
+    voxdagi_cond_init(&p->wake);
+    voxdagi_cond_init(&p->done);
+    for (; p->workers < workers; p->workers++) {
+#if defined(_WIN32)
+        p->tid[p->workers] = CreateThread(NULL, 0, voxdagi_pool_main, p, 0, NULL);
+        if (!p->tid[p->workers]) break;
+#else
+        if (pthread_create(&p->tid[p->workers], NULL, voxdagi_pool_main, p) != 0) break;
+#endif
+    }
+}
+
+static void voxdagi_pool_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    p->job = job;
+    p->job_user = job_user;
+    p->count = count;
+    p->next = p->finished = 0;
+    p->batch++;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_wait(void *user) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    voxdagi_pool_take(p);
+    while (p->finished < p->count) voxdagi_cond_wait(&p->done, &p->lock);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_stop(voxdagi_pool *p) {
+    uint32_t t;
+    voxdagi_lock(&p->lock);
+    p->quit = 1;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+    for (t = 0; t < p->workers; t++) {
+#if defined(_WIN32)
+        WaitForSingleObject(p->tid[t], INFINITE);
+        CloseHandle(p->tid[t]);
+#else
+        pthread_join(p->tid[t], NULL);
+#endif
+    }
+    voxdagi_cond_destroy(&p->wake);
+    voxdagi_cond_destroy(&p->done);
+    voxdagi_lock_destroy(&p->lock);
+}
+#endif
+
 struct voxdag_builder {
     voxdagi_mem mem;
     voxdag_build_opts opts;
@@ -1329,6 +1504,11 @@ struct voxdag_builder {
     uint64_t colors_base;        /* with a colour sink: the first colour not yet sent */
     uint64_t voxels;
     voxdag_status failed;        /* sticky error */
+    voxdag_thread_pool pool;     /* the host's (run NULL: the built-in one) */
+    voxdagi_batch batch;         /* between voxdagi_batch_start and _wait */
+#ifndef VOXDAG_NO_THREADS
+    voxdagi_pool *builtin;       /* started on the first batch */
+#endif
 };
 
 VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
@@ -1352,6 +1532,9 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     if ((o.allocator.alloc == NULL) != (o.allocator.free == NULL))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
                             "allocator needs both alloc and free");
+    if ((o.thread_pool.run == NULL) != (o.thread_pool.wait == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                            "thread_pool needs both run and wait");
     if (o.bounds) {
         for (k = 0; k < 3; k++)
             if (!(o.bounds[k] < o.bounds[k + 3]) || o.bounds[k] != o.bounds[k] ||
@@ -1372,6 +1555,8 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     b->threads = o.threads < 1 ? 1 : o.threads > VOXDAGI_MAX_THREADS ? VOXDAGI_MAX_THREADS : o.threads;
 #ifdef VOXDAG_NO_THREADS
     b->threads = 1;
+#else
+    b->pool = o.thread_pool;
 #endif
     if (o.bounds) {
         b->has_bounds = 1;
@@ -1397,59 +1582,58 @@ VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
     voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *b->pend_code);
     voxdagi_free(&b->mem, b->pend_rgb, b->opts.colors ? b->pend_cap * sizeof *b->pend_rgb : 0);
     voxdagi_free(&b->mem, b->colors, b->colors_cap * 3);
+#ifndef VOXDAG_NO_THREADS
+    if (b->builtin) {
+        voxdagi_pool_stop(b->builtin);
+        voxdagi_free(&b->mem, b->builtin, sizeof *b->builtin);
+    }
+#endif
     mem = b->mem;
     voxdagi_free(&mem, b, sizeof *b);
     voxdagi_mem_destroy(&mem);
 }
 
-/* Threads running FN on jobs FIRST..COUNT-1 of an array of SIZE-byte
-   elements, one each, while the calling thread does other work. Without
-   threads (or when one cannot start) the join runs the jobs itself. */
-typedef struct voxdagi_team {
+/* Starts FN on each of the COUNT SIZE-byte elements of JOBS on the thread
+   pool, the host's or the built-in one (started on the first batch), while
+   the calling thread does other work; voxdagi_batch_wait ends the batch.
+   With one thread (or no pool) the wait runs the jobs itself. */
+static void voxdagi_batch_start(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size,
+                                unsigned count) {
+    b->batch.fn = fn;
+    b->batch.jobs = (char *)jobs;
+    b->batch.size = size;
+    b->batch.count = count;
+    b->batch.pooled = 0;
 #ifndef VOXDAG_NO_THREADS
-    pthread_t tid[VOXDAGI_MAX_THREADS];
-    int started[VOXDAGI_MAX_THREADS];
-#endif
-    void *(*fn)(void *);
-    char *jobs;
-    size_t size;
-    unsigned first, count;
-} voxdagi_team;
-
-static void voxdagi_team_start(voxdagi_team *tm, void *(*fn)(void *), void *jobs, size_t size, unsigned first,
-                               unsigned count) {
-    unsigned t;
-    tm->fn = fn;
-    tm->jobs = (char *)jobs;
-    tm->size = size;
-    tm->first = first;
-    tm->count = count;
-    for (t = first; t < count; t++) {
-#ifndef VOXDAG_NO_THREADS
-        tm->started[t] = pthread_create(&tm->tid[t], NULL, fn, tm->jobs + t * size) == 0;
-#endif
+    if (b->threads < 2 || !count) return;
+    if (!b->pool.run && !b->builtin) {
+        b->builtin = (voxdagi_pool *)voxdagi_alloc(&b->mem, sizeof *b->builtin);
+        if (!b->builtin) return; /* the calling thread does it all */
+        voxdagi_pool_start(b->builtin, b->threads - 1);
     }
+    if (b->pool.run) b->pool.run(b->pool.user, voxdagi_batch_job, &b->batch, count);
+    else voxdagi_pool_run(b->builtin, voxdagi_batch_job, &b->batch, count);
+    b->batch.pooled = 1;
+#endif
 }
 
-static void voxdagi_team_join(voxdagi_team *tm) {
-    unsigned t;
-    for (t = tm->first; t < tm->count; t++) {
+static void voxdagi_batch_wait(voxdag_builder *b) {
+    uint32_t i;
 #ifndef VOXDAG_NO_THREADS
-        if (tm->started[t]) {
-            pthread_join(tm->tid[t], NULL);
-            continue;
-        }
-#endif
-        tm->fn(tm->jobs + t * tm->size);
+    if (b->batch.pooled) {
+        if (b->pool.wait) b->pool.wait(b->pool.user);
+        else voxdagi_pool_wait(b->builtin);
+        b->batch.pooled = 0;
+        return;
     }
+#endif
+    for (i = 0; i < b->batch.count; i++) voxdagi_batch_job(&b->batch, i);
 }
 
-/* Runs FN on COUNT jobs, one thread each; the calling thread takes job 0. */
-static void voxdagi_run_parallel(void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
-    voxdagi_team tm;
-    voxdagi_team_start(&tm, fn, jobs, size, 1, count);
-    if (count) fn(jobs);
-    voxdagi_team_join(&tm);
+/* Runs FN on the COUNT jobs, in parallel when the builder has threads. */
+static void voxdagi_run_parallel(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+    voxdagi_batch_start(b, fn, jobs, size, count);
+    voxdagi_batch_wait(b);
 }
 
 /* Morton encoding and checks of voxels [begin, end) of an add call. */
@@ -1535,7 +1719,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
             job[t].begin = n / jobs * t;
             job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
         }
-        voxdagi_run_parallel(voxdagi_encode_run, job, sizeof job[0], jobs);
+        voxdagi_run_parallel(b, voxdagi_encode_run, job, sizeof job[0], jobs);
         for (t = 0; t < jobs && st == VOXDAG_OK; t++)
             if (job[t].status != VOXDAG_OK) {
                 st = job[t].status;
@@ -1731,7 +1915,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
         for (k = 0; k < b->red_count; k++)
             voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], L, split);
     }
-    voxdagi_run_parallel(voxdagi_worker_run, worker, sizeof *worker, b->threads);
+    voxdagi_run_parallel(b, voxdagi_worker_run, worker, sizeof *worker, b->threads);
 
     /* Merge in worker order, then feed voxels and subtrees in Morton order. */
     for (t = 0; t < b->threads && st == VOXDAG_OK; t++)
@@ -2286,21 +2470,20 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift)) st = VOXDAG_ERR_OUT_OF_MEMORY;
     p = 0;
     t = st == VOXDAG_OK ? voxdagi_chunk_assign(chunk, b->threads, pair_chunk, pair_tri, pairs, &p) : 0;
-    voxdagi_run_parallel(voxdagi_chunk_run, chunk, sizeof *chunk, t);
+    voxdagi_run_parallel(b, voxdagi_chunk_run, chunk, sizeof *chunk, t);
     while (t) { /* chunk[cur..cur + t) are voxelized */
         voxdagi_chunk *next = sets == 2 ? chunk + (b->threads - cur) : chunk;
         unsigned m = 0;
-        voxdagi_team tm;
         if (sets == 2) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_team_start(&tm, voxdagi_chunk_run, next, sizeof *chunk, 0, st == VOXDAG_OK ? m : 0);
+            voxdagi_batch_start(b, voxdagi_chunk_run, next, sizeof *chunk, st == VOXDAG_OK ? m : 0);
         }
         for (k = 0; k < t && st == VOXDAG_OK; k++) st = voxdagi_builder_take(b, &chunk[cur + k]);
         if (sets == 2) {
-            voxdagi_team_join(&tm);
+            voxdagi_batch_wait(b);
         } else if (st == VOXDAG_OK) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_run_parallel(voxdagi_chunk_run, next, sizeof *chunk, m);
+            voxdagi_run_parallel(b, voxdagi_chunk_run, next, sizeof *chunk, m);
         }
         if (b->opts.progress)
             b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
