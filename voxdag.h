@@ -3983,7 +3983,138 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
 // A brick is walked as 4^3 voxels in one level, or, when level of detail can
 // stop inside it, as 2^3 cells (a byte of the mask each) and then voxels.
 
+#include <float.h>
 #include <math.h>
+
+/* Exact doubles on x87 (32-bit x86 without SSE2 maths, FLT_EVAL_METHOD 2).
+   x87 registers hold 64-bit mantissas and a wider exponent, so a t could be
+   rounded twice or kept past the double range, and a ray could pick another
+   voxel at a near-tie than on other processors. While tracing, the
+   precision control is set to 53 bits (each operation then rounds as a
+   double would, but for the exponent range), every product, quotient and
+   difference is stored as a double (overflow then gives infinity), and the
+   products and quotients that fall below DBL_MIN (where the store would
+   round a second time) are rounded once in integer arithmetic. */
+#if defined(FLT_EVAL_METHOD) && (FLT_EVAL_METHOD > 1 || FLT_EVAL_METHOD < 0)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__i386__)
+#define VOXDAGI_X87 1
+#elif defined(_MSC_VER) && defined(_M_IX86)
+#define VOXDAGI_X87 2
+#else
+#error "voxdag.h: exact ray casting needs double arithmetic without excess precision (FLT_EVAL_METHOD 0 or 1): compile with SSE2 maths (-msse2 -mfpmath=sse) or define VOXDAG_NO_RAYTRACE"
+#endif
+#elif defined(_MSC_VER) && defined(_M_IX86) && (!defined(_M_IX86_FP) || _M_IX86_FP < 2)
+#define VOXDAGI_X87 2
+#endif
+
+#ifdef VOXDAGI_X87
+static unsigned voxdagi_x87_begin(void) { /* returns the control word to restore */
+#if VOXDAGI_X87 == 1
+    unsigned short cw, pc53;
+    __asm__ __volatile__("fnstcw %0" : "=m"(cw));
+    pc53 = (unsigned short)((cw & ~0x300u) | 0x200u);
+    __asm__ __volatile__("fldcw %0" : : "m"(pc53));
+    return cw;
+#else
+    unsigned cw = _control87(0, 0);
+    _control87(_PC_53, _MCW_PC);
+    return cw;
+#endif
+}
+
+static void voxdagi_x87_end(unsigned saved) {
+#if VOXDAGI_X87 == 1
+    unsigned short cw = (unsigned short)saved;
+    __asm__ __volatile__("fldcw %0" : : "m"(cw));
+#else
+    _control87(saved, _MCW_PC);
+#endif
+}
+
+/* Bits K.. of the 128-bit HI:LO, and whether any bit below K is set. */
+static uint64_t voxdagi_shr128(uint64_t hi, uint64_t lo, int k) {
+    return k == 0 ? lo : k < 64 ? lo >> k | hi << (64 - k) : k < 128 ? hi >> (k - 64) : 0;
+}
+static int voxdagi_below128(uint64_t hi, uint64_t lo, int k) {
+    if (k <= 0) return 0;
+    if (k < 64) return (lo & ((1ull << k) - 1)) != 0;
+    return lo != 0 || (k > 64 && (hi & (k >= 128 ? ~0ull : (1ull << (k - 64)) - 1)) != 0);
+}
+
+/* The double with sign SIGN and magnitude M * 2^-1074 (M < 2^53). */
+static double voxdagi_tiny(uint64_t sign, uint64_t m) {
+    uint64_t u = sign | m;
+    double r;
+    memcpy(&r, &u, sizeof r);
+    return r;
+}
+
+/* A * B rounded once (to nearest, ties to even) for finite nonzero A and B
+   whose product is at most DBL_MIN in magnitude. */
+static double voxdagi_mul_tiny(double a, double b) {
+    uint64_t ua, ub, ma, mb, lo, m1, m2, hi, t, p0, p1, m;
+    int ea, eb, s;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ea = (int)(ua >> 52 & 0x7FF), eb = (int)(ub >> 52 & 0x7FF);
+    ma = ua & 0xFFFFFFFFFFFFFull, mb = ub & 0xFFFFFFFFFFFFFull;
+    if (ea) ma |= 1ull << 52; else ea = 1;
+    if (eb) mb |= 1ull << 52; else eb = 1;
+    /* |A B| = P 2^(ea + eb - 2150) = (P >> s) 2^-1074 */
+    lo = (ma & 0xFFFFFFFFu) * (mb & 0xFFFFFFFFu), m1 = (ma >> 32) * (mb & 0xFFFFFFFFu);
+    m2 = (ma & 0xFFFFFFFFu) * (mb >> 32), hi = (ma >> 32) * (mb >> 32);
+    t = (lo >> 32) + (m1 & 0xFFFFFFFFu) + (m2 & 0xFFFFFFFFu);
+    p0 = t << 32 | (lo & 0xFFFFFFFFu);
+    p1 = hi + (m1 >> 32) + (m2 >> 32) + (t >> 32);
+    s = 1076 - ea - eb;
+    if (s <= 0) return a * b; /* a multiple of 2^-1074: exact */
+    m = voxdagi_shr128(p1, p0, s);
+    if (s <= 128 && (voxdagi_shr128(p1, p0, s - 1) & 1) && (voxdagi_below128(p1, p0, s - 1) || (m & 1))) m++;
+    return voxdagi_tiny((ua ^ ub) & (1ull << 63), m);
+}
+
+/* 1 / D rounded once for finite D of magnitude at least 2^1022. */
+static double voxdagi_recip_tiny(double d) {
+    uint64_t u, md, q = 0, r = 0;
+    int k, K;
+    memcpy(&u, &d, sizeof u);
+    md = (u & 0xFFFFFFFFFFFFFull) | 1ull << 52;
+    K = 2149 - (int)(u >> 52 & 0x7FF); /* 1 / D = (2^K / md) 2^-1074 */
+    for (k = K; k >= 0; k--) { /* long division of 2^K */
+        r = r << 1 | (k == K);
+        q <<= 1;
+        if (r >= md) r -= md, q |= 1;
+    }
+    if (2 * r > md || (2 * r == md && (q & 1))) q++;
+    return voxdagi_tiny(u & (1ull << 63), q);
+}
+
+static double voxdagi_fsub(double a, double b) {
+    volatile double r = a - b; /* a difference below DBL_MIN is exact */
+    return r;
+}
+
+static double voxdagi_fmul(double a, double b) {
+    volatile double r = a * b;
+    double v = r;
+    if (v < DBL_MIN && v > -DBL_MIN && a != 0 && b != 0 && a - a == 0 && b - b == 0) v = voxdagi_mul_tiny(a, b);
+    return v;
+}
+
+static double voxdagi_frecip(double d) {
+    volatile double r = 1.0 / d;
+    double v = r;
+    if (v <= DBL_MIN && v >= -DBL_MIN && d - d == 0) v = voxdagi_recip_tiny(d);
+    return v;
+}
+#else
+#define voxdagi_fsub(a, b) ((a) - (b))
+#define voxdagi_fmul(a, b) ((a) * (b))
+#define voxdagi_frecip(d) (1.0 / (d))
+#endif
+
+/* The t at which a ray with origin O and inverse direction IX meets PLANE. */
+#define voxdagi_plane_t(plane, o, ix) voxdagi_fmul(voxdagi_fsub((plane), (o)), (ix))
 
 typedef struct voxdagi_frame {
     const uint8_t *rec;
@@ -4049,9 +4180,9 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             continue;
         }
         sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
-        ox[a] = o, ix[a] = 1.0 / dir;
-        lo = ((dir > 0 ? 0.0 : (double)N) - o) * ix[a];
-        hi = ((dir > 0 ? (double)N : 0.0) - o) * ix[a];
+        ox[a] = o, ix[a] = voxdagi_frecip(dir);
+        lo = voxdagi_plane_t(dir > 0 ? 0.0 : (double)N, o, ix[a]);
+        hi = voxdagi_plane_t(dir > 0 ? (double)N : 0.0, o, ix[a]);
         if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
@@ -4061,7 +4192,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     /* Level of detail may stop at a 2^3 cell of a brick before t_stop: then
        bricks are walked as two levels (l = B: 2^3 cells, l = B + 1: voxels),
        else as one level of 4^3 voxels. */
-    split = 2.0 < lod * t_stop;
+    split = 2.0 < voxdagi_fmul(lod, t_stop);
 
     for (;;) {
         /* Enter node (l, at, M), which is cell c of level q. */
@@ -4088,7 +4219,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 if (!sgn[b]) {
                     h = ray->origin[b] >= (double)mid;
                 } else {
-                    double tm = ((double)mid - ox[b]) * ix[b];
+                    double tm = voxdagi_plane_t((double)mid, ox[b], ix[b]);
                     unsigned crossed = tm < te || (tm == te && b < ae);
                     h = sgn[b] > 0 ? crossed : !crossed;
                 }
@@ -4109,9 +4240,9 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 break; /* a 2^3 cell: one byte of the brick, any bit */
             }
             sh = L - q;
-            t = ((double)((c[0] + up[0]) << sh) - ox[0]) * ix[0];
-            t1 = ((double)((c[1] + up[1]) << sh) - ox[1]) * ix[1];
-            t2 = ((double)((c[2] + up[2]) << sh) - ox[2]) * ix[2];
+            t = voxdagi_plane_t((double)((c[0] + up[0]) << sh), ox[0], ix[0]);
+            t1 = voxdagi_plane_t((double)((c[1] + up[1]) << sh), ox[1], ix[1]);
+            t2 = voxdagi_plane_t((double)((c[2] + up[2]) << sh), ox[2], ix[2]);
             a = 0;
             if (t1 < t) t = t1, a = 1;
             if (t2 < t) t = t2, a = 2;
@@ -4129,7 +4260,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             }
         }
         /* Cell c of level q is full: a hit, or go down into it. */
-        if (q == L || (double)(1u << (L - q)) < lod * te) {
+        if (q == L || (double)(1u << (L - q)) < voxdagi_fmul(lod, te)) {
             if (!hit) return 1;
             hit->t = te;
             for (b = 0; b < 3; b++) {
@@ -4152,14 +4283,31 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
 
 VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
                               voxdag_hit *hit) {
-    double lod = opts && opts->lod_pixels > 0 ? opts->lod_factor * opts->lod_pixels : 0;
+    double lod;
+    int r;
+#ifdef VOXDAGI_X87
+    unsigned cw = voxdagi_x87_begin();
+#endif
+    lod = opts && opts->lod_pixels > 0 ? voxdagi_fmul(opts->lod_factor, opts->lod_pixels) : 0;
     VOXDAG_ASSERT(dag && ray && hit);
-    return voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+    r = voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+#ifdef VOXDAGI_X87
+    voxdagi_x87_end(cw);
+#endif
+    return r;
 }
 
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
+    int r;
+#ifdef VOXDAGI_X87
+    unsigned cw = voxdagi_x87_begin();
+#endif
     VOXDAG_ASSERT(dag && ray);
-    return voxdagi_trace(dag, ray, 0, 0, NULL);
+    r = voxdagi_trace(dag, ray, 0, 0, NULL);
+#ifdef VOXDAGI_X87
+    voxdagi_x87_end(cw);
+#endif
+    return r;
 }
 
 #endif /* VOXDAG_NO_RAYTRACE */
