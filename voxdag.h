@@ -35,7 +35,7 @@
      VOXDAG_MALLOC(sz) / VOXDAG_FREE(p)  default allocator (define both or none)
      VOXDAG_ASSERT(x)     caller-contract checks (default: assert)
      VOXDAG_NO_STDIO      leave out the file helpers
-     VOXDAG_NO_THREADS    single-threaded build (no pthreads)
+     VOXDAG_NO_THREADS    single-threaded build (no threads, no thread pool)
      VOXDAG_NO_RAYTRACE   leave out ray casting
      VOXDAG_NO_BUILD      leave out the builder, the voxelizer and the encoder
                           (load-and-query programs: loading, queries, colours,
@@ -48,7 +48,10 @@
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
    THREADS: no global state. A voxdag is immutable: any number of threads may
-   query one at a time. A builder belongs to one thread at a time.
+   query one at a time. A builder belongs to one thread at a time; with
+   opts.threads > 1 it spreads its work over a pool of its own (pthreads, or
+   Win32 threads on Windows; workers started once and reused) or over the
+   host's (opts.thread_pool: run a batch of jobs, wait), with the same bytes.
 
    FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
 */
@@ -161,6 +164,22 @@ typedef enum voxdag_symmetry {
 
 typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
 
+/* A job of the builder's parallel work: run once for each INDEX of a batch. */
+typedef void (*voxdag_job_fn)(void *job_user, uint32_t index);
+
+/* The host's thread pool (optional; voxdag_build_opts.thread_pool). RUN
+   starts a batch: JOB(JOB_USER, i) must be called once for every i in
+   [0, COUNT), on any threads (the calling one too), in any order, before RUN
+   returns or before WAIT returns. WAIT returns when every job of the batch
+   has returned. The builder calls both from the thread that called it, one
+   batch at a time, never from inside a job, and may do its own work between
+   RUN and WAIT. Files are the same bytes whatever the pool does. */
+typedef struct voxdag_thread_pool {
+    void (*run)(void *user, voxdag_job_fn job, void *job_user, uint32_t count);
+    void (*wait)(void *user);
+    void *user;
+} voxdag_thread_pool;
+
 /* Build options. A NULL pointer or an all-zero struct means defaults. Every
    field is checked, in every build (NDEBUG too): out-of-range values make
    voxdag_builder_create fail with VOXDAG_ERR_INVALID_ARGUMENT (levels:
@@ -173,8 +192,12 @@ typedef struct voxdag_build_opts {
     int colors;                  /* 1: every voxel carries an RGB8 colour */
     int compare_structures;      /* 1: also count the nodes under the other two
                                     symmetry groups (3x work) */
-    uint32_t threads;            /* worker threads; 0 or 1: the calling thread only;
-                                    at most 64 are used */
+    uint32_t threads;            /* T > 1: work split in T jobs per batch, run on the
+                                    built-in pool (T - 1 workers, pthreads or Win32
+                                    threads, started once per builder) or on
+                                    thread_pool; 0 or 1: the calling thread only.
+                                    At most 64 are used. The file is the same
+                                    bytes whatever T. */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit; more
                                     is VOXDAG_ERR_LIMIT */
@@ -194,6 +217,9 @@ typedef struct voxdag_build_opts {
        rejected. */
     int (*color_sink)(void *user, const uint8_t *rgb, size_t n);
     void *color_sink_user;
+    voxdag_thread_pool thread_pool; /* run and wait NULL: the built-in pool; both
+                                    or neither. Ignored under VOXDAG_NO_THREADS,
+                                    which builds on the calling thread only */
     uint32_t zero_end;           /* must be 0 */
 } voxdag_build_opts;
 
@@ -579,7 +605,33 @@ enum {
 #include <stdio.h>
 #endif
 #ifndef VOXDAG_NO_THREADS
+#if defined(_WIN32)
+#include <windows.h> /* Win32 threads (Vista and later): SRW locks, condition variables */
+typedef SRWLOCK voxdagi_lock_t;
+typedef CONDITION_VARIABLE voxdagi_cond_t;
+typedef HANDLE voxdagi_thread_t;
+#define voxdagi_lock_init(m) InitializeSRWLock(m)
+#define voxdagi_lock_destroy(m) ((void)(m))
+#define voxdagi_lock(m) AcquireSRWLockExclusive(m)
+#define voxdagi_unlock(m) ReleaseSRWLockExclusive(m)
+#define voxdagi_cond_init(c) InitializeConditionVariable(c)
+#define voxdagi_cond_destroy(c) ((void)(c))
+#define voxdagi_cond_wait(c, m) SleepConditionVariableSRW(c, m, INFINITE, 0)
+#define voxdagi_cond_wake_all(c) WakeAllConditionVariable(c)
+#else
 #include <pthread.h>
+typedef pthread_mutex_t voxdagi_lock_t;
+typedef pthread_cond_t voxdagi_cond_t;
+typedef pthread_t voxdagi_thread_t;
+#define voxdagi_lock_init(m) pthread_mutex_init(m, NULL)
+#define voxdagi_lock_destroy(m) pthread_mutex_destroy(m)
+#define voxdagi_lock(m) pthread_mutex_lock(m)
+#define voxdagi_unlock(m) pthread_mutex_unlock(m)
+#define voxdagi_cond_init(c) pthread_cond_init(c, NULL)
+#define voxdagi_cond_destroy(c) pthread_cond_destroy(c)
+#define voxdagi_cond_wait(c, m) pthread_cond_wait(c, m)
+#define voxdagi_cond_wake_all(c) pthread_cond_broadcast(c)
+#endif
 #endif
 /* voxdag_color decodes voxcolor streams when voxcolor.h's declarations are
    here (included before this implementation, or by VOXDAG_WITH_VOXCOLOR). */
@@ -665,7 +717,7 @@ typedef struct voxdagi_mem {
     uint64_t used, peak, limit; /* limit 0: none */
     int over_limit;             /* an allocation was refused by the limit */
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_t lock; /* workers allocate concurrently */
+    voxdagi_lock_t lock; /* workers allocate concurrently */
 #endif
 } voxdagi_mem;
 
@@ -674,13 +726,13 @@ static void voxdagi_mem_init(voxdagi_mem *m, const voxdag_allocator *a, uint64_t
     if (a) m->a = *a;
     m->limit = limit;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_init(&m->lock, NULL);
+    voxdagi_lock_init(&m->lock);
 #endif
 }
 
 static void voxdagi_mem_destroy(voxdagi_mem *m) {
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_destroy(&m->lock);
+    voxdagi_lock_destroy(&m->lock);
 #else
     (void)m;
 #endif
@@ -691,7 +743,7 @@ static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
     int ok;
     if (size == 0) size = 1;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_lock(&m->lock);
+    voxdagi_lock(&m->lock);
 #endif
     ok = !m->limit || (m->used <= m->limit && size <= m->limit - m->used);
     if (!ok) m->over_limit = 1;
@@ -703,7 +755,7 @@ static void *voxdagi_alloc(voxdagi_mem *m, size_t size) {
         }
     }
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_unlock(&m->lock);
+    voxdagi_unlock(&m->lock);
 #endif
     return p;
 }
@@ -712,13 +764,13 @@ static void voxdagi_free(voxdagi_mem *m, void *p, size_t size) {
     if (!p) return;
     if (size == 0) size = 1;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_lock(&m->lock);
+    voxdagi_lock(&m->lock);
 #endif
     if (m->a.free) m->a.free(m->a.user, p, size);
     else if (!m->a.alloc) VOXDAG_FREE(p);
     m->used -= size;
 #ifndef VOXDAG_NO_THREADS
-    pthread_mutex_unlock(&m->lock);
+    voxdagi_unlock(&m->lock);
 #endif
 }
 
@@ -1469,6 +1521,129 @@ static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code
 
 #define VOXDAGI_MAX_THREADS 64
 
+/* A batch of jobs: FN on each of the COUNT SIZE-byte elements of JOBS (the
+   JOB_USER of voxdag_job_fn). */
+typedef struct voxdagi_batch {
+    void *(*fn)(void *);
+    char *jobs;
+    size_t size;
+    uint32_t count;
+    int pooled; /* running on a pool (else the wait runs it) */
+} voxdagi_batch;
+
+static void voxdagi_batch_job(void *user, uint32_t index) {
+    voxdagi_batch *bt = (voxdagi_batch *)user;
+    bt->fn(bt->jobs + (size_t)index * bt->size);
+}
+
+#ifndef VOXDAG_NO_THREADS
+/* The built-in pool: THREADS - 1 workers started on the first batch and kept
+   until the builder is freed. RUN hands a batch to the workers; WAIT takes the
+   jobs no worker has taken yet, then waits for the rest. */
+typedef struct voxdagi_pool {
+    voxdagi_lock_t lock;
+    voxdagi_cond_t wake, done;
+    voxdag_job_fn job;
+    void *job_user;
+    uint32_t count, next, finished, batch, workers;
+    int quit;
+    voxdagi_thread_t tid[VOXDAGI_MAX_THREADS - 1];
+} voxdagi_pool;
+
+/* Runs jobs of the current batch until none is left; called and returns with
+   the lock held. */
+static void voxdagi_pool_take(voxdagi_pool *p) {
+    while (p->next < p->count) {
+        uint32_t i = p->next++;
+        voxdagi_unlock(&p->lock);
+        p->job(p->job_user, i);
+        voxdagi_lock(&p->lock);
+        if (++p->finished == p->count) voxdagi_cond_wake_all(&p->done);
+    }
+}
+
+static void voxdagi_pool_worker(voxdagi_pool *p) {
+    uint32_t seen = 0;
+    voxdagi_lock(&p->lock);
+    while (!p->quit) {
+        if (p->batch == seen) {
+            voxdagi_cond_wait(&p->wake, &p->lock);
+            continue;
+        }
+        seen = p->batch;
+        voxdagi_pool_take(p);
+    }
+    voxdagi_unlock(&p->lock);
+}
+
+#if defined(_WIN32)
+static DWORD WINAPI voxdagi_pool_main(LPVOID p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return 0;
+}
+#else
+static void *voxdagi_pool_main(void *p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return NULL;
+}
+#endif
+
+/* Starts up to WORKERS threads (those the system refuses are left to WAIT). */
+static void voxdagi_pool_start(voxdagi_pool *p, uint32_t workers) {
+    memset(p, 0, sizeof *p);
+    voxdagi_lock_init(&p->lock);
+    voxdagi_cond_init(&p->wake);
+    voxdagi_cond_init(&p->done);
+    for (; p->workers < workers; p->workers++) {
+#if defined(_WIN32)
+        p->tid[p->workers] = CreateThread(NULL, 0, voxdagi_pool_main, p, 0, NULL);
+        if (!p->tid[p->workers]) break;
+#else
+        if (pthread_create(&p->tid[p->workers], NULL, voxdagi_pool_main, p) != 0) break;
+#endif
+    }
+}
+
+static void voxdagi_pool_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    p->job = job;
+    p->job_user = job_user;
+    p->count = count;
+    p->next = p->finished = 0;
+    p->batch++;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_wait(void *user) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    voxdagi_pool_take(p);
+    while (p->finished < p->count) voxdagi_cond_wait(&p->done, &p->lock);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_stop(voxdagi_pool *p) {
+    uint32_t t;
+    voxdagi_lock(&p->lock);
+    p->quit = 1;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+    for (t = 0; t < p->workers; t++) {
+#if defined(_WIN32)
+        WaitForSingleObject(p->tid[t], INFINITE);
+        CloseHandle(p->tid[t]);
+#else
+        pthread_join(p->tid[t], NULL);
+#endif
+    }
+    voxdagi_cond_destroy(&p->wake);
+    voxdagi_cond_destroy(&p->done);
+    voxdagi_lock_destroy(&p->lock);
+}
+#endif
+
 struct voxdag_builder {
     voxdagi_mem mem;
     voxdag_build_opts opts;
@@ -1490,6 +1665,11 @@ struct voxdag_builder {
     uint64_t colors_base;        /* with a colour sink: the first colour not yet sent */
     uint64_t voxels;
     voxdag_status failed;        /* sticky error */
+    voxdag_thread_pool pool;     /* the host's (run NULL: the built-in one) */
+    voxdagi_batch batch;         /* between voxdagi_batch_start and _wait */
+#ifndef VOXDAG_NO_THREADS
+    voxdagi_pool *builtin;       /* started on the first batch */
+#endif
 };
 
 VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
@@ -1517,6 +1697,9 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "chunk_levels is not 0 or 2..8");
     if (o.color_sink && !o.colors)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "color_sink without colors");
+    if ((o.thread_pool.run == NULL) != (o.thread_pool.wait == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                            "thread_pool needs both run and wait");
     if (o.bounds) {
         for (k = 0; k < 3; k++)
             if (!(o.bounds[k] < o.bounds[k + 3]) || o.bounds[k] != o.bounds[k] ||
@@ -1537,6 +1720,8 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     b->threads = o.threads < 1 ? 1 : o.threads > VOXDAGI_MAX_THREADS ? VOXDAGI_MAX_THREADS : o.threads;
 #ifdef VOXDAG_NO_THREADS
     b->threads = 1;
+#else
+    b->pool = o.thread_pool;
 #endif
     if (o.bounds) {
         b->has_bounds = 1;
@@ -1562,59 +1747,58 @@ VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
     voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *b->pend_code);
     voxdagi_free(&b->mem, b->pend_rgb, b->opts.colors ? b->pend_cap * sizeof *b->pend_rgb : 0);
     voxdagi_free(&b->mem, b->colors, b->colors_cap * 3);
+#ifndef VOXDAG_NO_THREADS
+    if (b->builtin) {
+        voxdagi_pool_stop(b->builtin);
+        voxdagi_free(&b->mem, b->builtin, sizeof *b->builtin);
+    }
+#endif
     mem = b->mem;
     voxdagi_free(&mem, b, sizeof *b);
     voxdagi_mem_destroy(&mem);
 }
 
-/* Threads running FN on jobs FIRST..COUNT-1 of an array of SIZE-byte
-   elements, one each, while the calling thread does other work. Without
-   threads (or when one cannot start) the join runs the jobs itself. */
-typedef struct voxdagi_team {
+/* Starts FN on each of the COUNT SIZE-byte elements of JOBS on the thread
+   pool, the host's or the built-in one (started on the first batch), while
+   the calling thread does other work; voxdagi_batch_wait ends the batch.
+   With one thread (or no pool) the wait runs the jobs itself. */
+static void voxdagi_batch_start(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size,
+                                unsigned count) {
+    b->batch.fn = fn;
+    b->batch.jobs = (char *)jobs;
+    b->batch.size = size;
+    b->batch.count = count;
+    b->batch.pooled = 0;
 #ifndef VOXDAG_NO_THREADS
-    pthread_t tid[VOXDAGI_MAX_THREADS];
-    int started[VOXDAGI_MAX_THREADS];
-#endif
-    void *(*fn)(void *);
-    char *jobs;
-    size_t size;
-    unsigned first, count;
-} voxdagi_team;
-
-static void voxdagi_team_start(voxdagi_team *tm, void *(*fn)(void *), void *jobs, size_t size, unsigned first,
-                               unsigned count) {
-    unsigned t;
-    tm->fn = fn;
-    tm->jobs = (char *)jobs;
-    tm->size = size;
-    tm->first = first;
-    tm->count = count;
-    for (t = first; t < count; t++) {
-#ifndef VOXDAG_NO_THREADS
-        tm->started[t] = pthread_create(&tm->tid[t], NULL, fn, tm->jobs + t * size) == 0;
-#endif
+    if (b->threads < 2 || !count) return;
+    if (!b->pool.run && !b->builtin) {
+        b->builtin = (voxdagi_pool *)voxdagi_alloc(&b->mem, sizeof *b->builtin);
+        if (!b->builtin) return; /* the calling thread does it all */
+        voxdagi_pool_start(b->builtin, b->threads - 1);
     }
+    if (b->pool.run) b->pool.run(b->pool.user, voxdagi_batch_job, &b->batch, count);
+    else voxdagi_pool_run(b->builtin, voxdagi_batch_job, &b->batch, count);
+    b->batch.pooled = 1;
+#endif
 }
 
-static void voxdagi_team_join(voxdagi_team *tm) {
-    unsigned t;
-    for (t = tm->first; t < tm->count; t++) {
+static void voxdagi_batch_wait(voxdag_builder *b) {
+    uint32_t i;
 #ifndef VOXDAG_NO_THREADS
-        if (tm->started[t]) {
-            pthread_join(tm->tid[t], NULL);
-            continue;
-        }
-#endif
-        tm->fn(tm->jobs + t * tm->size);
+    if (b->batch.pooled) {
+        if (b->pool.wait) b->pool.wait(b->pool.user);
+        else voxdagi_pool_wait(b->builtin);
+        b->batch.pooled = 0;
+        return;
     }
+#endif
+    for (i = 0; i < b->batch.count; i++) voxdagi_batch_job(&b->batch, i);
 }
 
-/* Runs FN on COUNT jobs, one thread each; the calling thread takes job 0. */
-static void voxdagi_run_parallel(void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
-    voxdagi_team tm;
-    voxdagi_team_start(&tm, fn, jobs, size, 1, count);
-    if (count) fn(jobs);
-    voxdagi_team_join(&tm);
+/* Runs FN on the COUNT jobs, in parallel when the builder has threads. */
+static void voxdagi_run_parallel(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+    voxdagi_batch_start(b, fn, jobs, size, count);
+    voxdagi_batch_wait(b);
 }
 
 /* Morton encoding and checks of voxels [begin, end) of an add call. */
@@ -1700,7 +1884,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
             job[t].begin = n / jobs * t;
             job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
         }
-        voxdagi_run_parallel(voxdagi_encode_run, job, sizeof job[0], jobs);
+        voxdagi_run_parallel(b, voxdagi_encode_run, job, sizeof job[0], jobs);
         for (t = 0; t < jobs && st == VOXDAG_OK; t++)
             if (job[t].status != VOXDAG_OK) {
                 st = job[t].status;
@@ -1901,7 +2085,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
         for (k = 0; k < b->red_count; k++)
             voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], L, split);
     }
-    voxdagi_run_parallel(voxdagi_worker_run, worker, sizeof *worker, b->threads);
+    voxdagi_run_parallel(b, voxdagi_worker_run, worker, sizeof *worker, b->threads);
 
     /* Merge in worker order, then feed voxels and subtrees in Morton order. */
     for (t = 0; t < b->threads && st == VOXDAG_OK; t++)
@@ -2526,21 +2710,20 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift)) st = VOXDAG_ERR_OUT_OF_MEMORY;
     p = 0;
     t = st == VOXDAG_OK ? voxdagi_chunk_assign(chunk, b->threads, pair_chunk, pair_tri, pairs, &p) : 0;
-    voxdagi_run_parallel(voxdagi_chunk_run, chunk, sizeof *chunk, t);
+    voxdagi_run_parallel(b, voxdagi_chunk_run, chunk, sizeof *chunk, t);
     while (t) { /* chunk[cur..cur + t) are voxelized */
         voxdagi_chunk *next = sets == 2 ? chunk + (b->threads - cur) : chunk;
         unsigned m = 0;
-        voxdagi_team tm;
         if (sets == 2) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_team_start(&tm, voxdagi_chunk_run, next, sizeof *chunk, 0, st == VOXDAG_OK ? m : 0);
+            voxdagi_batch_start(b, voxdagi_chunk_run, next, sizeof *chunk, st == VOXDAG_OK ? m : 0);
         }
         for (k = 0; k < t && st == VOXDAG_OK; k++) st = voxdagi_builder_take(b, &chunk[cur + k]);
         if (sets == 2) {
-            voxdagi_team_join(&tm);
+            voxdagi_batch_wait(b);
         } else if (st == VOXDAG_OK) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_run_parallel(voxdagi_chunk_run, next, sizeof *chunk, m);
+            voxdagi_run_parallel(b, voxdagi_chunk_run, next, sizeof *chunk, m);
         }
         if (b->opts.progress)
             b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
@@ -4295,7 +4478,138 @@ VOXDAG_API voxdag_status voxdag_grid_to_world(const voxdag *dag, const double gr
 // A brick is walked as 4^3 voxels in one level, or, when level of detail can
 // stop inside it, as 2^3 cells (a byte of the mask each) and then voxels.
 
+#include <float.h>
 #include <math.h>
+
+/* Exact doubles on x87 (32-bit x86 without SSE2 maths, FLT_EVAL_METHOD 2).
+   x87 registers hold 64-bit mantissas and a wider exponent, so a t could be
+   rounded twice or kept past the double range, and a ray could pick another
+   voxel at a near-tie than on other processors. While tracing, the
+   precision control is set to 53 bits (each operation then rounds as a
+   double would, but for the exponent range), every product, quotient and
+   difference is stored as a double (overflow then gives infinity), and the
+   products and quotients that fall below DBL_MIN (where the store would
+   round a second time) are rounded once in integer arithmetic. */
+#if defined(FLT_EVAL_METHOD) && (FLT_EVAL_METHOD > 1 || FLT_EVAL_METHOD < 0)
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__i386__)
+#define VOXDAGI_X87 1
+#elif defined(_MSC_VER) && defined(_M_IX86)
+#define VOXDAGI_X87 2
+#else
+#error "voxdag.h: exact ray casting needs double arithmetic without excess precision (FLT_EVAL_METHOD 0 or 1): compile with SSE2 maths (-msse2 -mfpmath=sse) or define VOXDAG_NO_RAYTRACE"
+#endif
+#elif defined(_MSC_VER) && defined(_M_IX86) && (!defined(_M_IX86_FP) || _M_IX86_FP < 2)
+#define VOXDAGI_X87 2
+#endif
+
+#ifdef VOXDAGI_X87
+static unsigned voxdagi_x87_begin(void) { /* returns the control word to restore */
+#if VOXDAGI_X87 == 1
+    unsigned short cw, pc53;
+    __asm__ __volatile__("fnstcw %0" : "=m"(cw));
+    pc53 = (unsigned short)((cw & ~0x300u) | 0x200u);
+    __asm__ __volatile__("fldcw %0" : : "m"(pc53));
+    return cw;
+#else
+    unsigned cw = _control87(0, 0);
+    _control87(_PC_53, _MCW_PC);
+    return cw;
+#endif
+}
+
+static void voxdagi_x87_end(unsigned saved) {
+#if VOXDAGI_X87 == 1
+    unsigned short cw = (unsigned short)saved;
+    __asm__ __volatile__("fldcw %0" : : "m"(cw));
+#else
+    _control87(saved, _MCW_PC);
+#endif
+}
+
+/* Bits K.. of the 128-bit HI:LO, and whether any bit below K is set. */
+static uint64_t voxdagi_shr128(uint64_t hi, uint64_t lo, int k) {
+    return k == 0 ? lo : k < 64 ? lo >> k | hi << (64 - k) : k < 128 ? hi >> (k - 64) : 0;
+}
+static int voxdagi_below128(uint64_t hi, uint64_t lo, int k) {
+    if (k <= 0) return 0;
+    if (k < 64) return (lo & ((1ull << k) - 1)) != 0;
+    return lo != 0 || (k > 64 && (hi & (k >= 128 ? ~0ull : (1ull << (k - 64)) - 1)) != 0);
+}
+
+/* The double with sign SIGN and magnitude M * 2^-1074 (M < 2^53). */
+static double voxdagi_tiny(uint64_t sign, uint64_t m) {
+    uint64_t u = sign | m;
+    double r;
+    memcpy(&r, &u, sizeof r);
+    return r;
+}
+
+/* A * B rounded once (to nearest, ties to even) for finite nonzero A and B
+   whose product is at most DBL_MIN in magnitude. */
+static double voxdagi_mul_tiny(double a, double b) {
+    uint64_t ua, ub, ma, mb, lo, m1, m2, hi, t, p0, p1, m;
+    int ea, eb, s;
+    memcpy(&ua, &a, sizeof ua);
+    memcpy(&ub, &b, sizeof ub);
+    ea = (int)(ua >> 52 & 0x7FF), eb = (int)(ub >> 52 & 0x7FF);
+    ma = ua & 0xFFFFFFFFFFFFFull, mb = ub & 0xFFFFFFFFFFFFFull;
+    if (ea) ma |= 1ull << 52; else ea = 1;
+    if (eb) mb |= 1ull << 52; else eb = 1;
+    /* |A B| = P 2^(ea + eb - 2150) = (P >> s) 2^-1074 */
+    lo = (ma & 0xFFFFFFFFu) * (mb & 0xFFFFFFFFu), m1 = (ma >> 32) * (mb & 0xFFFFFFFFu);
+    m2 = (ma & 0xFFFFFFFFu) * (mb >> 32), hi = (ma >> 32) * (mb >> 32);
+    t = (lo >> 32) + (m1 & 0xFFFFFFFFu) + (m2 & 0xFFFFFFFFu);
+    p0 = t << 32 | (lo & 0xFFFFFFFFu);
+    p1 = hi + (m1 >> 32) + (m2 >> 32) + (t >> 32);
+    s = 1076 - ea - eb;
+    if (s <= 0) return a * b; /* a multiple of 2^-1074: exact */
+    m = voxdagi_shr128(p1, p0, s);
+    if (s <= 128 && (voxdagi_shr128(p1, p0, s - 1) & 1) && (voxdagi_below128(p1, p0, s - 1) || (m & 1))) m++;
+    return voxdagi_tiny((ua ^ ub) & (1ull << 63), m);
+}
+
+/* 1 / D rounded once for finite D of magnitude at least 2^1022. */
+static double voxdagi_recip_tiny(double d) {
+    uint64_t u, md, q = 0, r = 0;
+    int k, K;
+    memcpy(&u, &d, sizeof u);
+    md = (u & 0xFFFFFFFFFFFFFull) | 1ull << 52;
+    K = 2149 - (int)(u >> 52 & 0x7FF); /* 1 / D = (2^K / md) 2^-1074 */
+    for (k = K; k >= 0; k--) { /* long division of 2^K */
+        r = r << 1 | (k == K);
+        q <<= 1;
+        if (r >= md) r -= md, q |= 1;
+    }
+    if (2 * r > md || (2 * r == md && (q & 1))) q++;
+    return voxdagi_tiny(u & (1ull << 63), q);
+}
+
+static double voxdagi_fsub(double a, double b) {
+    volatile double r = a - b; /* a difference below DBL_MIN is exact */
+    return r;
+}
+
+static double voxdagi_fmul(double a, double b) {
+    volatile double r = a * b;
+    double v = r;
+    if (v < DBL_MIN && v > -DBL_MIN && a != 0 && b != 0 && a - a == 0 && b - b == 0) v = voxdagi_mul_tiny(a, b);
+    return v;
+}
+
+static double voxdagi_frecip(double d) {
+    volatile double r = 1.0 / d;
+    double v = r;
+    if (v <= DBL_MIN && v >= -DBL_MIN && d - d == 0) v = voxdagi_recip_tiny(d);
+    return v;
+}
+#else
+#define voxdagi_fsub(a, b) ((a) - (b))
+#define voxdagi_fmul(a, b) ((a) * (b))
+#define voxdagi_frecip(d) (1.0 / (d))
+#endif
+
+/* The t at which a ray with origin O and inverse direction IX meets PLANE. */
+#define voxdagi_plane_t(plane, o, ix) voxdagi_fmul(voxdagi_fsub((plane), (o)), (ix))
 
 typedef struct voxdagi_frame {
     const uint8_t *rec;
@@ -4361,9 +4675,9 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             continue;
         }
         sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
-        ox[a] = o, ix[a] = 1.0 / dir;
-        lo = ((dir > 0 ? 0.0 : (double)N) - o) * ix[a];
-        hi = ((dir > 0 ? (double)N : 0.0) - o) * ix[a];
+        ox[a] = o, ix[a] = voxdagi_frecip(dir);
+        lo = voxdagi_plane_t(dir > 0 ? 0.0 : (double)N, o, ix[a]);
+        hi = voxdagi_plane_t(dir > 0 ? (double)N : 0.0, o, ix[a]);
         if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
@@ -4373,7 +4687,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     /* Level of detail may stop at a 2^3 cell of a brick before t_stop: then
        bricks are walked as two levels (l = B: 2^3 cells, l = B + 1: voxels),
        else as one level of 4^3 voxels. */
-    split = 2.0 < lod * t_stop;
+    split = 2.0 < voxdagi_fmul(lod, t_stop);
 
     for (;;) {
         /* Enter node (l, at, M), which is cell c of level q. */
@@ -4400,7 +4714,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 if (!sgn[b]) {
                     h = ray->origin[b] >= (double)mid;
                 } else {
-                    double tm = ((double)mid - ox[b]) * ix[b];
+                    double tm = voxdagi_plane_t((double)mid, ox[b], ix[b]);
                     unsigned crossed = tm < te || (tm == te && b < ae);
                     h = sgn[b] > 0 ? crossed : !crossed;
                 }
@@ -4421,9 +4735,9 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 break; /* a 2^3 cell: one byte of the brick, any bit */
             }
             sh = L - q;
-            t = ((double)((c[0] + up[0]) << sh) - ox[0]) * ix[0];
-            t1 = ((double)((c[1] + up[1]) << sh) - ox[1]) * ix[1];
-            t2 = ((double)((c[2] + up[2]) << sh) - ox[2]) * ix[2];
+            t = voxdagi_plane_t((double)((c[0] + up[0]) << sh), ox[0], ix[0]);
+            t1 = voxdagi_plane_t((double)((c[1] + up[1]) << sh), ox[1], ix[1]);
+            t2 = voxdagi_plane_t((double)((c[2] + up[2]) << sh), ox[2], ix[2]);
             a = 0;
             if (t1 < t) t = t1, a = 1;
             if (t2 < t) t = t2, a = 2;
@@ -4441,7 +4755,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             }
         }
         /* Cell c of level q is full: a hit, or go down into it. */
-        if (q == L || (double)(1u << (L - q)) < lod * te) {
+        if (q == L || (double)(1u << (L - q)) < voxdagi_fmul(lod, te)) {
             if (!hit) return 1;
             hit->t = te;
             for (b = 0; b < 3; b++) {
@@ -4468,19 +4782,41 @@ static int voxdagi_finite_nonneg(double v) { return v >= 0 && v <= 1.79769313486
 VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
                               voxdag_hit *hit) {
     double lod = 0;
+    int r;
+#ifdef VOXDAGI_X87
+    unsigned cw;
+#endif
     if (!dag || !ray || !hit) return -1;
     if (opts) {
         if (opts->zero_begin || opts->zero_end || !voxdagi_finite_nonneg(opts->lod_factor) ||
             !voxdagi_finite_nonneg(opts->lod_pixels))
             return -1;
-        if (opts->lod_pixels > 0) lod = opts->lod_factor * opts->lod_pixels;
+        if (opts->lod_pixels > 0) lod = voxdagi_fmul(opts->lod_factor, opts->lod_pixels);
     }
-    return voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+#ifdef VOXDAGI_X87
+    cw = voxdagi_x87_begin();
+#endif
+    r = voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+#ifdef VOXDAGI_X87
+    voxdagi_x87_end(cw);
+#endif
+    return r;
 }
 
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
+    int r;
+#ifdef VOXDAGI_X87
+    unsigned cw;
+#endif
     if (!dag || !ray) return -1;
-    return voxdagi_trace(dag, ray, 0, 0, NULL);
+#ifdef VOXDAGI_X87
+    cw = voxdagi_x87_begin();
+#endif
+    r = voxdagi_trace(dag, ray, 0, 0, NULL);
+#ifdef VOXDAGI_X87
+    voxdagi_x87_end(cw);
+#endif
+    return r;
 }
 
 VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *world_ray, voxdag_ray *grid_ray) {

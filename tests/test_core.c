@@ -464,6 +464,193 @@ static void test_determinism(void) {
     }
 }
 
+// -- Thread pools
+
+/* A host thread pool that runs every job on the calling thread: at once in
+   RUN, last first (IMMEDIATE), or in WAIT in a scrambled order. It counts
+   batches and jobs and flags a second RUN before the WAIT of the first. */
+typedef struct host_pool {
+    int immediate;
+    voxdag_job_fn job;
+    void *job_user;
+    uint32_t count;
+    int open;
+    size_t runs, jobs, misuse;
+    uint64_t seed;
+} host_pool;
+
+static void host_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
+    host_pool *h = (host_pool *)user;
+    uint32_t i;
+    h->misuse += h->open;
+    h->open = 1;
+    h->runs++;
+    h->jobs += count;
+    h->job = job, h->job_user = job_user, h->count = count;
+    if (h->immediate)
+        for (i = count; i-- > 0;) job(job_user, i);
+}
+
+static void host_wait(void *user) {
+    host_pool *h = (host_pool *)user;
+    uint32_t order[256], i;
+    h->misuse += !h->open;
+    h->open = 0;
+    if (h->immediate) return;
+    if (h->count > 256) {
+        h->misuse++;
+        return;
+    }
+    for (i = 0; i < h->count; i++) order[i] = i;
+    for (i = h->count; i > 1; i--) { /* Fisher-Yates */
+        uint32_t j = test_rand_below(&h->seed, i), t = order[i - 1];
+        order[i - 1] = order[j];
+        order[j] = t;
+    }
+    for (i = 0; i < h->count; i++) h->job(h->job_user, order[i]);
+}
+
+/* The threads that ran a mesh's colour callback, by kernel thread id
+   (Linux: ids are not reused soon, so threads made per round would show). */
+#if defined(__linux__) && defined(__GNUC__)
+#include <sys/syscall.h>
+long syscall(long number, ...);
+#define POOL_TIDS 64
+static long pool_tid[POOL_TIDS];
+static void pool_note_thread(void) {
+    long me = syscall(SYS_gettid);
+    unsigned i;
+    for (i = 0; i < POOL_TIDS; i++) {
+        long seen = __sync_val_compare_and_swap(&pool_tid[i], 0, me);
+        if (seen == 0 || seen == me) return;
+    }
+}
+static void pool_reset_threads(void) { memset(pool_tid, 0, sizeof pool_tid); }
+static unsigned pool_thread_count(void) {
+    unsigned i = 0;
+    while (i < POOL_TIDS && pool_tid[i]) i++;
+    return i;
+}
+#else
+static void pool_note_thread(void) {}
+static void pool_reset_threads(void) {}
+static unsigned pool_thread_count(void) { return 0; }
+#endif
+
+static void pool_mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
+    (void)user;
+    pool_note_thread();
+    rgb[0] = (uint8_t)(tri * 37);
+    rgb[1] = (uint8_t)(bary[0] * 255);
+    rgb[2] = (uint8_t)(bary[1] * 255);
+}
+
+/* Builds, with colours and the other structures compared: VOXELS from the
+   scene (shuffled, in two adds), else a mesh of random triangles in chunks
+   of 8^3. POOL may be NULL. */
+static voxdag *pool_build(const scene *s, int voxels, uint32_t threads, host_pool *pool) {
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag *d = NULL;
+    memset(&o, 0, sizeof o);
+    o.levels = s->levels;
+    o.colors = 1;
+    o.compare_structures = 1;
+    o.threads = threads;
+    o.chunk_levels = 3;
+    if (pool) {
+        o.thread_pool.run = host_run;
+        o.thread_pool.wait = host_wait;
+        o.thread_pool.user = pool;
+    }
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    if (!b) return NULL;
+    if (voxels) {
+        uint32_t *xyz;
+        uint8_t *rgb;
+        size_t n = scene_voxels(s, &xyz, &rgb), i, half = n / 3;
+        uint64_t seed = 5;
+        for (i = n; i > 1; i--) {
+            size_t j = test_rand(&seed) % i, k;
+            for (k = 0; k < 3; k++) {
+                uint32_t t = xyz[3 * (i - 1) + k];
+                uint8_t c = rgb[3 * (i - 1) + k];
+                xyz[3 * (i - 1) + k] = xyz[3 * j + k], xyz[3 * j + k] = t;
+                rgb[3 * (i - 1) + k] = rgb[3 * j + k], rgb[3 * j + k] = c;
+            }
+        }
+        CHECK(voxdag_builder_add(b, xyz, rgb, half, NULL) == VOXDAG_OK);
+        CHECK(voxdag_builder_add(b, xyz + 3 * half, rgb + 3 * half, n - half, NULL) == VOXDAG_OK);
+        free(xyz);
+        free(rgb);
+    } else {
+        double pos[3 * 60];
+        uint32_t idx[3 * 20], i;
+        uint64_t seed = 77;
+        voxdag_mesh m;
+        for (i = 0; i < 3 * 60; i++) pos[i] = (double)(test_rand(&seed) % 4096) / 4096.0 * s->n;
+        for (i = 0; i < 3 * 20; i++) idx[i] = i;
+        memset(&m, 0, sizeof m);
+        m.positions = pos, m.vertex_count = 60, m.indices = idx, m.triangle_count = 20;
+        m.color = pool_mesh_color;
+        CHECK(voxdag_builder_add_mesh(b, &m, NULL) == VOXDAG_OK);
+    }
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    return d;
+}
+
+/* The same bytes on 1 thread, on 2 and 4 threads of the built-in pool and on
+   host pools that run the jobs in reverse inside RUN or scrambled inside
+   WAIT; the host pool gets batches of several jobs, one at a time; the
+   built-in pool reuses its workers (no more threads than asked for, over
+   all the rounds of a mesh). A pool with RUN but no WAIT is refused. */
+static void test_thread_pool(void) {
+    scene s = make_scene(SC_NOISE_DENSE, 7, 31);
+    int voxels;
+    for (voxels = 0; voxels < 2; voxels++) {
+        voxdag *ref = pool_build(&s, voxels, 1, NULL);
+        size_t size0 = 0, size1;
+        const void *img0 = ref ? voxdag_image(ref, &size0) : NULL;
+        int variant;
+        for (variant = 0; variant < 4; variant++) {
+            host_pool h;
+            voxdag *d;
+            uint32_t threads = variant == 0 ? 2 : 4;
+            memset(&h, 0, sizeof h);
+            h.immediate = variant == 2;
+            h.seed = 11 + (uint64_t)variant;
+            pool_reset_threads();
+            d = pool_build(&s, voxels, threads, variant >= 2 ? &h : NULL);
+            if (d) {
+                const void *img1 = voxdag_image(d, &size1);
+                CHECK_MSG(size0 == size1 && !memcmp(img0, img1, size0), "%s, variant %d: image differs",
+                          voxels ? "voxels" : "mesh", variant);
+            }
+            if (variant >= 2)
+                CHECK_MSG(h.runs > 0 && h.jobs >= 2 * h.runs && !h.misuse && !h.open,
+                          "%s: %zu runs, %zu jobs, %zu misuses", voxels ? "voxels" : "mesh", h.runs, h.jobs,
+                          h.misuse);
+            if (!voxels && variant < 2)
+                CHECK_MSG(pool_thread_count() <= threads, "mesh on %u threads ran on %u", threads,
+                          pool_thread_count());
+            if (!voxels && variant >= 2)
+                CHECK_MSG(pool_thread_count() <= 1, "a host pool on the calling thread: %u threads",
+                          pool_thread_count());
+            voxdag_free(d);
+        }
+        voxdag_free(ref);
+    }
+    {
+        voxdag_build_opts o;
+        voxdag_builder *b = NULL;
+        voxdag_error e;
+        memset(&o, 0, sizeof o);
+        o.thread_pool.run = host_run;
+        CHECK(voxdag_builder_create(&o, &b, &e) == VOXDAG_ERR_INVALID_ARGUMENT && !b);
+    }
+    scene_free(&s);
+}
+
 /* Streaming: Morton-ordered chunks flushed one by one (subtrees of 16^3) give
    the same file as one batch; a voxel before a flushed one is refused. */
 static void test_streaming_chunks(void) {
@@ -779,6 +966,7 @@ const test_case test_core_cases[] = {
     {"core/oracle_scenes", test_oracle_scenes},
     {"core/mirrored_blob_merges", test_mirrored_blob_merges},
     {"core/determinism", test_determinism},
+    {"core/thread_pool", test_thread_pool},
     {"core/streaming_chunks", test_streaming_chunks},
     {"core/color_sink", test_color_sink},
     {"core/load_roundtrip", test_load_roundtrip},

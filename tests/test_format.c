@@ -1191,6 +1191,8 @@ static void test_save_file(void) {
                 CHECK(pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
                 CHECK_MSG(file_equals(path, small, small_size), "a failed save changed the existing file");
             }
+#else
+            (void)small; /* no file size limit to fail a write with */
 #endif
             voxdag_free(one);
         }

@@ -1,6 +1,8 @@
 /* The test runner: every suite registers its cases here. Usage:
-   test [--full] [FILTER]  runs the cases whose name contains FILTER; --full
-   makes the sweeps exhaustive (test.h). */
+   test [--full] [FILTER...]  runs the cases whose name contains a FILTER; --full
+   makes the sweeps exhaustive (test.h). Built with TEST_PORTABLE (the
+   foreign targets of tests/matrix.sh), it holds the library's suites only:
+   no importers, no images, no tool. */
 #include "test.h"
 
 int test_current_failed;
@@ -8,24 +10,30 @@ int test_full;
 
 extern const test_case test_core_cases[];
 extern const test_case test_voxcolor_cases[];
-extern const test_case test_import_cases[];
-extern const test_case test_import_scene_cases[];
 extern const test_case test_format_cases[];
 extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
+#ifndef TEST_PORTABLE
+extern const test_case test_import_cases[];
+extern const test_case test_import_scene_cases[];
 extern const test_case test_image_cases[];
 extern const test_case test_api_cases[];
+#endif
 
 static const test_case *const suites[] = {
     test_core_cases,
     test_voxcolor_cases,
+#ifndef TEST_PORTABLE
     test_import_cases,
     test_import_scene_cases,
+#endif
     test_format_cases,
     test_voxelize_cases,
     test_raytrace_cases,
+#ifndef TEST_PORTABLE
     test_image_cases,
     test_api_cases,
+#endif
 };
 
 const char *test_data_dir(void) {
@@ -34,15 +42,15 @@ const char *test_data_dir(void) {
 }
 
 int main(int argc, char **argv) {
-    const char *filter;
-    int passed = 0, failed = 0;
+    int passed = 0, failed = 0, first, i;
     size_t s;
     test_full = argc > 1 && !strcmp(argv[1], "--full");
-    filter = argc > 1 + test_full ? argv[1 + test_full] : NULL;
+    first = 1 + test_full;
     for (s = 0; s < sizeof suites / sizeof suites[0]; s++) {
         const test_case *t;
         for (t = suites[s]; t->name; t++) {
-            if (filter && !strstr(t->name, filter)) continue;
+            for (i = first; i < argc && !strstr(t->name, argv[i]); i++) continue;
+            if (first < argc && i == argc) continue;
             test_current_failed = 0;
             fprintf(stderr, "[ RUN ] %s\n", t->name);
             t->fn();
