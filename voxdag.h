@@ -2961,6 +2961,7 @@ typedef struct voxdagi_level {
     uint8_t table_inv[64];     /* code -> inverse of its transform */
     uint8_t table[64];         /* code -> transform */
     unsigned table_len;
+    uint8_t ptr_bits[256];     /* header byte (4 octants' tags) -> the bits of their pointers */
 } voxdagi_level;
 
 struct voxdag {
@@ -3042,15 +3043,23 @@ static void voxdagi_occupancy_init(voxdag *d) {
    follows the count); never on a level without them, whose P is 0. */
 VOXDAGI_INLINE unsigned voxdagi_has_private(unsigned header) { return (header & header >> 1 & 0x5555) != 0; }
 
+/* Fills LV->ptr_bits from its pointer widths: for each header byte, the sum
+   of the widths of its four tags. */
+static void voxdagi_ptr_bits_init(voxdagi_level *lv) {
+    unsigned b, i;
+    for (b = 0; b < 256; b++) {
+        unsigned n = 0;
+        for (i = 0; i < 4; i++) n += lv->width[b >> (2 * i) & 3];
+        lv->ptr_bits[b] = (uint8_t)n; /* 4 x 57 < 256 */
+    }
+}
+
 /* Bit offset of child octant S's pointer inside a record with HEADER: the
-   base field, then the widths of the lower octants' pointers (popcounts
-   over the tags). */
+   base field, then the widths of the lower octants' pointers (two lookups). */
 VOXDAGI_INLINE unsigned voxdagi_child_bit(const voxdagi_level *lv, unsigned header, unsigned s) {
     unsigned h = header & ((1u << (2 * s)) - 1);
-    unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
-    return 16 + lv->count_bits + lv->base_bits * voxdagi_has_private(header) +
-           lv->width[1] * (unsigned)voxdagi_popcount64(lo & ~hi) +
-           lv->width[2] * (unsigned)voxdagi_popcount64(hi & ~lo) + lv->width[3] * (unsigned)voxdagi_popcount64(lo & hi);
+    return 16 + lv->count_bits + (lv->base_bits & (0u - voxdagi_has_private(header))) + lv->ptr_bits[h & 0xFF] +
+           lv->ptr_bits[h >> 8];
 }
 
 static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
@@ -3065,11 +3074,17 @@ static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset)
 }
 
 /* The offset of the private child of stored octant S of record REC of
-   inner level L: the base, then one node further per lower private child. */
+   inner level L: the base, then one node further per lower private child
+   (bricks: one each). */
 static uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
     const voxdagi_level *lv = &d->level[l];
-    unsigned h = header & ((1u << (2 * s)) - 1), k = (unsigned)voxdagi_popcount64(h & h >> 1 & 0x5555);
+    unsigned h = header & ((1u << (2 * s)) - 1), k;
     uint64_t at = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits);
+    h &= h >> 1 & 0x5555; /* the lower private children, bits 0, 2, ..., 14 */
+    h = (h & 0x3333) + (h >> 2 & 0x3333);
+    h = (h + (h >> 4)) & 0x0F0F;
+    k = (h + (h >> 8)) & 0x1F;
+    if (l + 3 == d->levels) return at + k;
     while (k--) at += voxdagi_node_units(d, l + 1, at);
     return at;
 }
@@ -3314,6 +3329,7 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
         lv->code_bits[t] = (unsigned char)c;
         lv->code_mask[t] = (1ull << c) - 1;
     }
+    voxdagi_ptr_bits_init(lv);
     return NULL;
 }
 
