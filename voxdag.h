@@ -675,15 +675,32 @@ static uint64_t voxdagi_le(const uint8_t *p, unsigned n) { /* n <= 8 bytes */
     return v;
 }
 
-/* Reads N bytes at P where at least 8 bytes are readable (padded data). */
-static uint64_t voxdagi_le_fast(const uint8_t *p, unsigned n) {
+/* Little-endian hosts that read unaligned words cheaply. */
 #if (defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(__aarch64__)) && \
     (!defined(__BYTE_ORDER__) || __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+#define VOXDAGI_LE_WORDS 1
+#else
+#define VOXDAGI_LE_WORDS 0
+#endif
+
+/* Reads N bytes at P where at least 8 bytes are readable (padded data). */
+static uint64_t voxdagi_le_fast(const uint8_t *p, unsigned n) {
+#if VOXDAGI_LE_WORDS
     uint64_t v;
     memcpy(&v, p, 8);
     return n >= 8 ? v : v & ((1ull << (8 * n)) - 1);
 #else
     return voxdagi_le(p, n);
+#endif
+}
+
+static unsigned voxdagi_le16(const uint8_t *p) {
+#if VOXDAGI_LE_WORDS
+    uint16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    return (unsigned)p[0] | (unsigned)p[1] << 8;
 #endif
 }
 
@@ -3070,7 +3087,7 @@ static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
    bytes, or 1 on the brick level. */
 static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset) {
     if (l == d->levels - 2) return 1;
-    return (voxdagi_record_bits(&d->level[l], (unsigned)voxdagi_le(d->level[l].data + offset, 2)) + 7) / 8;
+    return (voxdagi_record_bits(&d->level[l], voxdagi_le16(d->level[l].data + offset)) + 7) / 8;
 }
 
 /* The offset of the private child of stored octant S of record REC of
@@ -3085,7 +3102,8 @@ static uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t
     h = (h + (h >> 4)) & 0x0F0F;
     k = (h + (h >> 8)) & 0x1F;
     if (l + 3 == d->levels) return at + k;
-    while (k--) at += voxdagi_node_units(d, l + 1, at);
+    lv++; /* the children's level: skip K records */
+    while (k--) at += (voxdagi_record_bits(lv, voxdagi_le16(lv->data + at)) + 7) >> 3;
     return at;
 }
 
@@ -3124,7 +3142,7 @@ static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset)
     if (l == d->levels - 2 || d->level[l].count_bits) return voxdagi_stored_count(d, l, offset);
     lv = &d->level[l];
     rec = lv->data + offset;
-    header = (unsigned)voxdagi_le(rec, 2);
+    header = voxdagi_le16(rec);
     for (s = 0; s < 8; s++)
         if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, s, 0) >> 6);
     return sum;
@@ -3892,7 +3910,7 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     for (l = 0; l < B; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
-        unsigned header = (unsigned)voxdagi_le(rec, 2), sh = L - 1 - l, v;
+        unsigned header = voxdagi_le16(rec), sh = L - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
         uint64_t ref;
         if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w);
@@ -3943,7 +3961,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
             const uint8_t *to_stored = dag->cube.act[f->MI];
-            unsigned header = (unsigned)voxdagi_le(rec, 2);
+            unsigned header = voxdagi_le16(rec);
             uint32_t half = 1u << (L - 1 - (uint32_t)depth);
             unsigned occ = dag->occupancy[f->MI][voxdagi_presence(header)];
             while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
@@ -4074,7 +4092,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
         unsigned halves = 1, b;
         if (l < B) {
             rec = d->level[l].data + at;
-            header = (unsigned)voxdagi_le(rec, 2);
+            header = voxdagi_le16(rec);
             occ = d->occupancy[MI][voxdagi_presence(header)];
             f[l].rec = rec;
             f[l].header = header;
