@@ -3093,7 +3093,7 @@ static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset)
 /* The offset of the private child of stored octant S of record REC of
    inner level L: the base, then one node further per lower private child
    (bricks: one each). */
-static uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
+VOXDAGI_INLINE uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
     const voxdagi_level *lv = &d->level[l];
     unsigned h = header & ((1u << (2 * s)) - 1), k;
     uint64_t at = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits);
@@ -4025,7 +4025,7 @@ static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
 }
 
 /* Morton position inside a 4^3 brick of the voxel with coordinates C. */
-static unsigned voxdagi_brick_pos(const uint32_t c[3]) {
+VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
     return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
            (c[2] & 2) << 4;
 }
