@@ -3083,11 +3083,16 @@ static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
     return voxdagi_child_bit(lv, header, 8);
 }
 
+/* Bytes of the record at byte OFFSET of inner level LV. */
+VOXDAGI_INLINE uint64_t voxdagi_record_bytes(const voxdagi_level *lv, uint64_t offset) {
+    return (voxdagi_record_bits(lv, voxdagi_le16(lv->data + offset)) + 7) >> 3;
+}
+
 /* Units from the node at OFFSET of level L to the next one: its record's
    bytes, or 1 on the brick level. */
 static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset) {
     if (l == d->levels - 2) return 1;
-    return (voxdagi_record_bits(&d->level[l], voxdagi_le16(d->level[l].data + offset)) + 7) / 8;
+    return voxdagi_record_bytes(&d->level[l], offset);
 }
 
 /* The offset of the private child of stored octant S of record REC of
@@ -3103,8 +3108,13 @@ VOXDAGI_INLINE uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const
     k = (h + (h >> 8)) & 0x1F;
     if (l + 3 == d->levels) return at + k;
     lv++; /* the children's level: skip K records */
-    while (k--) at += (voxdagi_record_bits(lv, voxdagi_le16(lv->data + at)) + 7) >> 3;
+    while (k--) at += voxdagi_record_bytes(lv, at);
     return at;
+}
+
+/* A pointer V of class T of level LV as target << 6 | TABLE[its code]. */
+VOXDAGI_INLINE uint64_t voxdagi_pointer_ref(const voxdagi_level *lv, uint64_t v, unsigned t, const uint8_t *table) {
+    return (v >> lv->code_bits[t]) << 6 | table[v & lv->code_mask[t]];
 }
 
 /* The child of stored octant S (which must be present) of record REC of
@@ -3117,7 +3127,31 @@ VOXDAGI_INLINE uint64_t voxdagi_child_ref(const voxdag *d, uint32_t l, const uin
     uint64_t v;
     if (t == 3 && lv->private_children) return voxdagi_private_child(d, l, rec, header, s) << 6;
     v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
-    return (v >> lv->code_bits[t]) << 6 | (inverse ? lv->table_inv : lv->table)[v & lv->code_mask[t]];
+    return voxdagi_pointer_ref(lv, v, t, inverse ? lv->table_inv : lv->table);
+}
+
+/* REF[s] for each stored octant s in SET (all present) of record REC of
+   inner level L: what voxdagi_child_ref with INVERSE gives, in one pass over
+   the record (private children one after another). */
+static void voxdagi_child_refs(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned set,
+                               uint64_t ref[8]) {
+    const voxdagi_level *lv = &d->level[l], *next = lv + 1;
+    unsigned bit = 16 + lv->count_bits, s, skip = 0, bricks = l + 3 == d->levels;
+    uint64_t priv = 0;
+    if (voxdagi_has_private(header)) priv = voxdagi_get_bits(rec, bit, lv->base_bits), bit += lv->base_bits;
+    for (s = 0; set >> s; s++) {
+        unsigned t = header >> (2 * s) & 3;
+        if (!t) continue;
+        if (t == 3 && lv->private_children) {
+            if (skip) priv += bricks ? 1 : voxdagi_record_bytes(next, priv);
+            skip = 1;
+            ref[s] = priv << 6;
+        } else {
+            uint64_t v = voxdagi_get_bits(rec, bit, lv->width[t]);
+            bit += lv->width[t];
+            ref[s] = voxdagi_pointer_ref(lv, v, t, lv->table_inv);
+        }
+    }
 }
 
 static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
@@ -3135,16 +3169,16 @@ static uint64_t voxdagi_stored_count(const voxdag *d, uint32_t l, uint64_t offse
    L is the brick level): stored, or, at a level without counts (C = 0), the
    sum of its children's, whose level stores them (validated on load). */
 static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset) {
-    const voxdagi_level *lv;
     const uint8_t *rec;
-    unsigned header, s;
-    uint64_t sum = 0;
+    unsigned header, set, s;
+    uint64_t sum = 0, ref[8];
     if (l == d->levels - 2 || d->level[l].count_bits) return voxdagi_stored_count(d, l, offset);
-    lv = &d->level[l];
-    rec = lv->data + offset;
+    rec = d->level[l].data + offset;
     header = voxdagi_le16(rec);
+    set = voxdagi_presence(header);
+    voxdagi_child_refs(d, l, rec, header, set, ref);
     for (s = 0; s < 8; s++)
-        if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, s, 0) >> 6);
+        if (set >> s & 1) sum += voxdagi_stored_count(d, l + 1, ref[s] >> 6);
     return sum;
 }
 
@@ -3890,15 +3924,22 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
    and a child reached through a pointer with transform t has MI' = t^-1 o MI.
    The voxel index (counts of the preceding siblings in world order) adds the
    stored children j with MI^-1(j) < w, and in a brick the voxels of the mask
-   transformed to world order below the voxel. */
+   transformed to world order below the voxel. *CHILD (when not NULL and
+   world octant w holds a child): that child, as voxdagi_child_ref with
+   INVERSE, found in the same pass. */
 static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned MI,
-                                  unsigned w) {
+                                  unsigned w, uint64_t *child) {
     const uint8_t *to_world = d->cube.act[d->cube.inv[MI]];
-    uint64_t idx = 0;
-    unsigned j;
+    unsigned present = voxdagi_presence(header), set = 0, j, v = d->cube.act[MI][w];
+    uint64_t idx = 0, ref[8];
     for (j = 0; j < 8; j++)
-        if ((header >> (2 * j) & 3) && to_world[j] < w)
-            idx += voxdagi_node_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, j, 0) >> 6);
+        if (to_world[j] < w) set |= 1u << j;
+    set &= present;
+    if (child && (present >> v & 1)) set |= 1u << v;
+    voxdagi_child_refs(d, l, rec, header, set, ref);
+    for (j = 0; j < 8; j++)
+        if ((set >> j & 1) && j != v) idx += voxdagi_node_count(d, l + 1, ref[j] >> 6);
+    if (child && (present >> v & 1)) *child = ref[v];
     return idx;
 }
 
@@ -3913,10 +3954,10 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
         unsigned header = voxdagi_le16(rec), sh = L - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
         uint64_t ref;
-        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w);
         v = dag->cube.act[MI][w];
         if (!(header >> (2 * v) & 3)) return 0;
-        ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
+        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w, &ref);
+        else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
         MI = dag->cube.comp[ref & 63][MI];
         at = ref >> 6;
     }
@@ -4039,7 +4080,7 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
     for (k = 0; k < top; k++) {
         unsigned sh = q - 1 - k;
         unsigned w = (c[0] >> sh & 1) | (c[1] >> sh & 1) << 1 | (c[2] >> sh & 1) << 2;
-        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w);
+        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w, NULL);
     }
     if (q > B) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
         uint32_t v[3];
