@@ -4105,18 +4105,22 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
 
     double t_max = ray->t_max == 0 ? HUGE_VAL : ray->t_max; /* 0: a zeroed ray has no limit */
     if (!d->voxels || !(ray->t_min <= t_max)) return 0;
-    for (a = 0; a < 3; a++) { /* the grid's entry and exit events */
+    /* The entry and exit events of the voxel box, without level of detail
+       (a hit is then a voxel, inside the box, entered through a plane of the
+       grid), else of the grid (a coarse cell may reach outside the box). */
+    for (a = 0; a < 3; a++) {
         double o = ray->origin[a], dir = ray->dir[a], lo, hi;
+        double box_lo = lod > 0 ? 0.0 : (double)d->voxel_box[a], box_hi = lod > 0 ? (double)N : (double)d->voxel_box[a + 3];
         if (o - o != 0 || dir - dir != 0) return 0; /* NaN or infinite */
         if (dir == 0) {
-            if (!(o >= 0 && o < (double)N)) return 0;
+            if (!(o >= box_lo && o < box_hi)) return 0;
             sgn[a] = 0, up[a] = 0, step[a] = 0, ox[a] = -HUGE_VAL, ix[a] = 1; /* t = +inf */
             continue;
         }
         sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
         ox[a] = o, ix[a] = 1.0 / dir;
-        lo = ((dir > 0 ? 0.0 : (double)N) - o) * ix[a];
-        hi = ((dir > 0 ? (double)N : 0.0) - o) * ix[a];
+        lo = ((dir > 0 ? box_lo : box_hi) - o) * ix[a];
+        hi = ((dir > 0 ? box_hi : box_lo) - o) * ix[a];
         if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
@@ -4154,7 +4158,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                     h = ray->origin[b] >= (double)mid;
                 } else {
                     double tm = ((double)mid - ox[b]) * ix[b];
-                    unsigned crossed = tm < te || (tm == te && b < ae);
+                    unsigned crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
                     h = sgn[b] > 0 ? crossed : !crossed;
                 }
                 c[b] = 2 * c[b] + h;
