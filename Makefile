@@ -150,16 +150,19 @@ BENCH_DEPS   := bench/scenes.h $(HEADERS) examples/import.c examples/import.h ex
 $(BUILD)/bench/bench_build: bench/bench_build.c $(BENCH_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
-# Format version 2's sizes, side by side: its voxdag.h from the last
-# version-2 commit (git history; without it the column reads 0).
+# Format version 2 side by side: its voxdag.h from the last version-2 commit
+# (git history; without it the size column reads 0 and the speed table is left out).
 VOXDAG_V2_COMMIT := 3013133
 $(BUILD)/bench/v2/voxdag.h:
 	@mkdir -p $(@D)
 	@git show $(VOXDAG_V2_COMMIT):voxdag.h > $@ 2>/dev/null || rm -f $@
-$(BUILD)/bench/bench_geometry: bench/bench_geometry.c bench/v2_size.c $(BENCH_DEPS) $(BUILD)/bench/v2/voxdag.h
+# bench/v2.c links it next to the current one (sizes, ray and lookup speeds).
+$(BUILD)/bench/v2.o: bench/v2.c bench/v2.h $(BUILD)/bench/v2/voxdag.h
 	@mkdir -p $(@D)
-	$(CC) $(BENCH_CFLAGS) $(if $(wildcard $(BUILD)/bench/v2/voxdag.h),-I$(BUILD)/bench,-DBENCH_NO_V2) -c -o $(BUILD)/bench/v2_size.o bench/v2_size.c
-	$(CC) $(BENCH_CFLAGS) -o $@ $< $(BUILD)/bench/v2_size.o examples/import.c examples/image_none.c -lm
+	$(CC) $(BENCH_CFLAGS) $(if $(wildcard $(BUILD)/bench/v2/voxdag.h),-I$(BUILD)/bench,-DBENCH_NO_V2) -c -o $@ bench/v2.c
+$(BUILD)/bench/bench_geometry: bench/bench_geometry.c $(BUILD)/bench/v2.o $(BENCH_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -o $@ $< $(BUILD)/bench/v2.o examples/import.c examples/image_none.c -lm
 
 bench-data:
 	@sh bench/deps.sh
@@ -175,14 +178,14 @@ bench-geometry: bench-data $(BUILD)/bench/bench_geometry
 # Embree on the source triangles (libembree-dev, when installed).
 NANOVDB = $(shell test -f /usr/include/nanovdb/NanoVDB.h && echo 1)
 EMBREE  = $(shell test -f /usr/include/embree3/rtcore.h && echo 1)
-$(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench/bench_rays_peer.h $(BENCH_DEPS)
+$(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench/bench_rays_peer.h $(BUILD)/bench/v2.o $(BENCH_DEPS)
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) -c -o $(BUILD)/bench/import.o examples/import.c
 	$(CC) $(BENCH_CFLAGS) -c -o $(BUILD)/bench/image_none.o examples/image_none.c
 	$(CC) $(BENCH_CFLAGS) $(if $(NANOVDB),-DBENCH_NANOVDB) $(if $(EMBREE),-DBENCH_EMBREE) -c -o $(BUILD)/bench/bench_rays.o bench/bench_rays.c
 	$(if $(NANOVDB),$(CXX) -std=c++17 -O2 -c -o $(BUILD)/bench/bench_rays_nanovdb.o bench/bench_rays_nanovdb.cpp)
 	$(if $(NANOVDB),$(CXX),$(CC)) -o $@ $(BUILD)/bench/bench_rays.o $(if $(NANOVDB),$(BUILD)/bench/bench_rays_nanovdb.o) \
-	    $(BUILD)/bench/import.o $(BUILD)/bench/image_none.o $(if $(EMBREE),-lembree3) $(THREADS) -lm
+	    $(BUILD)/bench/v2.o $(BUILD)/bench/import.o $(BUILD)/bench/image_none.o $(if $(EMBREE),-lembree3) $(THREADS) -lm
 .PHONY: bench-rays
 bench-rays: bench-data $(BUILD)/bench/bench_rays
 	$(BUILD)/bench/bench_rays bench/data $(BENCH_FLAGS)

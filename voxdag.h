@@ -859,15 +859,32 @@ static uint64_t voxdagi_le(const uint8_t *p, unsigned n) { /* n <= 8 bytes */
     return v;
 }
 
-/* Reads N bytes at P where at least 8 bytes are readable (padded data). */
-static uint64_t voxdagi_le_fast(const uint8_t *p, unsigned n) {
+/* Little-endian hosts that read unaligned words cheaply. */
 #if (defined(__x86_64__) || defined(__i386__) || defined(_M_X64) || defined(__aarch64__)) && \
     (!defined(__BYTE_ORDER__) || __BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__)
+#define VOXDAGI_LE_WORDS 1
+#else
+#define VOXDAGI_LE_WORDS 0
+#endif
+
+/* Reads N bytes at P where at least 8 bytes are readable (padded data). */
+static uint64_t voxdagi_le_fast(const uint8_t *p, unsigned n) {
+#if VOXDAGI_LE_WORDS
     uint64_t v;
     memcpy(&v, p, 8);
     return n >= 8 ? v : v & ((1ull << (8 * n)) - 1);
 #else
     return voxdagi_le(p, n);
+#endif
+}
+
+static unsigned voxdagi_le16(const uint8_t *p) {
+#if VOXDAGI_LE_WORDS
+    uint16_t v;
+    memcpy(&v, p, 2);
+    return v;
+#else
+    return (unsigned)p[0] | (unsigned)p[1] << 8;
 #endif
 }
 
@@ -3392,6 +3409,7 @@ typedef struct voxdagi_level {
     uint8_t table_inv[64];     /* code -> inverse of its transform */
     uint8_t table[64];         /* code -> transform */
     unsigned table_len;
+    uint8_t ptr_bits[256];     /* header byte (4 octants' tags) -> the bits of their pointers */
 } voxdagi_level;
 
 struct voxdag {
@@ -3476,36 +3494,61 @@ static void voxdagi_occupancy_init(voxdag *d) {
    follows the count); never on a level without them, whose P is 0. */
 VOXDAGI_INLINE unsigned voxdagi_has_private(unsigned header) { return (header & header >> 1 & 0x5555) != 0; }
 
+/* Fills LV->ptr_bits from its pointer widths: for each header byte, the sum
+   of the widths of its four tags. */
+static void voxdagi_ptr_bits_init(voxdagi_level *lv) {
+    unsigned b, i;
+    for (b = 0; b < 256; b++) {
+        unsigned n = 0;
+        for (i = 0; i < 4; i++) n += lv->width[b >> (2 * i) & 3];
+        lv->ptr_bits[b] = (uint8_t)n; /* 4 x 57 < 256 */
+    }
+}
+
 /* Bit offset of child octant S's pointer inside a record with HEADER: the
-   base field, then the widths of the lower octants' pointers (popcounts
-   over the tags). */
+   base field, then the widths of the lower octants' pointers (two lookups). */
 VOXDAGI_INLINE unsigned voxdagi_child_bit(const voxdagi_level *lv, unsigned header, unsigned s) {
     unsigned h = header & ((1u << (2 * s)) - 1);
-    unsigned lo = h & 0x5555, hi = (h >> 1) & 0x5555;
-    return 16 + lv->count_bits + lv->base_bits * voxdagi_has_private(header) +
-           lv->width[1] * (unsigned)voxdagi_popcount64(lo & ~hi) +
-           lv->width[2] * (unsigned)voxdagi_popcount64(hi & ~lo) + lv->width[3] * (unsigned)voxdagi_popcount64(lo & hi);
+    return 16 + lv->count_bits + (lv->base_bits & (0u - voxdagi_has_private(header))) + lv->ptr_bits[h & 0xFF] +
+           lv->ptr_bits[h >> 8];
 }
 
 static uint64_t voxdagi_record_bits(const voxdagi_level *lv, unsigned header) {
     return voxdagi_child_bit(lv, header, 8);
 }
 
+/* Bytes of the record at byte OFFSET of inner level LV. */
+VOXDAGI_INLINE uint64_t voxdagi_record_bytes(const voxdagi_level *lv, uint64_t offset) {
+    return (voxdagi_record_bits(lv, voxdagi_le16(lv->data + offset)) + 7) >> 3;
+}
+
 /* Units from the node at OFFSET of level L to the next one: its record's
    bytes, or 1 on the brick level. */
 static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset) {
     if (l == d->levels - 2) return 1;
-    return (voxdagi_record_bits(&d->level[l], (unsigned)voxdagi_le(d->level[l].data + offset, 2)) + 7) / 8;
+    return voxdagi_record_bytes(&d->level[l], offset);
 }
 
 /* The offset of the private child of stored octant S of record REC of
-   inner level L: the base, then one node further per lower private child. */
-static uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
+   inner level L: the base, then one node further per lower private child
+   (bricks: one each). */
+VOXDAGI_INLINE uint64_t voxdagi_private_child(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned s) {
     const voxdagi_level *lv = &d->level[l];
-    unsigned h = header & ((1u << (2 * s)) - 1), k = (unsigned)voxdagi_popcount64(h & h >> 1 & 0x5555);
+    unsigned h = header & ((1u << (2 * s)) - 1), k;
     uint64_t at = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits);
-    while (k--) at += voxdagi_node_units(d, l + 1, at);
+    h &= h >> 1 & 0x5555; /* the lower private children, bits 0, 2, ..., 14 */
+    h = (h & 0x3333) + (h >> 2 & 0x3333);
+    h = (h + (h >> 4)) & 0x0F0F;
+    k = (h + (h >> 8)) & 0x1F;
+    if (l + 3 == d->levels) return at + k;
+    lv++; /* the children's level: skip K records */
+    while (k--) at += voxdagi_record_bytes(lv, at);
     return at;
+}
+
+/* A pointer V of class T of level LV as target << 6 | TABLE[its code]. */
+VOXDAGI_INLINE uint64_t voxdagi_pointer_ref(const voxdagi_level *lv, uint64_t v, unsigned t, const uint8_t *table) {
+    return (v >> lv->code_bits[t]) << 6 | table[v & lv->code_mask[t]];
 }
 
 /* The child of stored octant S (which must be present) of record REC of
@@ -3518,7 +3561,31 @@ VOXDAGI_INLINE uint64_t voxdagi_child_ref(const voxdag *d, uint32_t l, const uin
     uint64_t v;
     if (t == 3 && lv->private_children) return voxdagi_private_child(d, l, rec, header, s) << 6;
     v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
-    return (v >> lv->code_bits[t]) << 6 | (inverse ? lv->table_inv : lv->table)[v & lv->code_mask[t]];
+    return voxdagi_pointer_ref(lv, v, t, inverse ? lv->table_inv : lv->table);
+}
+
+/* REF[s] for each stored octant s in SET (all present) of record REC of
+   inner level L: what voxdagi_child_ref with INVERSE gives, in one pass over
+   the record (private children one after another). */
+static void voxdagi_child_refs(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned set,
+                               uint64_t ref[8]) {
+    const voxdagi_level *lv = &d->level[l], *next = lv + 1;
+    unsigned bit = 16 + lv->count_bits, s, skip = 0, bricks = l + 3 == d->levels;
+    uint64_t priv = 0;
+    if (voxdagi_has_private(header)) priv = voxdagi_get_bits(rec, bit, lv->base_bits), bit += lv->base_bits;
+    for (s = 0; set >> s; s++) {
+        unsigned t = header >> (2 * s) & 3;
+        if (!t) continue;
+        if (t == 3 && lv->private_children) {
+            if (skip) priv += bricks ? 1 : voxdagi_record_bytes(next, priv);
+            skip = 1;
+            ref[s] = priv << 6;
+        } else {
+            uint64_t v = voxdagi_get_bits(rec, bit, lv->width[t]);
+            bit += lv->width[t];
+            ref[s] = voxdagi_pointer_ref(lv, v, t, lv->table_inv);
+        }
+    }
 }
 
 static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
@@ -3536,16 +3603,16 @@ static uint64_t voxdagi_stored_count(const voxdag *d, uint32_t l, uint64_t offse
    L is the brick level): stored, or, at a level without counts (C = 0), the
    sum of its children's, whose level stores them (validated on load). */
 static uint64_t voxdagi_node_count(const voxdag *d, uint32_t l, uint64_t offset) {
-    const voxdagi_level *lv;
     const uint8_t *rec;
-    unsigned header, s;
-    uint64_t sum = 0;
+    unsigned header, set, s;
+    uint64_t sum = 0, ref[8];
     if (l == d->levels - 2 || d->level[l].count_bits) return voxdagi_stored_count(d, l, offset);
-    lv = &d->level[l];
-    rec = lv->data + offset;
-    header = (unsigned)voxdagi_le(rec, 2);
+    rec = d->level[l].data + offset;
+    header = voxdagi_le16(rec);
+    set = voxdagi_presence(header);
+    voxdagi_child_refs(d, l, rec, header, set, ref);
     for (s = 0; s < 8; s++)
-        if (header >> (2 * s) & 3) sum += voxdagi_stored_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, s, 0) >> 6);
+        if (set >> s & 1) sum += voxdagi_stored_count(d, l + 1, ref[s] >> 6);
     return sum;
 }
 
@@ -3768,6 +3835,7 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
         lv->code_bits[t] = (unsigned char)c;
         lv->code_mask[t] = (1ull << c) - 1;
     }
+    voxdagi_ptr_bits_init(lv);
     return NULL;
 }
 
@@ -4329,15 +4397,22 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
    and a child reached through a pointer with transform t has MI' = t^-1 o MI.
    The voxel index (counts of the preceding siblings in world order) adds the
    stored children j with MI^-1(j) < w, and in a brick the voxels of the mask
-   transformed to world order below the voxel. */
+   transformed to world order below the voxel. *CHILD (when not NULL and
+   world octant w holds a child): that child, as voxdagi_child_ref with
+   INVERSE, found in the same pass. */
 static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned MI,
-                                  unsigned w) {
+                                  unsigned w, uint64_t *child) {
     const uint8_t *to_world = d->cube.act[d->cube.inv[MI]];
-    uint64_t idx = 0;
-    unsigned j;
+    unsigned present = voxdagi_presence(header), set = 0, j, v = d->cube.act[MI][w];
+    uint64_t idx = 0, ref[8];
     for (j = 0; j < 8; j++)
-        if ((header >> (2 * j) & 3) && to_world[j] < w)
-            idx += voxdagi_node_count(d, l + 1, voxdagi_child_ref(d, l, rec, header, j, 0) >> 6);
+        if (to_world[j] < w) set |= 1u << j;
+    set &= present;
+    if (child && (present >> v & 1)) set |= 1u << v;
+    voxdagi_child_refs(d, l, rec, header, set, ref);
+    for (j = 0; j < 8; j++)
+        if ((set >> j & 1) && j != v) idx += voxdagi_node_count(d, l + 1, ref[j] >> 6);
+    if (child && (present >> v & 1)) *child = ref[v];
     return idx;
 }
 
@@ -4350,13 +4425,13 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     for (l = 0; l < B; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
-        unsigned header = (unsigned)voxdagi_le(rec, 2), sh = L - 1 - l, v;
+        unsigned header = voxdagi_le16(rec), sh = L - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
         uint64_t ref;
-        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w);
         v = dag->cube.act[MI][w];
         if (!(header >> (2 * v) & 3)) return 0;
-        ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
+        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w, &ref);
+        else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
         MI = dag->cube.comp[ref & 63][MI];
         at = ref >> 6;
     }
@@ -4402,7 +4477,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
             const uint8_t *to_stored = dag->cube.act[f->MI];
-            unsigned header = (unsigned)voxdagi_le(rec, 2);
+            unsigned header = voxdagi_le16(rec);
             uint32_t half = 1u << (L - 1 - (uint32_t)depth);
             unsigned occ = dag->occupancy[f->MI][voxdagi_presence(header)];
             while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
@@ -4627,7 +4702,7 @@ static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
 }
 
 /* Morton position inside a 4^3 brick of the voxel with coordinates C. */
-static unsigned voxdagi_brick_pos(const uint32_t c[3]) {
+VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
     return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
            (c[2] & 2) << 4;
 }
@@ -4641,7 +4716,7 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
     for (k = 0; k < top; k++) {
         unsigned sh = q - 1 - k;
         unsigned w = (c[0] >> sh & 1) | (c[1] >> sh & 1) << 1 | (c[2] >> sh & 1) << 2;
-        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w);
+        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w, NULL);
     }
     if (q > B) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
         uint32_t v[3];
@@ -4666,18 +4741,22 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
 
     double t_max = ray->t_max == 0 ? HUGE_VAL : ray->t_max; /* 0: a zeroed ray has no limit */
     if (!d->voxels || !(ray->t_min <= t_max)) return 0;
-    for (a = 0; a < 3; a++) { /* the grid's entry and exit events */
+    /* The entry and exit events of the voxel box, without level of detail
+       (a hit is then a voxel, inside the box, entered through a plane of the
+       grid), else of the grid (a coarse cell may reach outside the box). */
+    for (a = 0; a < 3; a++) {
         double o = ray->origin[a], dir = ray->dir[a], lo, hi;
+        double box_lo = lod > 0 ? 0.0 : (double)d->voxel_box[a], box_hi = lod > 0 ? (double)N : (double)d->voxel_box[a + 3];
         if (o - o != 0 || dir - dir != 0) return 0; /* NaN or infinite */
         if (dir == 0) {
-            if (!(o >= 0 && o < (double)N)) return 0;
+            if (!(o >= box_lo && o < box_hi)) return 0;
             sgn[a] = 0, up[a] = 0, step[a] = 0, ox[a] = -HUGE_VAL, ix[a] = 1; /* t = +inf */
             continue;
         }
         sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
         ox[a] = o, ix[a] = voxdagi_frecip(dir);
-        lo = voxdagi_plane_t(dir > 0 ? 0.0 : (double)N, o, ix[a]);
-        hi = voxdagi_plane_t(dir > 0 ? (double)N : 0.0, o, ix[a]);
+        lo = voxdagi_plane_t(dir > 0 ? box_lo : box_hi, o, ix[a]);
+        hi = voxdagi_plane_t(dir > 0 ? box_hi : box_lo, o, ix[a]);
         if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
@@ -4694,7 +4773,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
         unsigned halves = 1, b;
         if (l < B) {
             rec = d->level[l].data + at;
-            header = (unsigned)voxdagi_le(rec, 2);
+            header = voxdagi_le16(rec);
             occ = d->occupancy[MI][voxdagi_presence(header)];
             f[l].rec = rec;
             f[l].header = header;
@@ -4715,7 +4794,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                     h = ray->origin[b] >= (double)mid;
                 } else {
                     double tm = voxdagi_plane_t((double)mid, ox[b], ix[b]);
-                    unsigned crossed = tm < te || (tm == te && b < ae);
+                    unsigned crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
                     h = sgn[b] > 0 ? crossed : !crossed;
                 }
                 c[b] = 2 * c[b] + h;

@@ -29,6 +29,7 @@
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "bench/scenes.h"
+#include "bench/v2.h"
 
 /* One level of a DAG as a plain graph: node i has children
    kid[first[i] .. first[i+1]) (target index in the next level << 3 | mirror). */
@@ -265,8 +266,6 @@ static void components(const voxdag *d, uint64_t bits[5]) {
         }
     }
 }
-
-uint64_t bench_v2_geometry_bytes(const uint32_t *xyz, size_t n, uint32_t levels); /* bench/v2_size.c */
 
 typedef struct row {
     const bscene *s;

@@ -11,11 +11,19 @@
    the same hit voxel or both miss (NanoVDB marches in float with a small
    forward nudge, so near edges and corners it may pick a neighbour). Besides
    wall-clock rays/s, rays per CPU-second (getrusage: user + system time of
-   the process) are reported, which other load on the machine disturbs less. */
+   the process) are reported, which other load on the machine disturbs less.
+   A second table sets format version 3 (this voxdag.h) against version 2
+   (the last version-2 voxdag.h, bench/v2.c; BENCH_NO_V2 leaves it out) on the
+   same voxels: the same primary rays, and voxdag_lookup with index on a fixed
+   random point set (half of them voxels of the scene, half uniform in its
+   bounding box), after checking that both versions give the same hit voxel
+   and voxel index for every ray and the same answer and index for every
+   point. */
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "bench/scenes.h"
 #include "bench/bench_rays_peer.h"
+#include "bench/v2.h"
 
 #include <pthread.h>
 #include <sys/resource.h>
@@ -64,9 +72,11 @@ static void make_rays(const bscene *s, uint32_t size, rays *r) {
 typedef struct run {
     const rays *r;
     const voxdag *dag;
+    const bench_v2 *v2;
     const bench_peer *peer;
     const void *embree; /* an RTCScene */
     uint32_t *hit_xyz; /* 3 per ray; UINT32_MAX = miss */
+    uint64_t *hit_index; /* voxdag and version 2: the hit voxel's index, when not NULL */
     unsigned thread, threads;
     size_t hits;
 } run;
@@ -80,12 +90,20 @@ static void *run_worker(void *arg) {
         int got;
         if (w->dag) {
             voxdag_ray ray;
+            voxdag_ray_opts opts;
             voxdag_hit hit;
             memcpy(ray.origin, w->r->eye, sizeof ray.origin);
             memcpy(ray.dir, w->r->dir + 3 * i, sizeof ray.dir);
             ray.t_min = 0, ray.t_max = HUGE_VAL;
-            got = voxdag_raycast(w->dag, &ray, NULL, &hit);
+            memset(&opts, 0, sizeof opts);
+            opts.want_index = w->hit_index != NULL;
+            got = voxdag_raycast(w->dag, &ray, w->hit_index ? &opts : NULL, &hit);
             if (got) memcpy(out, hit.xyz, sizeof hit.xyz);
+            if (w->hit_index) w->hit_index[i] = got ? hit.index : UINT64_MAX;
+        } else if (w->v2) {
+            uint64_t index;
+            got = bench_v2_raycast(w->v2, w->r->eye, w->r->dir + 3 * i, out, w->hit_index ? &index : NULL);
+            if (w->hit_index) w->hit_index[i] = got ? index : UINT64_MAX;
         } else if (w->peer) {
             got = bench_peer_trace(w->peer, w->r->eye, w->r->dir + 3 * i, out);
         } else {
@@ -124,8 +142,8 @@ typedef struct speed {
 } speed;
 
 /* Best of 3 runs; fills HIT_XYZ. */
-static speed timed(const rays *r, const voxdag *dag, const bench_peer *peer, const void *embree, unsigned threads,
-                   uint32_t *hit_xyz, size_t *hits) {
+static speed timed(const rays *r, const voxdag *dag, const bench_v2 *v2, const bench_peer *peer, const void *embree,
+                   unsigned threads, uint32_t *hit_xyz, size_t *hits) {
     speed best = {0, 0};
     int rep;
     for (rep = 0; rep < 3; rep++) {
@@ -135,7 +153,8 @@ static speed timed(const rays *r, const voxdag *dag, const bench_peer *peer, con
         double t0 = bench_now(), c0 = cpu_seconds(), secs, cpu;
         *hits = 0;
         for (t = 0; t < threads; t++) {
-            w[t].r = r, w[t].dag = dag, w[t].peer = peer, w[t].embree = embree, w[t].hit_xyz = hit_xyz;
+            w[t].r = r, w[t].dag = dag, w[t].v2 = v2, w[t].peer = peer, w[t].embree = embree;
+            w[t].hit_xyz = hit_xyz, w[t].hit_index = NULL;
             w[t].thread = t, w[t].threads = threads;
             if (threads == 1) run_worker(&w[0]);
             else pthread_create(&tid[t], NULL, run_worker, &w[t]);
@@ -207,6 +226,106 @@ static RTCScene embree_scene(RTCDevice dev, const bmesh *s) {
 }
 #endif
 
+// -- Format version 3 against version 2: the same rays and points
+
+/* NP lookup points (3 per point): half random voxels of S, half uniform in
+   the bounding box of its voxels; a fixed seed. */
+static uint32_t *make_points(const bscene *s, size_t np) {
+    uint32_t *p = (uint32_t *)bench_xmalloc(3 * np * sizeof(uint32_t)), lo[3] = {UINT32_MAX, UINT32_MAX, UINT32_MAX},
+             hi[3] = {0, 0, 0}, k;
+    uint64_t seed = 0x9E3779B97F4A7C15ull;
+    size_t i;
+    for (i = 0; i < s->n; i++)
+        for (k = 0; k < 3; k++) {
+            if (s->xyz[3 * i + k] < lo[k]) lo[k] = s->xyz[3 * i + k];
+            if (s->xyz[3 * i + k] > hi[k]) hi[k] = s->xyz[3 * i + k];
+        }
+    for (i = 0; i < np; i++) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        if (i & 1 || !s->n) {
+            for (k = 0; k < 3; k++) {
+                seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+                p[3 * i + k] = lo[k] + (uint32_t)((seed >> 33) % ((uint64_t)hi[k] - lo[k] + 1));
+            }
+        } else {
+            memcpy(p + 3 * i, s->xyz + 3 * (size_t)((seed >> 20) % s->n), 3 * sizeof(uint32_t));
+        }
+    }
+    return p;
+}
+
+/* voxdag_lookup with index (DAG, else version 2's V2) at the NP points, one
+   thread: lookups per CPU-second. INDEX[i]: the voxel index of point i,
+   UINT64_MAX when it is empty. */
+static double timed_lookups(const voxdag *dag, const bench_v2 *v2, const uint32_t *p, size_t np, uint64_t *index) {
+    double c0 = cpu_seconds(), cpu;
+    size_t i;
+    for (i = 0; i < np; i++) {
+        const uint32_t *x = p + 3 * i;
+        int got = dag ? voxdag_lookup(dag, x[0], x[1], x[2], index + i) : bench_v2_lookup(v2, x[0], x[1], x[2], index + i);
+        if (!got) index[i] = UINT64_MAX;
+    }
+    cpu = cpu_seconds() - c0;
+    return cpu > 0 ? (double)np / cpu : 0;
+}
+
+/* Rays with the voxel index (one thread, untimed) into XYZ and INDEX. */
+static void indexed_rays(const rays *r, const voxdag *dag, const bench_v2 *v2, uint32_t *xyz, uint64_t *index) {
+    run w;
+    memset(&w, 0, sizeof w);
+    w.r = r, w.dag = dag, w.v2 = v2, w.hit_xyz = xyz, w.hit_index = index, w.threads = 1;
+    run_worker(&w);
+}
+
+/* One row of the version table for scene S, appended to OUT; 0 without
+   version 2. The two versions are timed in turn (rays: 2 x best of 3 each;
+   lookups: best of 4 each), so that a change in the machine's load between
+   them moves both. */
+static int versions_row(const scene *s, const rays *r, unsigned threads, char *out, size_t cap) {
+    enum { POINTS = 1 << 19 };
+    bench_v2 *v2 = bench_v2_build(s->v.xyz, s->v.n, s->v.levels, threads);
+    uint32_t *xyz3, *xyz2, *p;
+    uint64_t *index3, *index2;
+    size_t hits, j, same = 0, same_points = 0, found = 0;
+    speed mine = {0, 0}, theirs = {0, 0}, t;
+    double look3 = 0, look2 = 0, u;
+    int rep;
+    if (!v2) return 0;
+    xyz3 = (uint32_t *)bench_xmalloc(3 * r->n * sizeof(uint32_t));
+    xyz2 = (uint32_t *)bench_xmalloc(3 * r->n * sizeof(uint32_t));
+    index3 = (uint64_t *)bench_xmalloc((r->n > POINTS ? r->n : POINTS) * sizeof(uint64_t));
+    index2 = (uint64_t *)bench_xmalloc((r->n > POINTS ? r->n : POINTS) * sizeof(uint64_t));
+    for (rep = 0; rep < 2; rep++) {
+        t = timed(r, s->dag, NULL, NULL, NULL, 1, xyz3, &hits);
+        if (t.cpu > mine.cpu) mine = t;
+        t = timed(r, NULL, v2, NULL, NULL, 1, xyz2, &hits);
+        if (t.cpu > theirs.cpu) theirs = t;
+    }
+    indexed_rays(r, s->dag, NULL, xyz3, index3);
+    indexed_rays(r, NULL, v2, xyz2, index2);
+    for (j = 0; j < r->n; j++)
+        same += !memcmp(xyz3 + 3 * j, xyz2 + 3 * j, 3 * sizeof(uint32_t)) && index3[j] == index2[j];
+    p = make_points(&s->v, POINTS);
+    for (rep = 0; rep < 4; rep++) {
+        if ((u = timed_lookups(s->dag, NULL, p, POINTS, index3)) > look3) look3 = u;
+        if ((u = timed_lookups(NULL, v2, p, POINTS, index2)) > look2) look2 = u;
+    }
+    for (j = 0; j < POINTS; j++) {
+        same_points += index3[j] == index2[j];
+        found += index3[j] != UINT64_MAX;
+    }
+    if (same != r->n || same_points != POINTS)
+        fprintf(stderr, "bench_rays: %s: versions 3 and 2 disagree on %zu of %zu rays and %zu of %d points\n",
+                s->v.name, r->n - same, r->n, POINTS - same_points, (int)POINTS);
+    snprintf(out, cap, "| %s | %u | %zu | %.2f | %.2f | **%.2f** | %d (%.0f%% full) | %.2f | %.2f | **%.2f** | %s |\n",
+             s->v.name, s->v.levels, s->v.n, mine.cpu * 1e-6, theirs.cpu * 1e-6, mine.cpu / theirs.cpu, (int)POINTS,
+             100.0 * found / POINTS, look3 * 1e-6, look2 * 1e-6, look3 / look2,
+             same == r->n && same_points == POINTS ? "yes" : "**no**");
+    free(p), free(xyz3), free(xyz2), free(index3), free(index2);
+    bench_v2_free(v2);
+    return 1;
+}
+
 static void row(const char *scene_name, uint32_t L, size_t voxels, const char *engine, double mb, size_t hits,
                 size_t n, speed one, speed all, const speed *ref, double agree) {
     printf("| %s | %u | %zu | %s | %.2f | %.1f%% | %.2f | %.2f | %.2f | %.2f |", scene_name, L, voxels, engine, mb,
@@ -224,7 +343,7 @@ int main(int argc, char **argv) {
     unsigned threads;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     size_t k;
-    char path[512];
+    char path[512], versions[4096] = "";
     static const struct {
         const char *file;
         uint32_t L;
@@ -281,8 +400,8 @@ int main(int argc, char **argv) {
         voxdag_get_info(s.dag, &info);
         make_rays(&s.v, size, &r);
         mine = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
-        mine_speed[0] = timed(&r, s.dag, NULL, NULL, 1, mine, &hits);
-        mine_speed[1] = timed(&r, s.dag, NULL, NULL, threads, mine, &hits);
+        mine_speed[0] = timed(&r, s.dag, NULL, NULL, NULL, 1, mine, &hits);
+        mine_speed[1] = timed(&r, s.dag, NULL, NULL, NULL, threads, mine, &hits);
         row(s.v.name, s.v.levels, s.v.n, "voxdag", (info.node_bytes + info.brick_bytes) / 1e6, hits, r.n,
             mine_speed[0], mine_speed[1], NULL, -1);
         fflush(stdout);
@@ -291,8 +410,8 @@ int main(int argc, char **argv) {
             size_t bytes, same = 0, j, peer_hits;
             uint32_t *theirs = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
             bench_peer *p = bench_peer_build(s.v.xyz, s.v.n, &bytes);
-            speed one = timed(&r, NULL, p, NULL, 1, theirs, &peer_hits);
-            speed all = timed(&r, NULL, p, NULL, threads, theirs, &peer_hits);
+            speed one = timed(&r, NULL, NULL, p, NULL, 1, theirs, &peer_hits);
+            speed all = timed(&r, NULL, NULL, p, NULL, threads, theirs, &peer_hits);
             for (j = 0; j < r.n; j++) same += !memcmp(mine + 3 * j, theirs + 3 * j, 3 * sizeof(uint32_t));
             row(s.v.name, s.v.levels, s.v.n, "NanoVDB", bytes / 1e6, peer_hits, r.n, one, all, mine_speed,
                 100.0 * same / r.n);
@@ -308,8 +427,8 @@ int main(int argc, char **argv) {
             speed one, all;
             embree_bytes = 0;
             es = embree_scene(dev, &s.mesh);
-            one = timed(&r, NULL, NULL, es, 1, theirs, &peer_hits);
-            all = timed(&r, NULL, NULL, es, threads, theirs, &peer_hits);
+            one = timed(&r, NULL, NULL, NULL, es, 1, theirs, &peer_hits);
+            all = timed(&r, NULL, NULL, NULL, es, threads, theirs, &peer_hits);
             row(s.v.name, s.v.levels, s.v.n, "Embree (triangles)", embree_bytes / 1e6, peer_hits, r.n, one, all,
                 mine_speed, -1);
             rtcReleaseScene(es);
@@ -317,6 +436,7 @@ int main(int argc, char **argv) {
         }
 #endif
         fflush(stdout);
+        versions_row(&s, &r, threads, versions + strlen(versions), sizeof versions - strlen(versions));
         free(mine);
         free(r.dir);
         bmesh_free(&s.mesh);
@@ -328,6 +448,17 @@ int main(int argc, char **argv) {
            "process CPU time (getrusage), less sensitive than wall-clock time to other jobs on a shared machine. "
            "Speed-up: voxdag's rays per CPU-second divided by the peer's. Mesh voxels come from "
            "`voxdag_builder_add_mesh` (exact conservative voxelization, the grid fitted to the bounding box).\n");
+    if (versions[0])
+        printf("\n### Format version 3 against version 2 (same voxels, rays and points; 1 thread)\n\n"
+               "| scene | L | voxels | v3 Mrays/CPU-s | v2 Mrays/CPU-s | v3 / v2 rays | lookup points | v3 M lookups/CPU-s "
+               "| v2 M lookups/CPU-s | v3 / v2 lookups | same hits and indices |\n"
+               "|---|---|---|---|---|---|---|---|---|---|---|\n%s\n"
+               "Version 2: the last version-2 voxdag.h (git history), built from the same voxels. Rays: the primary "
+               "rays above, the two versions timed in turn (best of 6 each). Lookups: `voxdag_lookup` with the voxel index, half of the points "
+               "voxels of the scene, half uniform in its bounding box, timed in turn, best of 4. Same: every ray hits the same voxel "
+               "with the same index (or both miss) and every point gives the same answer and index, checked in this "
+               "run.\n",
+               versions);
 #ifdef BENCH_EMBREE
     rtcReleaseDevice(dev);
 #endif
