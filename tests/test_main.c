@@ -14,6 +14,7 @@ extern const test_case test_format_cases[];
 extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
 extern const test_case test_image_cases[];
+extern const test_case test_check_colors_cases[];
 
 static const test_case *const suites[] = {
     test_core_cases,
@@ -24,6 +25,7 @@ static const test_case *const suites[] = {
     test_voxelize_cases,
     test_raytrace_cases,
     test_image_cases,
+    test_check_colors_cases,
 };
 
 const char *test_data_dir(void) {
