@@ -28,6 +28,7 @@
 #include <string.h>
 #include <time.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "check_colors.h"
@@ -617,6 +618,8 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
 /* Options of a build; its colours, if any, go to A's spill file, about
    VOXELS of them (an estimate, reported). */
 static int build_opts(build_args *a, int colors, const double *bounds, double voxels, voxdag_build_opts *o) {
+    struct statvfs fs;
+    double free_mib = -1; /* unknown */
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
     o->symmetry = a->symmetry;
@@ -630,9 +633,16 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
     if (!spill_open(a->spill))
         return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
                          strerror(errno));
-    if (!a->quiet)
+    if (statvfs(a->spill->dir, &fs) == 0) free_mib = (double)fs.f_bavail * (double)fs.f_frsize / 1048576.0;
+    if (!a->quiet && free_mib >= 0)
+        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; %.0f MiB free there; "
+                        "set TMPDIR to move it)\n", 3.0 * voxels / 1048576.0, a->spill->dir, free_mib);
+    else if (!a->quiet)
         fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
                 3.0 * voxels / 1048576.0, a->spill->dir);
+    if (free_mib >= 0 && 3.0 * voxels / 1048576.0 > free_mib)
+        fprintf(stderr, "vdag: warning: the colour spill may not fit in %s (about %.1f MiB, %.0f MiB free): set TMPDIR "
+                        "to a larger disk\n", a->spill->dir, 3.0 * voxels / 1048576.0, free_mib);
     o->color_sink = spill_colors;
     o->color_sink_user = a->spill;
     return 0;
