@@ -7,7 +7,10 @@
 # a markdown section.
 #   bench/image_quality.sh quick|full VDAG SSIM DATA_DIR PICTURE_DIR
 # Writes one mosaic per scene, PICTURE_DIR/quality_NAME.png:
-# raw | largest E | |difference| x 16.
+# raw | largest E | |difference| x 16. Also the cost of colours in a render:
+# the same view rendered from the same voxels built with --no-colors, raw
+# colours and each E, primary rays per CPU-second of the render (vdag
+# render's own count, one thread, best of 3).
 set -eu
 usage="usage: bench/image_quality.sh quick|full VDAG SSIM DATA_DIR PICTURE_DIR"
 mode=${1:?$usage} vdag=${2:?$usage} ssim=${3:?$usage} data=${4:?$usage} pics=${5:?$usage}
@@ -45,6 +48,21 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     set -- $cam
     render() { "$vdag" render "$1" "$2" --size $size --eye "$3" "$4" "$5" --target "$6" "$7" "$8" --fov "$fov" --shadows 2>/dev/null; }
     render "$work/raw.vdag" "$work/raw.png" "$@"
+    # rate FILE LABEL: a row of the render-cost table (ratio to no colours).
+    rate() {
+        best=$(for k in 1 2 3; do
+            "$vdag" render "$1" "$work/rate.png" --size $size --eye "$c1" "$c2" "$c3" --target "$c4" "$c5" "$c6" \
+                --fov "$fov" --shadows --threads 1 2>&1 | sed -n 's/.*, \([0-9.]*\) Mrays\/CPU-s.*/\1/p'
+        done | sort -g | tail -n 1)
+        [ "$2" = none ] && none=$best
+        awk -v n="$name" -v L="$levels" -v v="$voxels" -v c="$2" -v r="$best" -v z="$none" \
+            'BEGIN { printf "| %s | %s | %s | %s | %.2f | %.3f |\n", n, L, v, c, r, z / r }' >>"$work/rates.md"
+    }
+    c1=$1 c2=$2 c3=$3 c4=$4 c5=$5 c6=$6
+    # shellcheck disable=SC2086
+    "$vdag" build "$data/$in" "$work/none.vdag" $lv --no-colors 2>/dev/null
+    rate "$work/none.vdag" none
+    rate "$work/raw.vdag" "raw (24 bits)"
     "$vdag" export-voxels "$work/raw.vdag" >"$work/raw.xyz"
     oiiotool "$work/raw.png" --ch R,G,B -d uint8 -o "$work/raw.ppm"
     echo "| $name | $levels | $voxels | raw | $raw | 24.00 | 100.0 | - | - | - | - | - |"
@@ -54,6 +72,7 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
         "$vdag" build "$data/$in" "$work/e.vdag" $lv --color-error "$e" 2>/dev/null
         "$vdag" info "$work/e.vdag" --json >"$work/e.json"
         render "$work/e.vdag" "$work/e$e.png" "$@"
+        rate "$work/e.vdag" "e_t $e"
         "$vdag" export-voxels "$work/e.vdag" >"$work/e.xyz"
         vpsnr=$(paste "$work/raw.xyz" "$work/e.xyz" | awk '!/^#/ { for (i = 4; i <= 6; i++) { d = $i - $(i + 6); s += d * d } n += 3 }
             END { if (s) printf "%.1f", 10 * log(255 * 255 * n / s) / log(10); else printf "lossless" }')
@@ -81,4 +100,12 @@ echo
 echo "$scenes" | while IFS='|' read -r name rest; do
     [ -s "$pics/quality_$name.png" ] && echo "![$name, raw and e_t $last]($pics/quality_$name.png)"
 done
+echo
+echo "### Rendering with colours against without"
+echo
+echo "The same view of each scene as above (\`vdag render --size $size --shadows --threads 1\`), rendered from files of the same voxels built with \`--no-colors\` (every hit white: no colour lookup), raw colours and \`--color-error E\`: primary rays per CPU-second of the render alone (vdag render's report: CPU time of the process while it renders; loading and validating the file excluded), best of 3. Cost: rays per CPU-second without colours divided by those with them (target: at most 1.15)."
+echo
+echo "| scene | L | voxels | colours | Mrays/CPU-s | cost vs no colours |"
+echo "|---|---:|---:|---|---:|---:|"
+cat "$work/rates.md" 2>/dev/null || true
 echo

@@ -255,9 +255,11 @@ static void *render_worker(void *arg) {
     }
 }
 
-static double seconds_now(void) {
+/* Seconds on CLOCK (CLOCK_MONOTONIC: wall; CLOCK_PROCESS_CPUTIME_ID: the
+   CPU time of all the process's threads). */
+static double seconds_now(clockid_t clock) {
     struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
+    clock_gettime(clock, &ts);
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
@@ -279,7 +281,7 @@ int vdag_cmd_render(int argc, char **argv) {
     render_job job;
     vdag_file f;
     voxdag_info info;
-    double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, secs;
+    double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, cpu0, secs, cpu;
     int have_eye = 0, have_target = 0, quiet = 0, i, k;
     uint32_t box[6];
     unsigned threads, t;
@@ -362,16 +364,20 @@ int vdag_cmd_render(int argc, char **argv) {
     job.tiles = job.tiles_x * ((job.cam.h + TILE - 1) / TILE);
     pthread_mutex_init(&job.lock, NULL);
     threads = threads_d > 0 ? (unsigned)threads_d : vdag_cpu_count();
-    t0 = seconds_now();
+    t0 = seconds_now(CLOCK_MONOTONIC);
+    cpu0 = seconds_now(CLOCK_PROCESS_CPUTIME_ID);
     for (t = 0; t < threads; t++)
         if (pthread_create(&tid[t], NULL, render_worker, &job)) break;
     if (t == 0) render_worker(&job);
     while (t > 0) pthread_join(tid[--t], NULL);
-    secs = seconds_now() - t0;
+    secs = seconds_now(CLOCK_MONOTONIC) - t0;
+    cpu = seconds_now(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
     pthread_mutex_destroy(&job.lock);
     if (!quiet)
-        fprintf(stderr, "%srender: %ux%u in %.3f s, %.2f Mrays/s (%u threads)\n", job.tty ? "\r" : "", job.cam.w,
-                job.cam.h, secs, (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6, threads);
+        fprintf(stderr, "%srender: %ux%u in %.3f s (%.3f CPU-s), %.2f Mrays/s, %.2f Mrays/CPU-s (%u threads)\n",
+                job.tty ? "\r" : "", job.cam.w, job.cam.h, secs, cpu,
+                (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6,
+                (double)job.cam.w * job.cam.h / (cpu > 0 ? cpu : 1e-9) * 1e-6, threads);
     errno = 0;
     if (!write_png(argv[2], job.rgb, job.cam.w, job.cam.h)) {
         free(job.rgb);

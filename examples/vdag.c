@@ -2,7 +2,7 @@
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
-              [--color-effort smallest|fast] [--no-colors] [--no-alpha-test]
+              [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
               [--chunk-levels C] [--threads T] [--max-memory MIB] [--force] [--stats]
               [--quiet]
    vdag info FILE [--json]
@@ -29,8 +29,10 @@
 #include <string.h>
 #include <time.h>
 #include <sys/stat.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
+#include "check_colors.h"
 #include "cli.h"
 #include "import.h"
 
@@ -135,6 +137,8 @@ static const struct {
      "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
      "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
      "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
+     "  --verify-colors    after compressing, decode every colour and compare it with the\n"
+     "                     raw colour; fail when one is off by more than E (default: off)\n"
      "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
      "                     alpha test, the voxels stay the same\n"
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
@@ -225,6 +229,7 @@ typedef struct build_args {
     voxdag_symmetry symmetry;
     int no_colors, stats, compress;
     int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
+    int verify_colors;      /* --verify-colors */
     double color_error;
     uint32_t color_bits; /* 0: auto */
     voxcolor_effort color_effort;
@@ -560,6 +565,36 @@ static int encode_spill(FILE *f, uint64_t n, const build_args *a, grow_buf *g) {
     return ok;
 }
 
+/* --verify-colors: decodes the stream in G a slice at a time and compares
+   every colour with the spilled raw one, before the spill is gone. Returns
+   0, or 1 after printing why (a colour over e_t, or the check could not
+   run). */
+static int verify_spill(color_spill *spill, const grow_buf *g, const build_args *a) {
+    voxcolor_view view;
+    voxcolor_error verr;
+    vdag_color_check c;
+    double t0 = now_seconds();
+    if (voxcolor_view_init(&view, g->data, g->size, &verr) != VOXCOLOR_OK)
+        return vdag_fail("colour check: the compressed colours do not decode: %s (byte %llu)", verr.message,
+                         (unsigned long long)verr.byte_offset);
+    if (view.count != spill->n)
+        return vdag_fail("colour check: the stream holds %llu colours, the spill %llu", (unsigned long long)view.count,
+                         (unsigned long long)spill->n);
+    rewind(spill->f);
+    if (!vdag_check_colors(&view, spill->f, a->color_error, &c))
+        return vdag_fail("colour check: cannot read the raw colours back (or out of memory)");
+    if (c.over)
+        return vdag_fail("colour check FAILED: %llu of %llu colours are off by more than e_t %g (first: colour %llu; "
+                         "max error %.6f at colour %llu)",
+                         (unsigned long long)c.over, (unsigned long long)view.count, a->color_error,
+                         (unsigned long long)c.first_over, c.max_error, (unsigned long long)c.worst);
+    if (!a->quiet)
+        fprintf(stderr, "vdag: colour check: all %llu colours decoded and compared with the raw ones: max error %.6f "
+                        "<= e_t %g (%.2f s)\n",
+                (unsigned long long)view.count, c.max_error, a->color_error, now_seconds() - t0);
+    return 0;
+}
+
 /* Reads the spilled colours back and attaches them to *DAG: RGB8, or a
    voxcolor stream when COMPRESS is set (encoded as it is read, so only the
    stream is held). */
@@ -589,9 +624,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(g.data);
             return vdag_fail("colour compression failed (out of memory or the colours cannot be read back)");
         }
-        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
-        free(g.data);
-        if (!rc && !a->quiet)
+        if (!a->quiet)
             fprintf(stderr,
                     "vdag: colours %llu -> %zu bytes (%.1f%%, %.2f bits/colour, e_t %g, %s effort) in %.2f s on %u "
                     "thread%s\n",
@@ -599,6 +632,12 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
                     size ? 24.0 * (double)g.size / (double)size : 0.0, a->color_error,
                     a->color_effort == VOXCOLOR_EFFORT_FAST ? "fast" : "smallest", now_seconds() - t0, a->threads,
                     a->threads == 1 ? "" : "s");
+        if (a->verify_colors && verify_spill(spill, &g, a)) {
+            free(g.data);
+            return 1;
+        }
+        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
+        free(g.data);
     }
     if (rc) return vdag_fail("%s", err.message);
     voxdag_free(*dag);
@@ -609,6 +648,8 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
 /* Options of a build; its colours, if any, go to A's spill file, about
    VOXELS of them (an estimate, reported). */
 static int build_opts(build_args *a, int colors, const double *bounds, double voxels, voxdag_build_opts *o) {
+    struct statvfs fs;
+    double free_mib = -1; /* unknown */
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
     o->symmetry = a->symmetry;
@@ -623,9 +664,16 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
     if (!spill_open(a->spill))
         return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
                          strerror(errno));
-    if (!a->quiet)
+    if (statvfs(a->spill->dir, &fs) == 0) free_mib = (double)fs.f_bavail * (double)fs.f_frsize / 1048576.0;
+    if (!a->quiet && free_mib >= 0)
+        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; %.0f MiB free there; "
+                        "set TMPDIR to move it)\n", 3.0 * voxels / 1048576.0, a->spill->dir, free_mib);
+    else if (!a->quiet)
         fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
                 3.0 * voxels / 1048576.0, a->spill->dir);
+    if (free_mib >= 0 && 3.0 * voxels / 1048576.0 > free_mib)
+        fprintf(stderr, "vdag: warning: the colour spill may not fit in %s (about %.1f MiB, %.0f MiB free): set TMPDIR "
+                        "to a larger disk\n", a->spill->dir, 3.0 * voxels / 1048576.0, free_mib);
     o->color_sink = spill_colors;
     o->color_sink_user = a->spill;
     return 0;
@@ -776,6 +824,8 @@ static int cmd_build(int argc, char **argv) {
             else if (!strcmp(argv[k], "fast")) a.color_effort = VOXCOLOR_EFFORT_FAST;
             else return vdag_fail("build: --color-effort takes smallest or fast");
             a.compress = 1;
+        } else if (!strcmp(argv[k], "--verify-colors")) {
+            a.verify_colors = 1;
         } else if (!strcmp(argv[k], "--color-bits") && k + 1 < argc) {
             k++;
             if (!strcmp(argv[k], "auto")) a.color_bits = 0;
@@ -793,6 +843,7 @@ static int cmd_build(int argc, char **argv) {
         }
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
+    if (a.verify_colors && !a.compress) return vdag_fail("build: --verify-colors checks compressed colours: add --color-error E");
     if (!vdag_check_output(a.in, a.out)) return 1;
     if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
     memset(&limits, 0, sizeof limits);
@@ -1021,8 +1072,8 @@ static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...   (vdag COMMAND --help: its options and defaults; vdag --version)\n"
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
-          "                    [--no-colors] [--no-alpha-test] [--chunk-levels C] [--threads T]\n"
-          "                    [--max-memory MIB] [--force] [--stats] [--quiet]\n"
+          "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
+          "                    [--threads T] [--max-memory MIB] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

@@ -18,6 +18,7 @@ extern const test_case test_import_cases[];
 extern const test_case test_import_scene_cases[];
 extern const test_case test_image_cases[];
 extern const test_case test_api_cases[];
+extern const test_case test_check_colors_cases[];
 #endif
 
 static const test_case *const suites[] = {
@@ -33,6 +34,7 @@ static const test_case *const suites[] = {
 #ifndef TEST_PORTABLE
     test_image_cases,
     test_api_cases,
+    test_check_colors_cases,
 #endif
 };
 
