@@ -427,7 +427,7 @@ typedef struct voxdag_info {
     double bounds[6];           /* world-space min xyz, max xyz */
 } voxdag_info;
 
-/* Fills *INFO (nothing happens when DAG or INFO is NULL). */
+/* Fills *INFO; all zero when DAG is NULL (nothing happens when INFO is NULL). */
 VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info);
 
 /* World space. A file built with opts.bounds stores the world box of its grid
@@ -986,20 +986,20 @@ static uint64_t voxdagi_delta_mask(unsigned i, unsigned j) {
 }
 
 static void voxdagi_cube_init(voxdagi_cube *c) {
-    unsigned perm[6][3], T, A, B, i, k, s0, s1;
-    for (A = 0; A < 6; A++) voxdagi_perm(A, perm[A]);
-    for (T = 0; T < VOXDAGI_TRANSFORMS; T++)
-        for (i = 0; i < 8; i++) c->act[T][i] = (uint8_t)(voxdagi_permute_bits(i, perm[T >> 3]) ^ (T & 7));
-    for (A = 0; A < VOXDAGI_TRANSFORMS; A++)
-        for (B = 0; B < VOXDAGI_TRANSFORMS; B++) {
+    unsigned perm[6][3], tf, ta, tb, i, k, s0, s1;
+    for (ta = 0; ta < 6; ta++) voxdagi_perm(ta, perm[ta]);
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++)
+        for (i = 0; i < 8; i++) c->act[tf][i] = (uint8_t)(voxdagi_permute_bits(i, perm[tf >> 3]) ^ (tf & 7));
+    for (ta = 0; ta < VOXDAGI_TRANSFORMS; ta++)
+        for (tb = 0; tb < VOXDAGI_TRANSFORMS; tb++) {
             unsigned pc[3], p;
-            for (k = 0; k < 3; k++) pc[k] = perm[A >> 3][perm[B >> 3][k]];
+            for (k = 0; k < 3; k++) pc[k] = perm[ta >> 3][perm[tb >> 3][k]];
             for (p = 0; memcmp(perm[p], pc, sizeof pc); p++) {}
-            c->comp[A][B] = (uint8_t)(p << 3 | (voxdagi_permute_bits(B & 7, perm[A >> 3]) ^ (A & 7)));
-            if (c->comp[A][B] == 0) c->inv[A] = (uint8_t)B;
+            c->comp[ta][tb] = (uint8_t)(p << 3 | (voxdagi_permute_bits(tb & 7, perm[ta >> 3]) ^ (ta & 7)));
+            if (c->comp[ta][tb] == 0) c->inv[ta] = (uint8_t)tb;
         }
     /* Each permutation as at most two axis swaps, found by trying them. */
-    for (A = 0; A < 6; A++)
+    for (ta = 0; ta < 6; ta++)
         for (s0 = 0; s0 < 4; s0++)
             for (s1 = 0; s1 < 4; s1++) {
                 unsigned ok = 1;
@@ -1012,10 +1012,10 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
                             unsigned xa = x >> a & 1, xb = x >> b & 1;
                             x = (x & ~(1u << a | 1u << b)) | xa << b | xb << a;
                         }
-                    ok &= x == voxdagi_permute_bits(i, perm[A]);
+                    ok &= x == voxdagi_permute_bits(i, perm[ta]);
                 }
                 if (ok) {
-                    c->swap[A][0] = (uint8_t)s0, c->swap[A][1] = (uint8_t)s1;
+                    c->swap[ta][0] = (uint8_t)s0, c->swap[ta][1] = (uint8_t)s1;
                     s0 = s1 = 4; /* the first found */
                 }
             }
@@ -1043,10 +1043,10 @@ static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
 
 /* Transforming a 4^3 brick by T moves the voxel at Morton position p to T(p):
    the axis swaps of T's permutation (two delta swaps each), then its mirror. */
-static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsigned T) {
+static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsigned tf) {
     unsigned n, h;
     for (n = 0; n < 2; n++) {
-        unsigned k = c->swap[T >> 3][n];
+        unsigned k = c->swap[tf >> 3][n];
         if (k > 2) continue;
         for (h = 0; h < 2; h++) {
             unsigned d = (1u << (voxdagi_axis_pair[k][1] + 3 * h)) - (1u << (voxdagi_axis_pair[k][0] + 3 * h));
@@ -1054,7 +1054,7 @@ static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsig
             x ^= t ^ (t << d);
         }
     }
-    return voxdagi_reflect_brick(x, T & 7);
+    return voxdagi_reflect_brick(x, tf & 7);
 }
 #endif
 
@@ -1194,27 +1194,27 @@ typedef struct voxdagi_group {
 } voxdagi_group;
 
 static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
-    unsigned T, x, i;
+    unsigned tf, x, i;
     voxdagi_cube_init(&g->cube);
-    for (T = 0; T < VOXDAGI_TRANSFORMS; T++) {
-        for (i = 0; i < 8; i++) g->src[T][i] = g->cube.act[g->cube.inv[T]][i];
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
+        for (i = 0; i < 8; i++) g->src[tf][i] = g->cube.act[g->cube.inv[tf]][i];
         for (x = 0; x < 256; x++) {
             unsigned y = 0;
-            for (i = 0; i < 8; i++) y |= (x >> i & 1) << g->cube.act[T][i];
-            g->mask8[T][x] = (uint8_t)y;
+            for (i = 0; i < 8; i++) y |= (x >> i & 1) << g->cube.act[tf][i];
+            g->mask8[tf][x] = (uint8_t)y;
         }
     }
     g->count = symmetry == VOXDAG_SYMMETRY_NONE ? 1 : symmetry == VOXDAG_SYMMETRY_REFLECT ? 8 : 48;
 }
 
 /* The smallest tag of the coset T o S. */
-static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t S) {
+static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t stabs) {
     unsigned best = t;
-    S &= ~1ull; /* the identity gives t itself */
-    while (S) {
-        unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1), u = c->comp[t][s];
+    stabs &= ~1ull; /* the identity gives t itself */
+    while (stabs) {
+        unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1), u = c->comp[t][s];
         if (u < best) best = u;
-        S &= S - 1;
+        stabs &= stabs - 1;
     }
     return best;
 }
@@ -1232,23 +1232,23 @@ typedef struct voxdagi_canon {
 static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
     voxdagi_canon c;
     uint64_t r[VOXDAGI_TRANSFORMS], tie = 0;
-    unsigned T, best = 64, occ = 0, k, low = 256;
+    unsigned tf, best = 64, occ = 0, k, low = 256;
     for (k = 0; k < 8; k++) occ |= (unsigned)((mask >> 8 * k & 0xFF) != 0) << k;
-    for (T = 0; T < g->count; T++) {
-        unsigned o = g->mask8[T][occ];
+    for (tf = 0; tf < g->count; tf++) {
+        unsigned o = g->mask8[tf][occ];
         if (o < low) low = o, tie = 0;
-        if (o == low) tie |= 1ull << T;
+        if (o == low) tie |= 1ull << tf;
     }
-    for (T = 0; T < g->count; T++) {
-        if (!(tie >> T & 1)) continue;
-        r[T] = T ? voxdagi_transform_brick(&g->cube, mask, T) : mask;
-        if (best == 64 || r[T] < r[best]) best = T;
+    for (tf = 0; tf < g->count; tf++) {
+        if (!(tie >> tf & 1)) continue;
+        r[tf] = tf ? voxdagi_transform_brick(&g->cube, mask, tf) : mask;
+        if (best == 64 || r[tf] < r[best]) best = tf;
     }
     c.key = r[best];
     c.tag = g->cube.inv[best];
     c.stab = 0;
-    for (T = 0; T < g->count; T++)
-        if ((tie >> T & 1) && r[T] == r[best]) c.stab |= 1ull << g->cube.comp[T][c.tag];
+    for (tf = 0; tf < g->count; tf++)
+        if ((tie >> tf & 1) && r[tf] == r[best]) c.stab |= 1ull << g->cube.comp[tf][c.tag];
     return c;
 }
 
@@ -1286,20 +1286,20 @@ static int voxdagi_compare_transforms(const voxdagi_group *g, const voxdagi_chil
 static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_children *c,
                                         uint32_t slots[8]) {
     voxdagi_canon r;
-    unsigned T, i, best = 0, best_present = 0x100;
+    unsigned tf, i, best = 0, best_present = 0x100;
     uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (T = 0; T < g->count; T++) {
-        unsigned p = g->mask8[T][c->present];
-        if (p < best_present || (p == best_present && voxdagi_compare_transforms(g, c, p, T, best) < 0)) {
+    for (tf = 0; tf < g->count; tf++) {
+        unsigned p = g->mask8[tf][c->present];
+        if (p < best_present || (p == best_present && voxdagi_compare_transforms(g, c, p, tf, best) < 0)) {
             best_present = p;
-            best = T;
+            best = tf;
         }
     }
     r.tag = g->cube.inv[best];
     r.stab = 0;
-    for (T = 0; T < g->count; T++)
-        if (g->mask8[T][c->present] == best_present && voxdagi_compare_transforms(g, c, best_present, T, best) == 0)
-            r.stab |= 1ull << g->cube.comp[T][r.tag];
+    for (tf = 0; tf < g->count; tf++)
+        if (g->mask8[tf][c->present] == best_present && voxdagi_compare_transforms(g, c, best_present, tf, best) == 0)
+            r.stab |= 1ull << g->cube.comp[tf][r.tag];
     for (i = 0; i < 8; i++) {
         unsigned j = g->src[best][i], t;
         uint64_t v = 0;
@@ -1996,8 +1996,8 @@ static void *voxdagi_worker_run(void *arg) {
 }
 
 /* The reference "T applied to reference REF": the same node, tag T o t. */
-static uint32_t voxdagi_ref_compose(const voxdagi_group *g, unsigned T, uint32_t ref) {
-    return (ref & ~63u) | g->cube.comp[T][ref & 63];
+static uint32_t voxdagi_ref_compose(const voxdagi_group *g, unsigned tf, uint32_t ref) {
+    return (ref & ~63u) | g->cube.comp[tf][ref & 63];
 }
 
 /* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
@@ -2048,7 +2048,7 @@ static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map,
    the split does not pay (the caller then reduces serially). */
 static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *code, size_t n,
                                              int final, int *done) {
-    uint32_t split = 1, L = b->levels;
+    uint32_t split = 1, nlevels = b->levels;
     size_t npieces = 0, cap = 0, i, start, per;
     voxdagi_piece *piece = NULL;
     voxdagi_worker *worker;
@@ -2057,8 +2057,8 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
     uint64_t shift, first_open = UINT64_MAX, last_open = UINT64_MAX;
     *done = 0;
     while ((1ull << (3 * split)) < 16ull * b->threads) split++;
-    if (b->threads < 2 || split + 3 > L || n < 4096) return VOXDAG_OK;
-    shift = 3ull * (L - split);
+    if (b->threads < 2 || split + 3 > nlevels || n < 4096) return VOXDAG_OK;
+    shift = 3ull * (nlevels - split);
     /* A subtree may continue from an earlier flush, or into a later one: those
        two are reduced by the builder itself, not as pieces. */
     if (b->any_reduced) first_open = b->last_code >> shift;
@@ -2100,7 +2100,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
         worker[t].piece_count = i - first;
         worker[t].code = code;
         for (k = 0; k < b->red_count; k++)
-            voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], L, split);
+            voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], nlevels, split);
     }
     voxdagi_run_parallel(b, voxdagi_worker_run, worker, sizeof *worker, b->threads);
 
@@ -2923,15 +2923,15 @@ static int voxdagi_storage_order(voxdagi_mem *m, const voxdagi_store *s, const u
    code bits; N = 2 when tag 3 marks private children (then O[3] = K[3] = 0
    and P is the width of the base field). */
 typedef struct voxdagi_classes {
-    unsigned char O[4], K[4], N, P;
+    unsigned char target_bits[4], code_bits[4], classes, base_bits;
 } voxdagi_classes;
 
 /* The cheapest class (1..N) that holds a target of OB bits and a code of KB
    bits, or 0 when none does. */
 static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigned kb) {
     unsigned t, best = 0;
-    for (t = 1; t <= c->N; t++)
-        if (c->O[t] >= ob && c->K[t] >= kb && (!best || c->O[t] + c->K[t] < c->O[best] + c->K[best])) best = t;
+    for (t = 1; t <= c->classes; t++)
+        if (c->target_bits[t] >= ob && c->code_bits[t] >= kb && (!best || c->target_bits[t] + c->code_bits[t] < c->target_bits[best] + c->code_bits[best])) best = t;
     return best;
 }
 
@@ -2955,7 +2955,7 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_cla
         for (kb = 0; kb <= kmax; kb++) cand[nc][0] = ob, cand[nc][1] = kb, nc++;
     }
     memset(best, 0, sizeof *best); /* no pointers: zero widths */
-    best->N = (unsigned char)n;
+    best->classes = (unsigned char)n;
     for (a = 0; a < nc; a++)
         for (b = a; b < nc; b++) {
             unsigned char pair[58 * 7]; /* per cell: the narrower of classes a and b that holds it, 255 none */
@@ -2974,13 +2974,13 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_cla
                 }
                 if (i == ncell && cost < best_cost) {
                     best_cost = cost;
-                    best->O[1] = (unsigned char)cand[a][0], best->K[1] = (unsigned char)cand[a][1];
-                    best->O[2] = (unsigned char)cand[b][0], best->K[2] = (unsigned char)cand[b][1];
-                    best->O[3] = (unsigned char)cand[c][0], best->K[3] = (unsigned char)cand[c][1];
+                    best->target_bits[1] = (unsigned char)cand[a][0], best->code_bits[1] = (unsigned char)cand[a][1];
+                    best->target_bits[2] = (unsigned char)cand[b][0], best->code_bits[2] = (unsigned char)cand[b][1];
+                    best->target_bits[3] = (unsigned char)cand[c][0], best->code_bits[3] = (unsigned char)cand[c][1];
                 }
             }
         }
-    if (n == 2) best->O[3] = best->K[3] = 0;
+    if (n == 2) best->target_bits[3] = best->code_bits[3] = 0;
 }
 
 typedef struct voxdagi_encoder {
@@ -3021,11 +3021,11 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
     const voxdagi_cube *c = e->cube;
     unsigned u = c->comp[rp][x & 63], rc_inv = c->inv[e->orient[l + 1][x >> 6]];
     unsigned best = c->comp[u][rc_inv];
-    uint64_t S = e->r->store[l + 1].stab[x >> 6] & ~1ull;
-    while (S) {
-        unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1), v = c->comp[c->comp[u][s]][rc_inv];
+    uint64_t stabs = e->r->store[l + 1].stab[x >> 6] & ~1ull;
+    while (stabs) {
+        unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1), v = c->comp[c->comp[u][s]][rc_inv];
         if (v < best) best = v;
-        S &= S - 1;
+        stabs &= stabs - 1;
     }
     return best;
 }
@@ -3037,8 +3037,8 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
 static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     const voxdagi_cube *c = e->cube;
-    uint32_t B = e->levels - 2, l;
-    for (l = 0; l <= B; l++) {
+    uint32_t brick_level = e->levels - 2, l;
+    for (l = 0; l <= brick_level; l++) {
         const voxdagi_store *s = &r->store[l], *ps = l ? &r->store[l - 1] : NULL;
         size_t n = s->n, i, p, total = l ? 0 : 1;
         uint64_t *first = (uint64_t *)voxdagi_alloc(e->mem, (n + 1) * sizeof *first);
@@ -3067,18 +3067,18 @@ static int voxdagi_orient(voxdagi_encoder *e) {
         for (i = n; i > 0; i--) first[i] = first[i - 1]; /* back to the starts */
         first[0] = 0;
         for (i = 0; i < n; i++) {
-            unsigned votes[VOXDAGI_TRANSFORMS], T, best = 0;
+            unsigned votes[VOXDAGI_TRANSFORMS], tf, best = 0;
             uint64_t k;
             memset(votes, 0, sizeof votes);
             for (k = first[i]; k < first[i + 1]; k++) {
-                uint64_t S = s->stab[i];
-                while (S) {
-                    votes[c->comp[seen[k]][voxdagi_popcount64((S & (0 - S)) - 1)]]++;
-                    S &= S - 1;
+                uint64_t stabs = s->stab[i];
+                while (stabs) {
+                    votes[c->comp[seen[k]][voxdagi_popcount64((stabs & (0 - stabs)) - 1)]]++;
+                    stabs &= stabs - 1;
                 }
             }
-            for (T = 1; T < VOXDAGI_TRANSFORMS; T++)
-                if (votes[T] > votes[best]) best = T;
+            for (tf = 1; tf < VOXDAGI_TRANSFORMS; tf++)
+                if (votes[tf] > votes[best]) best = tf;
             e->orient[l][i] = (uint8_t)best;
         }
         voxdagi_free(e->mem, seen, total);
@@ -3097,31 +3097,31 @@ static int voxdagi_orient(voxdagi_encoder *e) {
    headers, counts, 16-bit pointers, bricks): small DAGs, which are mostly
    counts and stay in the cache. */
 static void voxdagi_count_widths(voxdagi_encoder *e) {
-    uint32_t B = e->levels - 2, l, drop = B;
-    uint64_t most = 0, estimate = 64 * (uint64_t)e->r->store[B].n;
-    for (l = 0; l < B; l++) {
+    uint32_t brick_level = e->levels - 2, l, drop = brick_level;
+    uint64_t most = 0, estimate = 64 * (uint64_t)e->r->store[brick_level].n;
+    for (l = 0; l < brick_level; l++) {
         const voxdagi_store *s = &e->r->store[l];
         uint64_t max_count = 0, bits;
         size_t i;
         for (i = 0; i < s->n; i++)
             if (s->count[i] > max_count) max_count = s->count[i];
         for (i = 0; i < 8 * s->n; i++) estimate += s->child[i] != VOXDAGI_NONE ? 16u : 0u;
-        e->count_bits[l] = l + 1 < B ? voxdagi_bit_length(max_count) : 0;
+        e->count_bits[l] = l + 1 < brick_level ? voxdagi_bit_length(max_count) : 0;
         bits = (uint64_t)s->n * e->count_bits[l];
         estimate += 16 * (uint64_t)s->n + bits;
-        if (l + 2 < B && bits >= most) {
+        if (l + 2 < brick_level && bits >= most) {
             most = bits;
             drop = l;
         }
     }
-    if (drop < B && most >= estimate / 32) e->count_bits[drop] = 0;
+    if (drop < brick_level && most >= estimate / 32) e->count_bits[drop] = 0;
 }
 
 /* Whether child reference X of a node of inner level L is a private child:
    the level uses them and the child is referenced once, through the
    identity. */
 static int voxdagi_is_private(const voxdagi_encoder *e, uint32_t l, uint32_t x) {
-    return e->cls[l].N == 2 && e->single[l + 1][x >> 6];
+    return e->cls[l].classes == 2 && e->single[l + 1][x >> 6];
 }
 
 /* The children of node ID of inner level L in stored octant order (stored
@@ -3153,7 +3153,7 @@ static unsigned voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, uint32_t x
     unsigned code = e->code[l][tag], t;
     if (voxdagi_is_private(e, l, x)) return 3;
     t = voxdagi_class_for(c, voxdagi_bit_length(target), voxdagi_bit_length(code));
-    *value = target << c->K[t] | code;
+    *value = target << c->code_bits[t] | code;
     return t;
 }
 
@@ -3168,17 +3168,17 @@ static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id
     if (p) voxdagi_put_bits(p, 16, e->r->store[l].count[id], e->count_bits[l]);
     base = voxdagi_private_base(e, l, child);
     if (base != UINT64_MAX) {
-        if (p) voxdagi_put_bits(p, bits, base, cls->P);
-        bits += cls->P;
+        if (p) voxdagi_put_bits(p, bits, base, cls->base_bits);
+        bits += cls->base_bits;
     }
     for (j = 0; j < 8; j++) {
         unsigned t;
         if (child[j] == VOXDAGI_NONE) continue;
         t = voxdagi_pointer(e, l, child[j], tag[j], &v);
         header |= t << (2 * j);
-        if (t == 3 && cls->N == 2) continue;
-        if (p) voxdagi_put_bits(p, bits, v, cls->O[t] + cls->K[t]);
-        bits += cls->O[t] + cls->K[t];
+        if (t == 3 && cls->classes == 2) continue;
+        if (p) voxdagi_put_bits(p, bits, v, cls->target_bits[t] + cls->code_bits[t]);
+        bits += cls->target_bits[t] + cls->code_bits[t];
     }
     if (p) voxdagi_put_le(p, header, 2);
     return bits;
@@ -3191,16 +3191,16 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
     const voxdagi_store *s = &e->r->store[l];
     voxdagi_classes *cls = &e->cls[l];
     uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0;
-    unsigned T, k, len = 0;
+    unsigned tf, k, len = 0;
     size_t i;
-    cls->N = (unsigned char)n;
+    cls->classes = (unsigned char)n;
     memset(freq, 0, sizeof freq);
     for (i = 0; i < 8 * s->n; i++) /* the table: stored transforms by decreasing frequency, ties by value */
         if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) freq[e->tag[l][i]]++;
-    for (T = 0; T < VOXDAGI_TRANSFORMS; T++) {
-        if (!freq[T]) continue;
-        for (k = len; k > 0 && freq[e->table[l][k - 1]] < freq[T]; k--) e->table[l][k] = e->table[l][k - 1];
-        e->table[l][k] = (uint8_t)T;
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
+        if (!freq[tf]) continue;
+        for (k = len; k > 0 && freq[e->table[l][k - 1]] < freq[tf]; k--) e->table[l][k] = e->table[l][k - 1];
+        e->table[l][k] = (uint8_t)tf;
         len++;
     }
     if (!len) e->table[l][len++] = 0; /* only private children: a table is never empty */
@@ -3217,7 +3217,7 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
         hist[ob][kb]++;
     }
     voxdagi_choose_classes(hist, n, cls);
-    cls->N = (unsigned char)n;
+    cls->classes = (unsigned char)n;
     for (i = 0; n == 2 && i < s->n; i++) {
         uint32_t child[8];
         unsigned tag[8];
@@ -3226,8 +3226,8 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
         base = voxdagi_private_base(e, l, child);
         if (base != UINT64_MAX && base > max_base) max_base = base;
     }
-    cls->P = (unsigned char)voxdagi_bit_length(max_base);
-    return cls->P <= 57;
+    cls->base_bits = (unsigned char)voxdagi_bit_length(max_base);
+    return cls->base_bits <= 57;
 }
 
 /* Record offsets of inner level L in storage order; returns its bytes. */
@@ -3279,8 +3279,8 @@ static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
    children of a record follow each other. Top-down. */
 static void voxdagi_private_order(voxdagi_encoder *e, uint32_t *const *refs, int *candidates) {
     const voxdagi_reducer *r = e->r;
-    uint32_t B = e->levels - 2, l;
-    for (l = 0; l < B; l++) {
+    uint32_t brick_level = e->levels - 2, l;
+    for (l = 0; l < brick_level; l++) {
         const voxdagi_store *s = &r->store[l];
         uint32_t *o = e->order[l + 1];
         size_t i, k = 0, n1 = r->store[l + 1].n;
@@ -3308,24 +3308,24 @@ static void voxdagi_private_order(voxdagi_encoder *e, uint32_t *const *refs, int
    or when a level needs pointers wider than 57 bits. */
 static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
-    uint32_t B = e->levels - 2, l;
+    uint32_t brick_level = e->levels - 2, l;
     uint32_t *refs[VOXDAG_MAX_LEVELS];
     int ok = 1, candidates[VOXDAG_MAX_LEVELS];
     memset(refs, 0, sizeof refs);
-    for (l = 0; l <= B; l++) {
+    for (l = 0; l <= brick_level; l++) {
         size_t n = r->store[l].n;
         refs[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
         e->order[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
         e->pos[l] = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof(uint64_t));
         e->orient[l] = (uint8_t *)voxdagi_alloc(e->mem, n);
-        e->tag[l] = l < B ? (uint8_t *)voxdagi_alloc(e->mem, 8 * n) : NULL;
+        e->tag[l] = l < brick_level ? (uint8_t *)voxdagi_alloc(e->mem, 8 * n) : NULL;
         e->single[l] = (uint8_t *)voxdagi_alloc(e->mem, n);
-        if (!refs[l] || !e->order[l] || !e->pos[l] || !e->orient[l] || (l < B && !e->tag[l]) || !e->single[l]) ok = 0;
+        if (!refs[l] || !e->order[l] || !e->pos[l] || !e->orient[l] || (l < brick_level && !e->tag[l]) || !e->single[l]) ok = 0;
         else memset(refs[l], 0, n * sizeof(uint32_t));
     }
     if (ok) {
         refs[0][r->root >> 6] = 1;
-        for (l = 0; l < B; l++) { /* reference counts, saturating */
+        for (l = 0; l < brick_level; l++) { /* reference counts, saturating */
             const voxdagi_store *s = &r->store[l];
             size_t i;
             for (i = 0; i < 8 * s->n; i++)
@@ -3339,24 +3339,24 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         const voxdagi_cube *c = e->cube;
         uint32_t x = r->root;
         unsigned best = c->comp[x & 63][c->inv[e->orient[0][x >> 6]]];
-        uint64_t S = r->store[0].stab[x >> 6];
-        while (S) {
-            unsigned s = (unsigned)voxdagi_popcount64((S & (0 - S)) - 1);
+        uint64_t stabs = r->store[0].stab[x >> 6];
+        while (stabs) {
+            unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1);
             unsigned v = c->comp[c->comp[x & 63][s]][c->inv[e->orient[0][x >> 6]]];
             if (v < best) best = v;
-            S &= S - 1;
+            stabs &= stabs - 1;
         }
         e->root_transform = best;
     }
-    for (l = 0; ok && l <= B; l++) ok = voxdagi_storage_order(e->mem, &r->store[l], refs[l], e->order[l]);
+    for (l = 0; ok && l <= brick_level; l++) ok = voxdagi_storage_order(e->mem, &r->store[l], refs[l], e->order[l]);
     if (ok) voxdagi_private_order(e, refs, candidates);
-    for (l = B + 1; ok && l-- > 0;) {
+    for (l = brick_level + 1; ok && l-- > 0;) {
         size_t i;
-        if (l < B) ok = voxdagi_plan_level(e, l, candidates[l]);
+        if (l < brick_level) ok = voxdagi_plan_level(e, l, candidates[l]);
         else
             for (i = 0; i < r->store[l].n; i++) e->pos[l][e->order[l][i]] = i;
     }
-    for (l = 0; l <= B; l++) voxdagi_free(e->mem, refs[l], r->store[l].n * sizeof(uint32_t));
+    for (l = 0; l <= brick_level; l++) voxdagi_free(e->mem, refs[l], r->store[l].n * sizeof(uint32_t));
     return ok;
 }
 
@@ -3365,10 +3365,10 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
 static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_table, uint8_t *nodes,
                                   uint8_t *bricks) {
     const voxdagi_reducer *r = e->r;
-    uint32_t B = e->levels - 2, l;
+    uint32_t brick_level = e->levels - 2, l;
     uint64_t level_at = 0;
     size_t i;
-    for (l = 0; l < B; l++) {
+    for (l = 0; l < brick_level; l++) {
         const voxdagi_classes *cls = &e->cls[l];
         uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
         unsigned t;
@@ -3378,18 +3378,18 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
         te[20] = (uint8_t)e->count_bits[l];
         te[21] = (uint8_t)e->table_len[l];
         for (t = 1; t <= 3; t++) {
-            te[21 + t] = cls->O[t];
-            te[24 + t] = cls->K[t];
+            te[21 + t] = cls->target_bits[t];
+            te[24 + t] = cls->code_bits[t];
         }
-        te[28] = cls->N == 2;
-        te[29] = cls->P;
+        te[28] = cls->classes == 2;
+        te[29] = cls->base_bits;
         memcpy(te + 32, e->table[l], e->table_len[l]);
         for (i = 0; i < r->store[l].n; i++) p += (voxdagi_record(e, l, e->order[l][i], p) + 7) / 8;
         level_at += e->size[l];
     }
-    for (i = 0; i < r->store[B].n; i++) {
-        uint32_t id = e->order[B][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[B].key[id], e->orient[B][id]), 8);
+    for (i = 0; i < r->store[brick_level].n; i++) {
+        uint32_t id = e->order[brick_level][i];
+        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[brick_level].key[id], e->orient[brick_level][id]), 8);
     }
 }
 
@@ -3470,8 +3470,8 @@ static unsigned voxdagi_presence(unsigned header) {
 /* A stored brick mask seen through world-to-stored transform MI, in world
    order: byte w of the result (the 2^3 cell w) is stored byte MI(w) with its
    bits mapped the same way; branch-free, one table lookup a byte. */
-VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, unsigned MI) {
-    const uint8_t *to_stored = d->cube.act[MI], *occ = d->occupancy[MI];
+VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, unsigned mi) {
+    const uint8_t *to_stored = d->cube.act[mi], *occ = d->occupancy[mi];
     uint64_t w = 0;
     unsigned k;
     for (k = 0; k < 8; k++) w |= (uint64_t)occ[(mask >> 8 * to_stored[k]) & 0xFF] << 8 * k;
@@ -3481,12 +3481,12 @@ VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, u
 /* occupancy[MI][p]: the world octants w holding a child, for stored presence
    P seen through world-to-stored transform MI (w is full when MI(w) is). */
 static void voxdagi_occupancy_init(voxdag *d) {
-    unsigned T, p, w;
-    for (T = 0; T < VOXDAGI_TRANSFORMS; T++)
+    unsigned tf, p, w;
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++)
         for (p = 0; p < 256; p++) {
             unsigned o = 0;
-            for (w = 0; w < 8; w++) o |= (p >> d->cube.act[T][w] & 1) << w;
-            d->occupancy[T][p] = (uint8_t)o;
+            for (w = 0; w < 8; w++) o |= (p >> d->cube.act[tf][w] & 1) << w;
+            d->occupancy[tf][p] = (uint8_t)o;
         }
 }
 
@@ -3677,8 +3677,8 @@ static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
    counts (the sum of the children's), every node and brick referenced, one
    root holding every voxel. */
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
-    uint32_t B = d->levels - 2, l;
-    uint64_t base = B ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
+    uint32_t brick_level = d->levels - 2, l;
+    uint64_t base = brick_level ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
     voxdagi_bitmaps child, cur;
     voxdag_status st = VOXDAG_OK;
     const char *msg = NULL;
@@ -3694,7 +3694,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "nodes in an empty scene");
         return VOXDAG_OK;
     }
-    if (B == 0) {
+    if (brick_level == 0) {
         if (d->brick_count != 1 || (uint64_t)voxdagi_popcount64(voxdagi_brick(d, 0)) != d->voxels)
             return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "root brick does not match the voxel count");
         return VOXDAG_OK;
@@ -3704,9 +3704,9 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
     }
     for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.map[VOXDAGI_START], i); /* every brick starts a record */
-    for (l = B; st == VOXDAG_OK && l-- > 0;) {
+    for (l = brick_level; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
-        uint64_t at = 0, records = 0, child_units = l + 1 == B ? d->brick_count : d->level[l + 1].size;
+        uint64_t at = 0, records = 0, child_units = l + 1 == brick_level ? d->brick_count : d->level[l + 1].size;
         if (!voxdagi_bitmaps_alloc(m, &cur, lv->size)) {
             st = VOXDAG_ERR_OUT_OF_MEMORY;
             msg = "cannot allocate validation bitmaps";
@@ -3844,7 +3844,7 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
 static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, int deep,
                                   uint32_t max_levels, uint64_t max_nodes, voxdagi_mem *m,
                                   voxdag_error *err) {
-    uint32_t count, i, l, B, seen = 0;
+    uint32_t count, i, l, brick_level, seen = 0;
     uint64_t end, node_sum = 0, level_at = 0;
     const uint8_t *levels = NULL, *nodes = NULL;
     uint64_t nodes_size = 0;
@@ -3973,8 +3973,8 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the last section", end, UINT64_MAX);
     if (!levels || !nodes || !d->bricks)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "missing level, node or brick section");
-    B = d->levels - 2;
-    for (l = 0; l < B; l++) {
+    brick_level = d->levels - 2;
+    for (l = 0; l < brick_level; l++) {
         const uint8_t *e = levels + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
         voxdagi_level *lv = &d->level[l];
         const char *bad = voxdagi_parse_level(d, l, e, level_at, nodes_size);
@@ -4071,15 +4071,15 @@ static void voxdagi_write_bounds(uint8_t *p, const double *bounds) {
 
 /* Transforms the box B (min xyz, max xyz, half-open) of a cube of side SIDE
    by T: axis a moves to axis perm[a], then mirrored axes flip. */
-static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned T, uint32_t side) {
+static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned tf, uint32_t side) {
     uint32_t t[6];
     unsigned a;
     for (a = 0; a < 3; a++) {
-        unsigned to = (unsigned)voxdagi_popcount64(c->act[T & ~7u][1u << a] - 1u); /* perm[a] */
+        unsigned to = (unsigned)voxdagi_popcount64(c->act[tf & ~7u][1u << a] - 1u); /* perm[a] */
         t[to] = b[a], t[to + 3] = b[a + 3];
     }
     for (a = 0; a < 3; a++) {
-        if (T >> a & 1) b[a] = side - t[a + 3], b[a + 3] = side - t[a];
+        if (tf >> a & 1) b[a] = side - t[a + 3], b[a + 3] = side - t[a];
         else b[a] = t[a], b[a + 3] = t[a + 3];
     }
 }
@@ -4087,11 +4087,11 @@ static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned
 /* The occupied voxel box of the scene, bottom-up over the unique nodes (each
    box in its node's canonical frame). Returns 0 when out of memory. */
 static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const voxdagi_cube *c, uint32_t box[6]) {
-    uint32_t B = r->levels - 2, l, *below = NULL, *cur = NULL;
+    uint32_t brick_level = r->levels - 2, l, *below = NULL, *cur = NULL;
     size_t below_n = 0, i, k;
     memset(box, 0, 6 * sizeof *box);
     if (r->root == VOXDAGI_NONE) return 1;
-    for (l = B + 1; l-- > 0;) {
+    for (l = brick_level + 1; l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
         cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur);
         if (!cur) {
@@ -4102,9 +4102,9 @@ static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const vox
             uint32_t *o = cur + 6 * i, half = 1u << (r->levels - l - 1), cb[6];
             o[0] = o[1] = o[2] = UINT32_MAX;
             o[3] = o[4] = o[5] = 0;
-            for (k = 0; k < (l == B ? 64u : 8u); k++) {
+            for (k = 0; k < (l == brick_level ? 64u : 8u); k++) {
                 unsigned a;
-                if (l == B) { /* a voxel of the brick */
+                if (l == brick_level) { /* a voxel of the brick */
                     uint32_t x, y, z;
                     if (!(s->key[i] >> k & 1)) continue;
                     voxdag_morton_decode(k, &x, &y, &z);
@@ -4137,7 +4137,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     voxdagi_encoder e;
     voxdagi_layout lay;
     voxdagi_scene sc;
-    uint32_t B = b->levels - 2, l;
+    uint32_t brick_level = b->levels - 2, l;
     uint64_t node_bytes = 0;
     uint8_t *img;
     voxdag *d;
@@ -4147,11 +4147,11 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     e.r = r;
     e.cube = &b->group[0].cube;
     e.levels = b->levels;
-    for (l = 0; l < B; l++) { /* what an empty scene's level table says */
+    for (l = 0; l < brick_level; l++) { /* what an empty scene's level table says */
         unsigned t;
-        for (t = 1; t <= 3; t++) e.cls[l].O[t] = (unsigned char)(8 * t);
-        e.cls[l].N = 3;
-        e.count_bits[l] = l + 1 < B;
+        for (t = 1; t <= 3; t++) e.cls[l].target_bits[t] = (unsigned char)(8 * t);
+        e.cls[l].classes = 3;
+        e.count_bits[l] = l + 1 < brick_level;
         e.table_len[l] = 1;
     }
     if (r->root != VOXDAGI_NONE && !voxdagi_encoder_plan(&e)) {
@@ -4167,11 +4167,11 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
-    for (l = 0; l < B; l++) node_bytes += e.size[l];
+    for (l = 0; l < brick_level; l++) node_bytes += e.size[l];
     memset(&lay, 0, sizeof lay);
-    voxdagi_layout_add(&lay, VOXDAG_SECTION_LEVELS, 0, (uint64_t)B * VOXDAG_FILE_LEVEL_ENTRY_SIZE);
+    voxdagi_layout_add(&lay, VOXDAG_SECTION_LEVELS, 0, (uint64_t)brick_level * VOXDAG_FILE_LEVEL_ENTRY_SIZE);
     voxdagi_layout_add(&lay, VOXDAG_SECTION_NODES, 0, node_bytes + VOXDAG_FILE_NODE_PADDING);
-    voxdagi_layout_add(&lay, VOXDAG_SECTION_BRICKS, 0, 8 * (uint64_t)r->store[B].n);
+    voxdagi_layout_add(&lay, VOXDAG_SECTION_BRICKS, 0, 8 * (uint64_t)r->store[brick_level].n);
     if (b->opts.colors && !b->opts.color_sink) voxdagi_layout_add(&lay, VOXDAG_SECTION_COLORS_RGB8, 0, 3 * b->voxels);
     if (b->has_bounds) voxdagi_layout_add(&lay, VOXDAG_SECTION_BOUNDS, 0, 48);
     st = voxdagi_new_dag(&b->mem, &d);
@@ -4368,20 +4368,21 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
 // -- Queries
 
 VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
-    uint32_t l, B;
-    if (!dag || !info) return;
-    B = dag->levels - 2;
-    memset(info, 0, sizeof *info);
+    uint32_t l, brick_level;
+    if (!info) return;
+    memset(info, 0, sizeof *info); /* all zero for a NULL DAG */
+    if (!dag) return;
+    brick_level = dag->levels - 2;
     info->levels = dag->levels;
     info->symmetry = dag->symmetry;
     info->voxels = dag->voxels;
     memcpy(info->voxel_box, dag->voxel_box, sizeof info->voxel_box);
-    for (l = 0; l < B; l++) {
+    for (l = 0; l < brick_level; l++) {
         info->nodes[l] = dag->level[l].nodes;
         info->level_bytes[l] = dag->level[l].size;
     }
-    info->nodes[B] = dag->brick_count;
-    info->level_bytes[B] = 8 * dag->brick_count;
+    info->nodes[brick_level] = dag->brick_count;
+    info->level_bytes[brick_level] = 8 * dag->brick_count;
     info->file_bytes = dag->image_size;
     info->node_bytes = dag->node_bytes;
     info->brick_bytes = 8 * dag->brick_count;
@@ -4400,10 +4401,10 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
    transformed to world order below the voxel. *CHILD (when not NULL and
    world octant w holds a child): that child, as voxdagi_child_ref with
    INVERSE, found in the same pass. */
-static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned MI,
+static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned mi,
                                   unsigned w, uint64_t *child) {
-    const uint8_t *to_world = d->cube.act[d->cube.inv[MI]];
-    unsigned present = voxdagi_presence(header), set = 0, j, v = d->cube.act[MI][w];
+    const uint8_t *to_world = d->cube.act[d->cube.inv[mi]];
+    unsigned present = voxdagi_presence(header), set = 0, j, v = d->cube.act[mi][w];
     uint64_t idx = 0, ref[8];
     for (j = 0; j < 8; j++)
         if (to_world[j] < w) set |= 1u << j;
@@ -4417,25 +4418,25 @@ static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *re
 }
 
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z, uint64_t *index) {
-    uint32_t L, B, l;
-    unsigned MI, p;
+    uint32_t nlevels, brick_level, l;
+    unsigned mi, p;
     uint64_t at = 0, idx = 0, mask;
     if (!dag || !dag->voxels || (x | y | z) >> dag->levels) return 0;
-    L = dag->levels, B = L - 2, MI = dag->cube.inv[dag->root_transform];
-    for (l = 0; l < B; l++) {
+    nlevels = dag->levels, brick_level = nlevels - 2, mi = dag->cube.inv[dag->root_transform];
+    for (l = 0; l < brick_level; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
-        unsigned header = voxdagi_le16(rec), sh = L - 1 - l, v;
+        unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
-        uint64_t ref;
-        v = dag->cube.act[MI][w];
+        uint64_t ref = 0; /* set by either call: the child is present */
+        v = dag->cube.act[mi][w];
         if (!(header >> (2 * v) & 3)) return 0;
-        if (index) idx += voxdagi_preceding(dag, l, rec, header, MI, w, &ref);
+        if (index) idx += voxdagi_preceding(dag, l, rec, header, mi, w, &ref);
         else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
-        MI = dag->cube.comp[ref & 63][MI];
+        mi = dag->cube.comp[ref & 63][mi];
         at = ref >> 6;
     }
-    mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, at), MI);
+    mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, at), mi);
     p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
     if (!(mask >> p & 1)) return 0;
     if (index) *index = idx + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
@@ -4447,21 +4448,21 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
     struct frame {
         uint64_t at;
         uint32_t x, y, z;
-        unsigned MI, next;
+        unsigned mi, next;
     } stack[VOXDAG_MAX_LEVELS];
-    uint32_t L, B;
+    uint32_t nlevels, brick_level;
     uint64_t index = 0;
     int depth = 0;
     if (!dag || !dag->voxels) return 0;
-    L = dag->levels, B = L - 2;
+    nlevels = dag->levels, brick_level = nlevels - 2;
     stack[0].at = 0;
     stack[0].x = stack[0].y = stack[0].z = 0;
-    stack[0].MI = dag->cube.inv[dag->root_transform];
+    stack[0].mi = dag->cube.inv[dag->root_transform];
     stack[0].next = 0;
     while (depth >= 0) {
         struct frame *f = &stack[depth];
-        if ((uint32_t)depth == B) { /* a brick, in world order */
-            uint64_t mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, f->at), f->MI);
+        if ((uint32_t)depth == brick_level) { /* a brick, in world order */
+            uint64_t mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, f->at), f->mi);
             while (mask) {
                 unsigned p = (unsigned)voxdagi_popcount64((mask & (0 - mask)) - 1);
                 uint32_t bx, by, bz;
@@ -4476,10 +4477,10 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         {
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
-            const uint8_t *to_stored = dag->cube.act[f->MI];
+            const uint8_t *to_stored = dag->cube.act[f->mi];
             unsigned header = voxdagi_le16(rec);
-            uint32_t half = 1u << (L - 1 - (uint32_t)depth);
-            unsigned occ = dag->occupancy[f->MI][voxdagi_presence(header)];
+            uint32_t half = 1u << (nlevels - 1 - (uint32_t)depth);
+            unsigned occ = dag->occupancy[f->mi][voxdagi_presence(header)];
             while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
             if (f->next == 8) {
                 depth--;
@@ -4490,7 +4491,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
                 uint64_t ref = voxdagi_child_ref(dag, (uint32_t)depth, rec, header, to_stored[w], 1);
                 struct frame *c = &stack[depth + 1];
                 c->at = ref >> 6;
-                c->MI = dag->cube.comp[ref & 63][f->MI];
+                c->mi = dag->cube.comp[ref & 63][f->mi];
                 c->x = f->x + (w & 1 ? half : 0);
                 c->y = f->y + (w & 2 ? half : 0);
                 c->z = f->z + (w & 4 ? half : 0);
@@ -4646,12 +4647,12 @@ static double voxdagi_mul_tiny(double a, double b) {
 /* 1 / D rounded once for finite D of magnitude at least 2^1022. */
 static double voxdagi_recip_tiny(double d) {
     uint64_t u, md, q = 0, r = 0;
-    int k, K;
+    int k, kr;
     memcpy(&u, &d, sizeof u);
     md = (u & 0xFFFFFFFFFFFFFull) | 1ull << 52;
-    K = 2149 - (int)(u >> 52 & 0x7FF); /* 1 / D = (2^K / md) 2^-1074 */
-    for (k = K; k >= 0; k--) { /* long division of 2^K */
-        r = r << 1 | (k == K);
+    kr = 2149 - (int)(u >> 52 & 0x7FF); /* 1 / D = (2^K / md) 2^-1074 */
+    for (k = kr; k >= 0; k--) { /* long division of 2^K */
+        r = r << 1 | (k == kr);
         q <<= 1;
         if (r >= md) r -= md, q |= 1;
     }
@@ -4688,7 +4689,7 @@ static double voxdagi_frecip(double d) {
 
 typedef struct voxdagi_frame {
     const uint8_t *rec;
-    unsigned header, MI, occ; /* occ: which world octants hold a child */
+    unsigned header, mi, occ; /* occ: which world octants hold a child */
 } voxdagi_frame;
 
 static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
@@ -4711,14 +4712,14 @@ VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
    preceding siblings on the path (FORMAT.md, Voxel index), read from the frames. */
 static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint64_t mask,
                                   const uint32_t c[3], uint32_t q) {
-    uint32_t B = d->levels - 2, top = q < B ? q : B, k;
+    uint32_t brick_level = d->levels - 2, top = q < brick_level ? q : brick_level, k;
     uint64_t idx = 0;
     for (k = 0; k < top; k++) {
         unsigned sh = q - 1 - k;
         unsigned w = (c[0] >> sh & 1) | (c[1] >> sh & 1) << 1 | (c[2] >> sh & 1) << 2;
-        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].MI, w, NULL);
+        idx += voxdagi_preceding(d, k, f[k].rec, f[k].header, f[k].mi, w, NULL);
     }
-    if (q > B) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
+    if (q > brick_level) { /* a voxel or a 2^3 cell of the brick: from its first voxel */
         uint32_t v[3];
         for (k = 0; k < 3; k++) v[k] = c[k] << (d->levels - q);
         idx += (uint64_t)voxdagi_popcount64(mask & ((1ull << voxdagi_brick_pos(v)) - 1)); /* MASK: world order */
@@ -4729,12 +4730,12 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
 /* The traversal shared by both queries; HIT NULL means any hit will do. */
 static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index,
                          voxdag_hit *hit) {
-    const uint32_t L = d->levels, B = L - 2, N = 1u << L;
+    const uint32_t nlevels = d->levels, brick_level = nlevels - 2, side = 1u << nlevels;
     voxdagi_frame f[VOXDAG_MAX_LEVELS];
     double ox[3], ix[3], te = -HUGE_VAL, tx = HUGE_VAL, t_stop;
     uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
     int sgn[3];
-    unsigned ae = 0, ax = 0, a, MI = d->cube.inv[d->root_transform], header = 0, occ = 0;
+    unsigned ae = 0, ax = 0, a, mi = d->cube.inv[d->root_transform], header = 0, occ = 0;
     int split;
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
@@ -4746,7 +4747,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
        grid), else of the grid (a coarse cell may reach outside the box). */
     for (a = 0; a < 3; a++) {
         double o = ray->origin[a], dir = ray->dir[a], lo, hi;
-        double box_lo = lod > 0 ? 0.0 : (double)d->voxel_box[a], box_hi = lod > 0 ? (double)N : (double)d->voxel_box[a + 3];
+        double box_lo = lod > 0 ? 0.0 : (double)d->voxel_box[a], box_hi = lod > 0 ? (double)side : (double)d->voxel_box[a + 3];
         if (o - o != 0 || dir - dir != 0) return 0; /* NaN or infinite */
         if (dir == 0) {
             if (!(o >= box_lo && o < box_hi)) return 0;
@@ -4771,22 +4772,22 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
     for (;;) {
         /* Enter node (l, at, M), which is cell c of level q. */
         unsigned halves = 1, b;
-        if (l < B) {
+        if (l < brick_level) {
             rec = d->level[l].data + at;
             header = voxdagi_le16(rec);
-            occ = d->occupancy[MI][voxdagi_presence(header)];
+            occ = d->occupancy[mi][voxdagi_presence(header)];
             f[l].rec = rec;
             f[l].header = header;
             f[l].occ = occ;
-        } else if (l == B) { /* the brick in world order */
-            mask = voxdagi_brick_to_world(d, voxdagi_brick(d, at), MI);
+        } else if (l == brick_level) { /* the brick in world order */
+            mask = voxdagi_brick_to_world(d, voxdagi_brick(d, at), mi);
             f[l].rec = NULL;
             f[l].header = f[l].occ = 0;
             halves = split ? 1 : 2;
         } /* else l == B + 1: a 2^3 cell of the same brick */
-        f[l].MI = MI;
+        f[l].mi = mi;
         while (halves--) { /* the child cell: which mid planes are crossed by (te, ae) */
-            uint32_t sh = L - q - 1;
+            uint32_t sh = nlevels - q - 1;
             for (b = 0; b < 3; b++) {
                 uint32_t mid = (2 * c[b] + 1) << sh;
                 unsigned h;
@@ -4806,14 +4807,14 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             double t, t1, t2;
             uint32_t old, sh;
             int k;
-            if (l < B) {
+            if (l < brick_level) {
                 if (occ >> ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 1) break;
-            } else if (q == L) {
+            } else if (q == nlevels) {
                 if (mask >> voxdagi_brick_pos(c) & 1) break;
             } else if (mask >> 8 * ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 0xFF) {
                 break; /* a 2^3 cell: one byte of the brick, any bit */
             }
-            sh = L - q;
+            sh = nlevels - q;
             t = voxdagi_plane_t((double)((c[0] + up[0]) << sh), ox[0], ix[0]);
             t1 = voxdagi_plane_t((double)((c[1] + up[1]) << sh), ox[1], ix[1]);
             t2 = voxdagi_plane_t((double)((c[2] + up[2]) << sh), ox[2], ix[2]);
@@ -4830,25 +4831,25 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
                 if (k < 0) return 0; /* left the grid */
                 c[0] >>= sh, c[1] >>= sh, c[2] >>= sh;
                 q -= sh, l = (uint32_t)k;
-                rec = f[l].rec, header = f[l].header, MI = f[l].MI, occ = f[l].occ;
+                rec = f[l].rec, header = f[l].header, mi = f[l].mi, occ = f[l].occ;
             }
         }
         /* Cell c of level q is full: a hit, or go down into it. */
-        if (q == L || (double)(1u << (L - q)) < voxdagi_fmul(lod, te)) {
+        if (q == nlevels || (double)(1u << (nlevels - q)) < voxdagi_fmul(lod, te)) {
             if (!hit) return 1;
             hit->t = te;
             for (b = 0; b < 3; b++) {
-                hit->xyz[b] = c[b] << (L - q);
+                hit->xyz[b] = c[b] << (nlevels - q);
                 hit->normal[b] = b == ae ? -sgn[b] : 0;
             }
             hit->level = q;
             hit->index = want_index ? voxdagi_ray_index(d, f, mask, c, q) : 0;
             return 1;
         }
-        if (l < B) {
+        if (l < brick_level) {
             uint64_t ref = voxdagi_child_ref(d, l, rec, header,
-                                             d->cube.act[MI][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
-            MI = d->cube.comp[ref & 63][MI];
+                                             d->cube.act[mi][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
+            mi = d->cube.comp[ref & 63][mi];
             at = ref >> 6;
         }
         l++;

@@ -16,6 +16,8 @@
 #             with an implementation built with 21 (and 12 against 21), under
 #             ASan: build stats and info across the boundary, layouts compared;
 #             a header whose public arrays follow VOXDAG_MAX_LEVELS must fail it
+#   macros    every one- and two-letter upper-case name defined as a macro
+#             before both implementations (C and C++, gcc and clang)
 #   symbols   the library objects export only voxdag_ and voxcolor_ names
 #   readme    README.md's ```c blocks compiled and run
 #   matrix    the portable unit tests (tests/test_main.c with TEST_PORTABLE:
@@ -297,6 +299,20 @@ job "mixed: MAX_LEVELS 8 + NO_ switches with 21, 21 with 12, under ASan: stats, 
 job "mixed: the control (public arrays sized by VOXDAG_MAX_LEVELS) fails" "AddressSanitizer: stack-buffer-overflow" \
     "grep -q 'CAPACITY VOXDAG_MAX_LEVELS' $out/badabi/voxdag.h
      $(mixed "-I$out/badabi -I." bad)"
+
+# -- Macro names: a user's short macros (every upper-case name of one or two
+# characters, N L B M S T and the like, defined as an invalid token) before
+# both implementations in one unit; the control shows such a name breaks code.
+awk 'BEGIN { u = "ABCDEFGHIJKLMNOPQRSTUVWXYZ"; v = u "0123456789_"
+    for (i = 1; i <= 26; i++) { a = substr(u, i, 1); print "#define " a " @"
+        for (j = 1; j <= 37; j++) print "#define " a substr(v, j, 1) " @" } }' >"$out/macros.h"
+for cc in $CCS $CXXS; do
+    job "macros $cc: one- and two-letter user macros before both implementations" ok \
+        "$cc $(lang_flags $cc) -O0 -include $out/macros.h -c -o $O/$cc-macros.o -I. $L/impl_both.c"
+done
+job "macros: the control (a variable named N under those macros) fails" "error" \
+    "printf 'int f(void) { int N = 1; return N; }\\n' >$out/macros_control.c
+     $cc1 $C99 -include $out/macros.h -c -o $O/macros_control.o $out/macros_control.c"
 
 # -- README: every ```c block, preprocessor lines first, the rest in main(),
 # run where build/demo.vdag is a scene built as `make demo` does (colours in a

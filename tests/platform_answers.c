@@ -143,7 +143,6 @@ static void print_rays(const char *name, const voxdag *d, unsigned count, uint64
     voxdag_ray_opts o;
     double n;
     unsigned i, a;
-    memset(&in, 0, sizeof in); /* voxdag_get_info leaves it alone on NULL arguments */
     voxdag_get_info(d, &in);
     n = (double)(1u << in.levels);
     for (i = 0; i < count; i++) {
