@@ -682,26 +682,19 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
 static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0);
 
 /* A rough estimate of a mesh build, printed before a long one (more than
-   10^7 voxels): voxels about twice the surface area in grid units (a
-   conservative voxelization is about two voxels thick), memory about 4
-   bytes a voxel for the nodes, plus 3 for uncompressed colours. Past the
-   machine's memory the build needs --force. Returns 0 after printing why it
-   stops. */
+   10^7 voxels): the voxels from the mesh's area (mesh_voxel_estimate);
+   memory 4 bytes a voxel up to 2048^3, then 3/4 of that per level more (the
+   builder holds the unique nodes, which grow about 3x per level while the
+   voxels grow 4x: on a game level its peak fell from 2.4 bytes a voxel at
+   2048^3 to 0.3 at 65536^3), plus 3 a voxel for uncompressed colours. Past
+   the machine's memory the build needs --force. Returns 0 after printing
+   why it stops. */
 static int mesh_estimate(const build_args *a, const vdag_scene *sc, const double *grid, int colors) {
-    double area = 0, voxels, bytes, machine;
-    size_t t;
+    double voxels = mesh_voxel_estimate(grid, sc->indices, sc->triangle_count), per_voxel = 4, bytes, machine;
     long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
-    for (t = 0; t < sc->triangle_count; t++) {
-        const double *p = grid + 3 * (size_t)sc->indices[3 * t], *q = grid + 3 * (size_t)sc->indices[3 * t + 1],
-                     *r = grid + 3 * (size_t)sc->indices[3 * t + 2];
-        double u[3], v[3], c[3];
-        int k;
-        for (k = 0; k < 3; k++) u[k] = q[k] - p[k], v[k] = r[k] - p[k];
-        c[0] = u[1] * v[2] - u[2] * v[1], c[1] = u[2] * v[0] - u[0] * v[2], c[2] = u[0] * v[1] - u[1] * v[0];
-        area += 0.5 * sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
-    }
-    voxels = 2 * area + (double)sc->triangle_count;
-    bytes = voxels * (4 + (colors && !a->compress ? 3 : 0));
+    uint32_t l;
+    for (l = 12; l <= a->levels; l++) per_voxel *= 0.75;
+    bytes = voxels * (per_voxel + (colors && !a->compress ? 3 : 0));
     machine = pages > 0 && page > 0 ? (double)pages * (double)page : 0;
     if (voxels > 1e7 && !a->quiet)
         fprintf(stderr, "vdag: estimate: about %.3g voxels and %.0f MiB (rough)\n", voxels, bytes / 1048576.0);
