@@ -1506,29 +1506,29 @@ static void voxdagi_reducer_finish(voxdagi_reducer *r) {
    of the codes, stably. TMP_CODE/TMP_RGB hold N elements each. */
 static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code,
                                uint32_t *tmp_rgb, size_t n, unsigned bits) {
-    enum { DIGIT = 11, BUCKETS = 1 << DIGIT };
-    size_t count[BUCKETS];
+    enum { radix_bits = 11, radix_buckets = 1 << radix_bits };
+    size_t count[radix_buckets];
     unsigned shift;
-    for (shift = 0; shift < bits; shift += DIGIT) {
+    for (shift = 0; shift < bits; shift += radix_bits) {
         size_t i, sum = 0;
         uint64_t *c;
         uint32_t *t;
         memset(count, 0, sizeof count);
-        for (i = 0; i < n; i++) count[(code[i] >> shift) & (BUCKETS - 1)]++;
-        for (i = 0; i < BUCKETS; i++) {
+        for (i = 0; i < n; i++) count[(code[i] >> shift) & (radix_buckets - 1)]++;
+        for (i = 0; i < radix_buckets; i++) {
             size_t k = count[i];
             count[i] = sum;
             sum += k;
         }
         for (i = 0; i < n; i++) {
-            size_t d = count[(code[i] >> shift) & (BUCKETS - 1)]++;
+            size_t d = count[(code[i] >> shift) & (radix_buckets - 1)]++;
             tmp_code[d] = code[i];
             if (rgb) tmp_rgb[d] = rgb[i];
         }
         c = code; code = tmp_code; tmp_code = c;
         t = rgb; rgb = tmp_rgb; tmp_rgb = t;
     }
-    if (((bits + DIGIT - 1) / DIGIT) & 1) { /* odd pass count: result is in tmp */
+    if (((bits + radix_bits - 1) / radix_bits) & 1) { /* odd pass count: result is in tmp */
         memcpy(tmp_code, code, n * sizeof *code);
         if (rgb) memcpy(tmp_rgb, rgb, n * sizeof *rgb);
     }
