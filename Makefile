@@ -62,10 +62,10 @@ $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/oiio_ref.o
 
 # voxcolor's option and argument checks in a release build (-DNDEBUG),
 # sanitized: they must not be asserts.
-$(BUILD)/test_voxcolor_ndebug: tests/test_voxcolor_ndebug.c voxcolor.h | $(BUILD)
+$(BUILD)/test_voxcolor_ndebug: tests/test_voxcolor_ndebug.c tests/tally.h voxcolor.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
 # The same for voxdag.h: its options and NULL arguments in a release build.
-$(BUILD)/test_voxdag_ndebug: tests/test_voxdag_ndebug.c voxdag.h | $(BUILD)
+$(BUILD)/test_voxdag_ndebug: tests/test_voxdag_ndebug.c tests/tally.h voxdag.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
 
 # Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):

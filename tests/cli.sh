@@ -341,6 +341,10 @@ check "a small coloured mesh builds in a few MiB (builder peak < 8 MiB at 2^10)"
     awk '/ peak / { for (i = 1; i <= NF; i++) if (\$i == \"peak\") v = \$(i + 1) } END { exit !(v != \"\" && v + 0 < 8) }' '$T/err'"
 check "--chunk-levels takes 2..8, and does not change the file" sh -c "! '$VDAG' build '$T/tetra.obj' '$T/t.vdag' --chunk-levels 9 2>/dev/null &&
     '$VDAG' build '$T/tetra.obj' '$T/t8.vdag' --chunk-levels 8 2>/dev/null && cmp -s '$T/t8.vdag' '$T/tetra.vdag'"
+check "the estimate before a long build: voxels within 2x of the build's, memory not below its peak" sh -c "
+    '$VDAG' build '$T/tetra.obj' '$T/t12.vdag' --levels 12 --no-colors 2>'$T/err' &&
+    awk '/estimate: about/ { ev = \$4; em = \$7 } / voxels, L=/ { v = \$2; for (i = 1; i <= NF; i++) if (\$i == \"peak\") p = \$(i + 1) }
+         END { exit !(ev > 0 && v > 0 && ev / v < 2 && v / ev < 2 && em + 0 >= p + 0) }' '$T/err'"
 check "a build estimated past the machine's memory needs --force" sh -c "
     ! timeout 60 '$VDAG' build '$T/tetra.obj' '$T/huge.vdag' --levels 21 2>'$T/err' && grep -q -- '--force' '$T/err' && [ ! -e '$T/huge.vdag' ]"
 

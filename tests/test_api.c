@@ -8,34 +8,14 @@
    compiled after voxcolor.h's declarations so that voxdag_color decodes
    voxcolor streams (voxcolor's implementation is in tests/impl.c). */
 #include "voxcolor.h"
-#define VOXDAG_STATIC
-#define VOXDAG_IMPLEMENTATION
-#if defined(__GNUC__) || defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#endif
-#include "voxdag.h"
-#if defined(__GNUC__) || defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
+#include "static_impl.h"
 
 #include <math.h>
 
+#include "golden.h"
 #include "test.h"
 
 // -- Helpers
-
-/* CRC-32C one bit at a time, straight from the definition. */
-static uint32_t ref_crc32c(const uint8_t *p, size_t n) {
-    uint32_t crc = 0xFFFFFFFFu;
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {
-        crc ^= p[i];
-        for (k = 0; k < 8; k++) crc = crc & 1 ? (crc >> 1) ^ 0x82F63B78u : crc >> 1;
-    }
-    return ~crc;
-}
 
 /* Random voxels (distinct or not) in a 2^levels grid, with colours. */
 typedef struct vox_set {
@@ -108,32 +88,26 @@ static void test_crc32c(void) {
     for (i = 0; i < (1u << 20) + 8; i++) buf[i] = (uint8_t)test_rand(&r);
     /* The standard check value of CRC-32C. */
     CHECK(voxdagi_crc32c((const uint8_t *)check, 9) == 0xE3069283u);
-    CHECK(ref_crc32c((const uint8_t *)check, 9) == 0xE3069283u);
+    CHECK(golden_crc32c((const uint8_t *)check, 9) == 0xE3069283u);
     for (off = 0; off < 8; off++)
         for (n = 0; n <= 600; n++)
-            if (voxdagi_crc32c(buf + off, n) != ref_crc32c(buf + off, n)) bad++;
+            if (voxdagi_crc32c(buf + off, n) != golden_crc32c(buf + off, n)) bad++;
     CHECK_MSG(bad == 0, "%zu of 4808 buffers differ from the bitwise CRC", bad);
     for (i = 0; i < 4; i++) {
         n = (size_t)test_rand_below(&r, 1u << 20) + 1;
         off = (size_t)test_rand_below(&r, 8);
-        CHECK(voxdagi_crc32c(buf + off, n) == ref_crc32c(buf + off, n));
+        CHECK(voxdagi_crc32c(buf + off, n) == golden_crc32c(buf + off, n));
     }
     free(buf);
 }
 
 // -- Loads that skip checksums
 
-/* Section I's offset and size in a valid image. */
-static void section_at(const uint8_t *img, uint32_t type, uint64_t *off, uint64_t *size) {
-    uint32_t count = (uint32_t)voxdagi_le(img + VOXDAG_FILE_OFF_SECTION_COUNT, 4), i;
-    *off = *size = 0;
-    for (i = 0; i < count; i++) {
-        const uint8_t *e = img + VOXDAG_FILE_HEADER_SIZE + i * VOXDAG_FILE_SECTION_ENTRY_SIZE;
-        if (voxdagi_le(e, 4) == type) {
-            *off = voxdagi_le(e + 8, 8);
-            *size = voxdagi_le(e + 16, 8);
-        }
-    }
+/* The offset and size of section TYPE in a valid image. */
+static void section_at(uint8_t *img, size_t size, uint32_t type, uint64_t *off, uint64_t *sz) {
+    const uint8_t *e = golden_section(img, size, type);
+    *off = e ? golden_le(e + 8, 8) : 0;
+    *sz = e ? golden_le(e + 16, 8) : 0;
 }
 
 static int count_fn(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
@@ -188,7 +162,7 @@ static void test_skip_checksums(void) {
     /* A colour byte changed: the default load refuses it, the trusting one
        loads it and returns the changed colour. */
     memcpy(copy, img, size);
-    section_at(copy, VOXDAG_SECTION_COLORS_RGB8, &off, &sz);
+    section_at(copy, size, VOXDAG_SECTION_COLORS_RGB8, &off, &sz);
     CHECK(sz == 3 * 3000 || sz > 0);
     copy[off + 4] ^= 0x5A;
     CHECK(voxdag_load_memory(copy, size, NULL, &e, &err) == VOXDAG_ERR_CHECKSUM && !e);
@@ -198,7 +172,7 @@ static void test_skip_checksums(void) {
 
     /* Structure is still validated: an empty brick (checksum fixed or not). */
     memcpy(copy, img, size);
-    section_at(copy, VOXDAG_SECTION_BRICKS, &off, &sz);
+    section_at(copy, size, VOXDAG_SECTION_BRICKS, &off, &sz);
     memset(copy + off, 0, 8);
     CHECK(voxdag_load_memory(copy, size, &lo, &e, &err) == VOXDAG_ERR_CORRUPT && !e);
     /* and the header's and section table's checksums always are. */

@@ -27,16 +27,7 @@
 
 /* This unit carries its own static copy of the implementation, for the file
    layout macros (VOXDAG_FILE_*) that only the implementation part defines. */
-#define VOXDAG_STATIC
-#define VOXDAG_IMPLEMENTATION
-#if defined(__GNUC__) || defined(__clang__)
-#pragma GCC diagnostic push
-#pragma GCC diagnostic ignored "-Wunused-function"
-#endif
-#include "voxdag.h"
-#if defined(__GNUC__) || defined(__clang__)
-#pragma GCC diagnostic pop
-#endif
+#include "static_impl.h"
 
 #include "golden.h"
 #include "test.h"

@@ -18,16 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-static int passed, failed;
-
-static void check(int ok, const char *what, unsigned long long k) {
-    if (ok) {
-        passed++;
-    } else {
-        failed++;
-        if (failed < 20) fprintf(stderr, "FAIL %s (case %llu)\n", what, k);
-    }
-}
+#include "tally.h"
 
 static long allocs;
 static void *counting_alloc(void *user, size_t size) {
