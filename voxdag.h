@@ -817,6 +817,22 @@ static int voxdagi_popcount64(uint64_t x) {
 #endif
 }
 
+/* The number of bits of V (0 for 0). */
+VOXDAGI_INLINE unsigned voxdagi_bit_length(uint64_t v) {
+#if defined(__GNUC__) || defined(__clang__)
+    return v ? 64u - (unsigned)__builtin_clzll(v) : 0u;
+#else
+    unsigned n = 0;
+    if (v >> 32) n += 32, v >>= 32;
+    if (v >> 16) n += 16, v >>= 16;
+    if (v >> 8) n += 8, v >>= 8;
+    if (v >> 4) n += 4, v >>= 4;
+    if (v >> 2) n += 2, v >>= 2;
+    if (v >> 1) n += 1, v >>= 1;
+    return n + (unsigned)v;
+#endif
+}
+
 /* Bit i of a byte moved to bit 3i, for all 256 bytes, built by the
    preprocessor. */
 #define VOXDAGI_S8(v)                                                                        \
@@ -2860,13 +2876,6 @@ static void voxdagi_layout_seal(uint8_t *img, const voxdagi_layout *lay, const v
 // level picks this or a third class, and its classes, for the fewest bytes.
 
 #ifndef VOXDAG_NO_BUILD
-/* The number of bits of V (0 for 0). */
-static unsigned voxdagi_bit_length(uint64_t v) {
-    unsigned n = 0;
-    while (v) n++, v >>= 1;
-    return n;
-}
-
 /* ORs the low N bits of V into P at bit POS (P zeroed beforehand). */
 static void voxdagi_put_bits(uint8_t *p, uint64_t pos, uint64_t v, unsigned n) {
     while (n) {
@@ -2940,7 +2949,7 @@ static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigne
    classes take a target width that occurs and any code width up to the
    largest. */
 static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_classes *best) {
-    unsigned cand[7 * 58][2], cell[58 * 7][2], nc = 0, ncell = 0, ob, kb, kmax = 0, a, b, c, i;
+    unsigned cand[7 * 58][2], cell[58 * 7][2], nc = 0, ncell = 0, ob, kb, kmax = 0, a, b, c, i, widest;
     uint64_t best_cost = UINT64_MAX;
     for (ob = 0; ob < 58; ob++)
         for (kb = 0; kb < 7; kb++)
@@ -2956,15 +2965,19 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_cla
     }
     memset(best, 0, sizeof *best); /* no pointers: zero widths */
     best->classes = (unsigned char)n;
+    /* Some class must hold the widest targets: the last class of a set
+       (candidates run by target width) comes from the last KMAX + 1. */
+    widest = nc ? nc - kmax - 1 : 0;
     for (a = 0; a < nc; a++)
         for (b = a; b < nc; b++) {
             unsigned char pair[58 * 7]; /* per cell: the narrower of classes a and b that holds it, 255 none */
+            if (n == 2 && b < widest) continue;
             for (i = 0; i < ncell; i++) {
                 unsigned wa = cand[a][0] >= cell[i][0] && cand[a][1] >= cell[i][1] ? cand[a][0] + cand[a][1] : 255;
                 unsigned wb = cand[b][0] >= cell[i][0] && cand[b][1] >= cell[i][1] ? cand[b][0] + cand[b][1] : 255;
                 pair[i] = (unsigned char)(wa < wb ? wa : wb);
             }
-            for (c = b; c < (n == 3 ? nc : b + 1); c++) {
+            for (c = n == 3 && b < widest ? widest : b; c < (n == 3 ? nc : b + 1); c++) {
                 uint64_t cost = 0;
                 for (i = 0; i < ncell; i++) {
                     unsigned w = cand[c][0] >= cell[i][0] && cand[c][1] >= cell[i][1] ? cand[c][0] + cand[c][1] : 255;
@@ -2996,6 +3009,7 @@ typedef struct voxdagi_encoder {
     uint64_t size[VOXDAG_MAX_LEVELS];    /* bytes of each inner level */
     unsigned count_bits[VOXDAG_MAX_LEVELS];
     voxdagi_classes cls[VOXDAG_MAX_LEVELS];
+    uint8_t class_of[VOXDAG_MAX_LEVELS][58][7]; /* [target bits][code bits]: voxdagi_class_for */
     uint8_t code[VOXDAG_MAX_LEVELS][VOXDAGI_TRANSFORMS];  /* transform -> code */
     uint8_t table[VOXDAG_MAX_LEVELS][VOXDAGI_TRANSFORMS]; /* code -> transform */
     unsigned table_len[VOXDAG_MAX_LEVELS];
@@ -3152,7 +3166,7 @@ static unsigned voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, uint32_t x
     uint64_t target = e->pos[l + 1][x >> 6];
     unsigned code = e->code[l][tag], t;
     if (voxdagi_is_private(e, l, x)) return 3;
-    t = voxdagi_class_for(c, voxdagi_bit_length(target), voxdagi_bit_length(code));
+    t = e->class_of[l][voxdagi_bit_length(target)][voxdagi_bit_length(code)];
     *value = target << c->code_bits[t] | code;
     return t;
 }
@@ -3218,6 +3232,7 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
     }
     voxdagi_choose_classes(hist, n, cls);
     cls->classes = (unsigned char)n;
+    for (k = 0; k < 58 * 7; k++) e->class_of[l][k / 7][k % 7] = (uint8_t)voxdagi_class_for(cls, k / 7, k % 7);
     for (i = 0; n == 2 && i < s->n; i++) {
         uint32_t child[8];
         unsigned tag[8];
@@ -3242,34 +3257,53 @@ static uint64_t voxdagi_level_offsets(voxdagi_encoder *e, uint32_t l) {
     return at;
 }
 
+/* What a level's plan decides: kept while the other plan is tried. */
+typedef struct voxdagi_level_plan {
+    voxdagi_classes cls;
+    uint8_t code[VOXDAGI_TRANSFORMS], table[VOXDAGI_TRANSFORMS], class_of[58][7];
+    unsigned table_len;
+} voxdagi_level_plan;
+
+static void voxdagi_plan_swap(voxdagi_encoder *e, uint32_t l, voxdagi_level_plan *p) {
+    voxdagi_level_plan cur;
+    cur.cls = e->cls[l], cur.table_len = e->table_len[l];
+    memcpy(cur.code, e->code[l], sizeof cur.code);
+    memcpy(cur.table, e->table[l], sizeof cur.table);
+    memcpy(cur.class_of, e->class_of[l], sizeof cur.class_of);
+    e->cls[l] = p->cls, e->table_len[l] = p->table_len;
+    memcpy(e->code[l], p->code, sizeof p->code);
+    memcpy(e->table[l], p->table, sizeof p->table);
+    memcpy(e->class_of[l], p->class_of, sizeof p->class_of);
+    *p = cur;
+}
+
 /* Plans inner level L bottom-up (pointer widths depend on where the next
    level put its nodes): with private children when the next level has
-   candidates and they make the level smaller, else with three classes. */
+   candidates and they make the level smaller, else with three classes.
+   Returns 0 when out of memory or when no plan holds the pointers. */
 static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
-    voxdagi_classes three;
-    uint8_t code[VOXDAGI_TRANSFORMS], table[VOXDAGI_TRANSFORMS];
-    unsigned table_len;
-    uint64_t size3 = 0;
-    int ok3 = voxdagi_choose_level(e, l, 3);
+    size_t n = e->r->store[l].n;
+    voxdagi_level_plan three;
+    uint64_t size3 = 0, size2, *pos3;
+    int ok2, ok3 = voxdagi_choose_level(e, l, 3);
     if (ok3) size3 = voxdagi_level_offsets(e, l);
     e->size[l] = size3;
     if (!candidates) return ok3;
-    three = e->cls[l], table_len = e->table_len[l];
-    memcpy(code, e->code[l], sizeof code);
-    memcpy(table, e->table[l], sizeof table);
-    if (voxdagi_choose_level(e, l, 2)) {
-        uint64_t size2 = voxdagi_level_offsets(e, l);
-        if (!ok3 || size2 < size3) {
-            e->size[l] = size2;
-            return 1;
-        }
+    pos3 = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof *pos3);
+    if (!pos3) return 0;
+    if (ok3) memcpy(pos3, e->pos[l], n * sizeof *pos3);
+    memset(&three, 0, sizeof three);
+    voxdagi_plan_swap(e, l, &three); /* THREE now holds the three-class plan */
+    ok2 = voxdagi_choose_level(e, l, 2);
+    size2 = ok2 ? voxdagi_level_offsets(e, l) : 0;
+    if (ok2 && (!ok3 || size2 < size3)) {
+        e->size[l] = size2;
+    } else if (ok3) { /* back to the three-class plan and its offsets */
+        voxdagi_plan_swap(e, l, &three);
+        memcpy(e->pos[l], pos3, n * sizeof *pos3);
     }
-    if (!ok3) return 0;
-    e->cls[l] = three, e->table_len[l] = table_len;
-    memcpy(e->code[l], code, sizeof code);
-    memcpy(e->table[l], table, sizeof table);
-    e->size[l] = voxdagi_level_offsets(e, l);
-    return 1;
+    voxdagi_free(e->mem, pos3, n * sizeof *pos3);
+    return ok2 || ok3;
 }
 
 /* Stored transforms of every pointer, the private-child candidates (nodes
@@ -4692,16 +4726,6 @@ typedef struct voxdagi_frame {
     unsigned header, mi, occ; /* occ: which world octants hold a child */
 } voxdagi_frame;
 
-static unsigned voxdagi_high_bit(uint32_t x) { /* x != 0 */
-#if defined(__GNUC__) || defined(__clang__)
-    return 31u - (unsigned)__builtin_clz(x);
-#else
-    unsigned n = 0;
-    while (x >>= 1) n++;
-    return n;
-#endif
-}
-
 /* Morton position inside a 4^3 brick of the voxel with coordinates C. */
 VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
     return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
@@ -4825,7 +4849,7 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             old = c[a];
             c[a] += step[a];
             te = t, ae = a;
-            sh = voxdagi_high_bit(old ^ c[a]);
+            sh = voxdagi_bit_length(old ^ c[a]) - 1;
             k = (int)q - 1 - (int)sh; /* the node level whose child changed */
             if (k < (int)l) {
                 if (k < 0) return 0; /* left the grid */
