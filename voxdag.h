@@ -1090,7 +1090,7 @@ typedef struct voxdagi_store {
     uint64_t *count;   /* voxels below (inner only) */
     uint64_t *stab;    /* stabilizer: bit s set when transform s maps the node to itself */
     size_t n, cap;
-    uint32_t *slot;    /* open-addressing table of id + 1; 0 = free */
+    uint32_t *slot;    /* open-addressing table of id + 1 and a hash tag above it; 0 = free */
     size_t slot_count; /* power of two */
     uint64_t svo;      /* tree nodes reduced into this level */
 } voxdagi_store;
@@ -1112,11 +1112,17 @@ static uint64_t voxdagi_store_count(const voxdagi_store *s, uint32_t id) {
     return s->child ? s->count[id] : (uint64_t)voxdagi_popcount64(s->key[id]);
 }
 
+/* Whether node ID is (KEY, CHILD). An inner node's key is a function of
+   its children, so they alone decide. */
 static int voxdagi_store_same(const voxdagi_store *s, uint32_t id, uint64_t key,
                               const uint32_t *child) {
-    return s->key[id] == key &&
-           (!child || !memcmp(s->child + 8 * (size_t)id, child, 8 * sizeof *child));
+    return child ? !memcmp(s->child + 8 * (size_t)id, child, 8 * sizeof *child) : s->key[id] == key;
 }
+
+/* A slot holds id + 1 (below 2^26) and the hash's top 6 bits above it, so
+   that most probes of other nodes end without reading the node arrays. */
+#define VOXDAGI_SLOT_ID(v) (((v) & (VOXDAGI_MAX_IDS - 1)) - 1)
+#define VOXDAGI_SLOT_TAG(h) ((uint32_t)((h) >> 58) << 26)
 
 /* Doubles the capacity of every array of S, all or nothing. */
 static int voxdagi_store_reserve(voxdagi_mem *m, voxdagi_store *s, int inner) {
@@ -1155,12 +1161,14 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
                                      uint64_t key, const uint32_t *child,
                                      uint64_t count, uint64_t stab) {
     uint64_t h = inner ? key : voxdagi_mix64(key);
+    uint32_t tag = VOXDAGI_SLOT_TAG(h), id;
     size_t i, mask;
-    uint32_t id;
     if (s->slot_count) {
         mask = s->slot_count - 1;
-        for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask)
-            if (voxdagi_store_same(s, s->slot[i] - 1, key, child)) return s->slot[i] - 1;
+        for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask) {
+            id = VOXDAGI_SLOT_ID(s->slot[i]);
+            if ((s->slot[i] ^ tag) < VOXDAGI_MAX_IDS && voxdagi_store_same(s, id, key, child)) return id;
+        }
     }
     if (s->n + 1 >= VOXDAGI_MAX_IDS) return VOXDAGI_NONE;
     if ((s->n + 1) * 2 > s->slot_count) { /* rehash at half load */
@@ -1171,7 +1179,7 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
         for (j = 0; j < s->n; j++) {
             uint64_t hj = inner ? s->key[j] : voxdagi_mix64(s->key[j]);
             for (i = (size_t)hj & (count2 - 1); slot[i]; i = (i + 1) & (count2 - 1)) {}
-            slot[i] = (uint32_t)j + 1;
+            slot[i] = ((uint32_t)j + 1) | VOXDAGI_SLOT_TAG(hj);
         }
         voxdagi_free(m, s->slot, s->slot_count * sizeof *s->slot);
         s->slot = slot;
@@ -1187,7 +1195,7 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
     }
     mask = s->slot_count - 1;
     for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask) {}
-    s->slot[i] = id + 1;
+    s->slot[i] = (id + 1) | tag;
     return id;
 }
 
