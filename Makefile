@@ -147,16 +147,16 @@ BENCH_SUBMAKE := $(MAKE)
 BENCH_DEPS   := bench/scenes.h $(HEADERS) examples/import.c examples/import.h examples/image_none.c
 .PHONY: bench-quick bench-build bench-geometry bench-data
 
-$(BUILD)/bench/bench_build: bench/bench_build.c $(BENCH_DEPS)
+$(BUILD)/bench/bench_build: bench/bench_build.c $(BUILD)/bench/v2.o $(BENCH_DEPS)
 	@mkdir -p $(@D)
-	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
+	$(CC) $(BENCH_CFLAGS) -o $@ $< $(BUILD)/bench/v2.o examples/import.c examples/image_none.c -lm
 # Format version 2 side by side: its voxdag.h from the last version-2 commit
-# (git history; without it the size column reads 0 and the speed table is left out).
+# (git history; without it the size column reads 0 and the speed tables are left out).
 VOXDAG_V2_COMMIT := 3013133
 $(BUILD)/bench/v2/voxdag.h:
 	@mkdir -p $(@D)
 	@git show $(VOXDAG_V2_COMMIT):voxdag.h > $@ 2>/dev/null || rm -f $@
-# bench/v2.c links it next to the current one (sizes, ray and lookup speeds).
+# bench/v2.c links it next to the current one (sizes, ray, lookup and build speeds).
 $(BUILD)/bench/v2.o: bench/v2.c bench/v2.h $(BUILD)/bench/v2/voxdag.h
 	@mkdir -p $(@D)
 	$(CC) $(BENCH_CFLAGS) $(if $(wildcard $(BUILD)/bench/v2/voxdag.h),-I$(BUILD)/bench,-DBENCH_NO_V2) -c -o $@ bench/v2.c

@@ -4,10 +4,14 @@
    DATA_DIR holds what bench/fetch.sh fetched. Times are wall-clock seconds,
    the best of a few runs for small scenes. Peak memory is the builder's own
    accounting (voxdag_build_stats.peak_memory): the voxel buffer, the sort
-   buffer, the unique-node tables and the encoder, not the caller's input. */
+   buffer, the unique-node tables and the encoder, not the caller's input.
+   Two tables set this builder against the last version-2 voxdag.h
+   (bench/v2.c) on the same voxels and the same triangles, one thread, timed
+   in turn. */
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "bench/scenes.h"
+#include "bench/v2.h"
 
 #include <unistd.h>
 
@@ -122,6 +126,39 @@ static size_t *chunk_ends(const bscene *s, size_t chunk, size_t *nends) {
     return ends;
 }
 
+/* Format version 3 (this voxdag.h) against version 2 on one thread: the
+   triangles of M (when not NULL; voxelize + reduce + encode) or the
+   Morton-sorted voxels of S (add + flush + finish), into 2^(S's levels).
+   The two builds run in turn, REPEAT times each, so that a change in the
+   machine's load moves both; CPU[0] / CPU[1] = the least process CPU seconds
+   of version 3 / 2, *V2_VOXELS = version 2's voxel count. Returns 0 without
+   version 2. */
+static int versus_v2(const bscene *s, const bmesh *m, int repeat, double cpu[2], uint64_t *v2_voxels) {
+    int r;
+    cpu[0] = cpu[1] = 1e300;
+    for (r = 0; r < repeat; r++) {
+        double c0 = bench_cpu(), c;
+        bench_v2 *d2 = m ? bench_v2_build_mesh(m->pos, m->verts, m->idx, m->tris, s->levels, BENCH_CHUNK_LEVELS, 1)
+                         : bench_v2_build(s->xyz, s->n, s->levels, 1);
+        c = bench_cpu() - c0;
+        if (!d2) return 0;
+        *v2_voxels = bench_v2_voxels(d2);
+        bench_v2_free(d2);
+        if (c < cpu[1]) cpu[1] = c;
+        if (m) {
+            voxdag *d3;
+            c0 = bench_cpu();
+            d3 = bmesh_voxelize(m, s->levels, 1, NULL);
+            c = bench_cpu() - c0;
+            voxdag_free(d3);
+        } else {
+            c = build(s, s->xyz, 1, 0, 1).cpu;
+        }
+        if (c < cpu[0]) cpu[0] = c;
+    }
+    return 1;
+}
+
 static void shuffle(uint32_t *xyz, size_t n) {
     uint64_t x = 0x2545F4914F6CDD1Dull;
     size_t i;
@@ -140,6 +177,7 @@ typedef struct result {
     bscene *s;
     run sorted[2], unsorted[2], cmp, streamed;
     uint64_t cells2;
+    double cpu[2];  /* v3, v2 CPU seconds, Morton-sorted, 1 thread */
 } result;
 
 static double mb(uint64_t b) { return (double)b / 1048576.0; }
@@ -154,11 +192,12 @@ static uint64_t sum(const uint64_t *a, uint32_t n) {
 /* Triangle scenes (SSVDAG Table 1 shape, voxelization included): the mesh
    voxelized and reduced by voxdag_builder_add_mesh + finish, then its voxels
    reduced alone, replayed through add + flush in the same aligned cells the
-   voxelizer flushes; voxelization = the difference. */
-static void mesh_table(const char *dir, int quick, const unsigned tcount[2]) {
+   voxelizer flushes; voxelization = the difference. The rows of the table
+   against version 2 (versions_table) go to VERSIONS (CAP bytes). */
+static void mesh_table(const char *dir, int quick, const unsigned tcount[2], char *versions, size_t cap) {
     static const char *meshes[] = {"bunny.off", "armadillo.off", "dragon.off"};
     uint32_t L, Lmax = quick ? 11 : 12;
-    size_t k;
+    size_t k, used = 0;
     printf("### Triangle scenes: voxelization and DAG reduction\n\n");
     printf("Each mesh fitted into the 2^L grid and voxelized by `voxdag_builder_add_mesh` (exact conservative "
            "voxelization, aligned 2^%u-voxel cells, each reduced as soon as it is voxelized), then `finish`: "
@@ -210,10 +249,35 @@ static void mesh_table(const char *dir, int quick, const unsigned tcount[2]) {
                        wall - red.total, cpu - red.cpu, (double)s.n / cpu / 1e6, (double)s.n / red.cpu / 1e6);
                 fflush(stdout);
             }
+            {
+                double c[2];
+                uint64_t v2n = 0;
+                fprintf(stderr, "bench_build: %s voxelized by versions 3 and 2 (L=%u, 1 thread)\n", meshes[k], L);
+                if (versus_v2(&s, &m, quick ? 1 : 3, c, &v2n) && used < cap)
+                    used += (size_t)snprintf(versions + used, cap - used,
+                                             "| %s | %u | %zu | %zu | %.3f | %.3f | %.1f | %.1f | **%.2f** | %s |\n",
+                                             meshes[k], L, m.tris, s.n, c[1], c[0], (double)s.n / c[1] / 1e6,
+                                             (double)s.n / c[0] / 1e6, c[1] / c[0], v2n == s.n ? "yes" : "**no**");
+            }
             bscene_free(&s);
             bmesh_free(&m);
         }
     printf("\n");
+}
+
+/* The triangle builds against version 2: ROWS from mesh_table, if any. */
+static void versions_table(int quick, const char *rows) {
+    if (!*rows) return;
+    printf("### Build from triangles, format 3 vs 2 (same meshes, 1 thread)\n\n");
+    printf("The meshes and grids of the triangle-scene table, voxelized and built by `voxdag_builder_add_mesh` + `finish` of this voxdag.h "
+           "(format version 3, 48 cube symmetries) and of the last version-2 voxdag.h (git history, 8 reflections), "
+           "each with its default options and the same 2^%u-voxel cells, one thread; the two versions timed in turn, "
+           "%s. CPU s = process CPU seconds of the whole build. v3 / v2 speed = v2 CPU s / v3 CPU s; target: >= 0.9, "
+           "i.e. no more than 10 %% slower than version 2. Same voxels: both voxelizers gave the same voxel count.\n\n",
+           BENCH_CHUNK_LEVELS, quick ? "one run each" : "least CPU time of 3 runs each");
+    printf("| scene | L | triangles | voxels | v2 CPU s | v3 CPU s | v2 M vox/CPU-s | v3 M vox/CPU-s | v3 / v2 speed "
+           "| same voxels |\n");
+    printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---|\n%s\n", rows);
 }
 
 int main(int argc, char **argv) {
@@ -221,10 +285,11 @@ int main(int argc, char **argv) {
     int quick = 0, i;
     const char *profile = NULL; /* --profile NAME: only repeat NAME's sorted 1-thread build */
     unsigned threads = (unsigned)sysconf(_SC_NPROCESSORS_ONLN), tcount[2];
-    char path[512];
+    char path[512], versions[4096];
     bscene scenes[16];
     result res[16];
     size_t ns, k;
+    int v2 = 0; /* 1: version 2 was timed */
     for (i = 2; i < argc; i++) {
         if (!strcmp(argv[i], "--quick")) quick = 1;
         else if (!strcmp(argv[i], "--threads") && i + 1 < argc) threads = (unsigned)atoi(argv[++i]);
@@ -269,6 +334,13 @@ int main(int argc, char **argv) {
         }
         r->cmp = build(s, s->xyz, threads, 1, 1);
         {
+            uint64_t v2n = 0;
+            v2 = versus_v2(s, NULL, quick ? 1 : 3, r->cpu, &v2n);
+            if (v2 && v2n != s->n)
+                fprintf(stderr, "bench_build: %s: version 2 built %llu voxels of %zu\n", s->name,
+                        (unsigned long long)v2n, s->n);
+        }
+        {
             size_t nends, *ends = chunk_ends(s, STREAM_CHUNK, &nends);
             r->streamed = build_chunked(s, s->xyz, 1, 0, rep, ends, nends);
             free(ends);
@@ -302,7 +374,24 @@ int main(int argc, char **argv) {
             }
     }
     printf("\nTarget: 30 M voxels/s per core from Morton-sorted input.\n\n");
-    mesh_table(dir, quick, tcount);
+    if (v2) {
+        printf("### Build from voxels, format 3 vs 2 (same voxels, 1 thread)\n\n");
+        printf("The Morton-sorted voxels above, built by this voxdag.h (format version 3, 48 cube symmetries: add, "
+               "flush, finish) and by the last version-2 voxdag.h (git history, 8 reflections: add, finish), each "
+               "with its default options, one thread; the two versions timed in turn, %s. CPU s = process CPU "
+               "seconds of the build. v3 / v2 speed = v2 CPU s / v3 CPU s. Target: version 3 >= 30 M voxels per "
+               "CPU-second.\n\n",
+               quick ? "one run each" : "least CPU time of 3 runs each");
+        printf("| scene | L | voxels | v2 CPU s | v3 CPU s | v2 M vox/CPU-s | v3 M vox/CPU-s | v3 / v2 speed |\n");
+        printf("|---|---:|---:|---:|---:|---:|---:|---:|\n");
+        for (k = 0; k < ns; k++)
+            printf("| %s | %u | %zu | %.3f | %.3f | %.1f | %.1f | **%.2f** |\n", res[k].s->name, res[k].s->levels,
+                   res[k].s->n, res[k].cpu[1], res[k].cpu[0], (double)res[k].s->n / res[k].cpu[1] / 1e6,
+                   (double)res[k].s->n / res[k].cpu[0] / 1e6, res[k].cpu[1] / res[k].cpu[0]);
+        printf("\n");
+    }
+    versions[0] = 0;
+    mesh_table(dir, quick, tcount, versions, sizeof versions);
 
     printf("Published (SSVDAG paper, Table 1; Intel i7-4790K, 8 threads, reduction from an SVO on disk, "
            "excluding voxelization); M vox/s derived here as MVoxels / SSVDAG time:\n\n");
@@ -321,7 +410,9 @@ int main(int argc, char **argv) {
                    pub[j].svdag, pub[j].ssvdag, pub[j].mv / pub[j].ssvdag, pub[j].mv / pub[j].ssvdag / 8);
     }
 
-    printf("\n### Node counts per structure (SSVDAG Table 2 shape)\n\n");
+    printf("\n");
+    versions_table(quick, versions);
+    printf("### Node counts per structure (SSVDAG Table 2 shape)\n\n");
     printf("Total nodes over all levels. SVO: every non-empty octree node of levels 0..L-1 "
            "(level L-1 = 2^3 cells). SVDAG / SSVDAG: unique nodes of levels 0..L-3 plus unique 4^3 bricks "
            "(level L-2), from one build with `compare_structures`; SSVDAG = exact merging up to the 8 reflections; "

@@ -21,6 +21,8 @@ tsv build_triangle-scenes | awk -F'\t' '$5 == 1 { if (!($1 in best)) ord[++n] = 
     END { for (i = 1; i <= n; i++) { split(best[ord[i]], f, "\t")
           s = s (s ? ", " : "") sprintf("%s L=%s: %s (reduction alone %s)", f[1], f[2], f[14], f[15]) }
           if (s) print "| Build from triangles (voxelize + reduce), 1 thread, largest L: M voxels per CPU-second | " s " | 30 |" }'
+tsv build_build-from-triangles-format-3-vs-2 | awk -F'\t' '{ s = s (s ? ", " : "") sprintf("%s L=%s: %s", $1, $2, $9) }
+    END { if (s) print "| Build from triangles, v3 / v2 speed (CPU seconds, same meshes), 1 thread | " s " | >= 0.9 |" }'
 tsv geometry_geometry-size | awk -F'\t' '{ r = $15 + 0; n++; if (r <= 1) le++
     if (!lo || r < lo) lo = r; if (r > hi) hi = r }
     END { if (n) printf "| Geometry bytes: ours (with voxel counts) / SSVDAG paper layout (without counts) | %.3f to %.3f; <= 1 on %d of %d scenes | <= 1 |\n", lo, hi, le, n }'
