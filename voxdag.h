@@ -833,6 +833,9 @@ VOXDAGI_INLINE unsigned voxdagi_bit_length(uint64_t v) {
 #endif
 }
 
+/* The position of the lowest set bit of X (X != 0). */
+VOXDAGI_INLINE unsigned voxdagi_lowest_bit(uint64_t x) { return (unsigned)voxdagi_popcount64((x & (0 - x)) - 1); }
+
 /* Bit i of a byte moved to bit 3i, for all 256 bytes, built by the
    preprocessor. */
 #define VOXDAGI_S8(v)                                                                        \
@@ -1083,12 +1086,17 @@ static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsig
 
 /* The unique nodes of one level. Inner nodes keep 8 child references (each
    (id << 6 | tag) into the next level, tag normalized by the child's
-   stabilizer) and a fingerprint; bricks keep their 64-bit mask in KEY. */
+   stabilizer) and a fingerprint; bricks keep their 64-bit mask in KEY. What
+   a parent reads of a child sits together (one cache line). */
+typedef struct voxdagi_node {
+    uint64_t key;   /* fingerprint (inner) or mask (brick) */
+    uint64_t stab;  /* stabilizer: bit s set when transform s maps the node to itself */
+    uint64_t count; /* voxels below */
+} voxdagi_node;
+
 typedef struct voxdagi_store {
     uint32_t *child;   /* 8 per node; NULL on the brick level */
-    uint64_t *key;     /* fingerprint (inner) or mask (brick) */
-    uint64_t *count;   /* voxels below (inner only) */
-    uint64_t *stab;    /* stabilizer: bit s set when transform s maps the node to itself */
+    voxdagi_node *node;
     size_t n, cap;
     uint32_t *slot;    /* open-addressing table of id + 1 and a hash tag above it; 0 = free */
     size_t slot_count; /* power of two */
@@ -1097,9 +1105,7 @@ typedef struct voxdagi_store {
 
 static void voxdagi_store_free_arrays(voxdagi_mem *m, voxdagi_store *s) {
     voxdagi_free(m, s->child, s->cap * 8 * sizeof *s->child);
-    voxdagi_free(m, s->key, s->cap * sizeof *s->key);
-    voxdagi_free(m, s->count, s->cap * sizeof *s->count);
-    voxdagi_free(m, s->stab, s->cap * sizeof *s->stab);
+    voxdagi_free(m, s->node, s->cap * sizeof *s->node);
 }
 
 static void voxdagi_store_free(voxdagi_mem *m, voxdagi_store *s) {
@@ -1108,15 +1114,11 @@ static void voxdagi_store_free(voxdagi_mem *m, voxdagi_store *s) {
     memset(s, 0, sizeof *s);
 }
 
-static uint64_t voxdagi_store_count(const voxdagi_store *s, uint32_t id) {
-    return s->child ? s->count[id] : (uint64_t)voxdagi_popcount64(s->key[id]);
-}
-
 /* Whether node ID is (KEY, CHILD). An inner node's key is a function of
    its children, so they alone decide. */
 static int voxdagi_store_same(const voxdagi_store *s, uint32_t id, uint64_t key,
                               const uint32_t *child) {
-    return child ? !memcmp(s->child + 8 * (size_t)id, child, 8 * sizeof *child) : s->key[id] == key;
+    return child ? !memcmp(s->child + 8 * (size_t)id, child, 8 * sizeof *child) : s->node[id].key == key;
 }
 
 /* A slot holds id + 1 (below 2^26) and the hash's top 6 bits above it, so
@@ -1127,36 +1129,27 @@ static int voxdagi_store_same(const voxdagi_store *s, uint32_t id, uint64_t key,
 /* Doubles the capacity of every array of S, all or nothing. */
 static int voxdagi_store_reserve(voxdagi_mem *m, voxdagi_store *s, int inner) {
     size_t cap = s->cap ? s->cap * 2 : 256;
-    uint64_t *key = (uint64_t *)voxdagi_alloc(m, cap * sizeof *key);
-    uint64_t *stab = (uint64_t *)voxdagi_alloc(m, cap * sizeof *stab);
+    voxdagi_node *node = (voxdagi_node *)voxdagi_alloc(m, cap * sizeof *node);
     uint32_t *child = inner ? (uint32_t *)voxdagi_alloc(m, cap * 8 * sizeof *child) : NULL;
-    uint64_t *count = inner ? (uint64_t *)voxdagi_alloc(m, cap * sizeof *count) : NULL;
-    if (!key || !stab || (inner && (!child || !count))) {
-        voxdagi_free(m, key, cap * sizeof *key);
-        voxdagi_free(m, stab, cap * sizeof *stab);
+    if (!node || (inner && !child)) {
+        voxdagi_free(m, node, cap * sizeof *node);
         voxdagi_free(m, child, cap * 8 * sizeof *child);
-        voxdagi_free(m, count, cap * sizeof *count);
         return 0;
     }
     if (s->n) {
-        memcpy(key, s->key, s->n * sizeof *key);
-        memcpy(stab, s->stab, s->n * sizeof *stab);
-        if (inner) {
-            memcpy(child, s->child, s->n * 8 * sizeof *child);
-            memcpy(count, s->count, s->n * sizeof *count);
-        }
+        memcpy(node, s->node, s->n * sizeof *node);
+        if (inner) memcpy(child, s->child, s->n * 8 * sizeof *child);
     }
     voxdagi_store_free_arrays(m, s);
-    s->key = key;
-    s->stab = stab;
+    s->node = node;
     s->child = child;
-    s->count = count;
     s->cap = cap;
     return 1;
 }
 
-/* Finds the node (KEY, CHILD) or appends it. Returns its id, or VOXDAGI_NONE
-   when out of memory or ids. */
+/* Finds the node (KEY, CHILD) or appends it (with COUNT voxels; a brick's
+   are its mask's). Returns its id, or VOXDAGI_NONE when out of memory or
+   ids. */
 static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner,
                                      uint64_t key, const uint32_t *child,
                                      uint64_t count, uint64_t stab) {
@@ -1177,7 +1170,7 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
         if (!slot) return VOXDAGI_NONE;
         memset(slot, 0, count2 * sizeof *slot);
         for (j = 0; j < s->n; j++) {
-            uint64_t hj = inner ? s->key[j] : voxdagi_mix64(s->key[j]);
+            uint64_t hj = inner ? s->node[j].key : voxdagi_mix64(s->node[j].key);
             for (i = (size_t)hj & (count2 - 1); slot[i]; i = (i + 1) & (count2 - 1)) {}
             slot[i] = ((uint32_t)j + 1) | VOXDAGI_SLOT_TAG(hj);
         }
@@ -1187,12 +1180,10 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
     }
     if (s->n == s->cap && !voxdagi_store_reserve(m, s, inner)) return VOXDAGI_NONE;
     id = (uint32_t)s->n++;
-    s->key[id] = key;
-    s->stab[id] = stab;
-    if (inner) {
-        memcpy(s->child + 8 * (size_t)id, child, 8 * sizeof *child);
-        s->count[id] = count;
-    }
+    s->node[id].key = key;
+    s->node[id].stab = stab;
+    s->node[id].count = inner ? count : (uint64_t)voxdagi_popcount64(key);
+    if (inner) memcpy(s->child + 8 * (size_t)id, child, 8 * sizeof *child);
     mask = s->slot_count - 1;
     for (i = (size_t)h & mask; s->slot[i]; i = (i + 1) & mask) {}
     s->slot[i] = (id + 1) | tag;
@@ -1214,6 +1205,8 @@ typedef struct voxdagi_group {
     voxdagi_cube cube;
     uint8_t src[VOXDAGI_TRANSFORMS][8];      /* octant whose child lands in slot i: T^-1(i) */
     uint8_t mask8[VOXDAGI_TRANSFORMS][256];  /* a child-presence mask seen through T */
+    uint8_t least[256];                      /* per presence mask: its smallest image in the group */
+    uint64_t least_by[256];                  /* the transforms of the group giving it */
     unsigned count;
 } voxdagi_group;
 
@@ -1229,14 +1222,23 @@ static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
         }
     }
     g->count = symmetry == VOXDAG_SYMMETRY_NONE ? 1 : symmetry == VOXDAG_SYMMETRY_REFLECT ? 8 : 48;
+    for (x = 0; x < 256; x++) {
+        g->least[x] = 255;
+        g->least_by[x] = 0;
+        for (tf = 0; tf < g->count; tf++) {
+            if (g->mask8[tf][x] < g->least[x]) g->least[x] = g->mask8[tf][x], g->least_by[x] = 0;
+            if (g->mask8[tf][x] == g->least[x]) g->least_by[x] |= 1ull << tf;
+        }
+    }
 }
+
 
 /* The smallest tag of the coset T o S. */
 static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t stabs) {
     unsigned best = t;
     stabs &= ~1ull; /* the identity gives t itself */
     while (stabs) {
-        unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1), u = c->comp[t][s];
+        unsigned s = voxdagi_lowest_bit(stabs), u = c->comp[t][s];
         if (u < best) best = u;
         stabs &= stabs - 1;
     }
@@ -1251,28 +1253,24 @@ typedef struct voxdagi_canon {
 } voxdagi_canon;
 
 /* Bricks: the canonical form is the transform with the smallest occupancy
-   of its eight 2^3 cells (a table lookup per transform), then the smallest
-   mask; only the transforms that tie on occupancy move the 64 bits. */
+   of its eight 2^3 cells (a table lookup), then the smallest mask; only the
+   transforms that tie on occupancy move the 64 bits. */
 static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
     voxdagi_canon c;
-    uint64_t r[VOXDAGI_TRANSFORMS], tie = 0;
-    unsigned tf, best = 64, occ = 0, k, low = 256;
+    uint64_t cand, tie = 0, best_mask = 0; /* TIE: the candidates giving BEST_MASK */
+    unsigned tf, best = 0, occ = 0, k;
     for (k = 0; k < 8; k++) occ |= (unsigned)((mask >> 8 * k & 0xFF) != 0) << k;
-    for (tf = 0; tf < g->count; tf++) {
-        unsigned o = g->mask8[tf][occ];
-        if (o < low) low = o, tie = 0;
-        if (o == low) tie |= 1ull << tf;
+    for (cand = g->least_by[occ]; cand; cand &= cand - 1) {
+        uint64_t r;
+        tf = voxdagi_lowest_bit(cand);
+        r = tf ? voxdagi_transform_brick(&g->cube, mask, tf) : mask;
+        if (!tie || r < best_mask) best = tf, best_mask = r, tie = 0;
+        if (r == best_mask) tie |= 1ull << tf;
     }
-    for (tf = 0; tf < g->count; tf++) {
-        if (!(tie >> tf & 1)) continue;
-        r[tf] = tf ? voxdagi_transform_brick(&g->cube, mask, tf) : mask;
-        if (best == 64 || r[tf] < r[best]) best = tf;
-    }
-    c.key = r[best];
+    c.key = best_mask;
     c.tag = g->cube.inv[best];
     c.stab = 0;
-    for (tf = 0; tf < g->count; tf++)
-        if ((tie >> tf & 1) && r[tf] == r[best]) c.stab |= 1ull << g->cube.comp[tf][c.tag];
+    for (; tie; tie &= tie - 1) c.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(tie)][c.tag];
     return c;
 }
 
@@ -1310,20 +1308,19 @@ static int voxdagi_compare_transforms(const voxdagi_group *g, const voxdagi_chil
 static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_children *c,
                                         uint32_t slots[8]) {
     voxdagi_canon r;
-    unsigned tf, i, best = 0, best_present = 0x100;
+    unsigned i, best_present = g->least[c->present];
+    uint64_t cand = g->least_by[c->present], tie = cand & (0 - cand); /* TIE: the candidates equal to BEST */
+    unsigned best = voxdagi_lowest_bit(cand);
     uint64_t h = 0x9E3779B97F4A7C15ull;
-    for (tf = 0; tf < g->count; tf++) {
-        unsigned p = g->mask8[tf][c->present];
-        if (p < best_present || (p == best_present && voxdagi_compare_transforms(g, c, p, tf, best) < 0)) {
-            best_present = p;
-            best = tf;
-        }
+    for (cand &= cand - 1; cand; cand &= cand - 1) {
+        unsigned tf = voxdagi_lowest_bit(cand);
+        int order = voxdagi_compare_transforms(g, c, best_present, tf, best);
+        if (order < 0) best = tf, tie = 0;
+        if (order <= 0) tie |= 1ull << tf;
     }
     r.tag = g->cube.inv[best];
     r.stab = 0;
-    for (tf = 0; tf < g->count; tf++)
-        if (g->mask8[tf][c->present] == best_present && voxdagi_compare_transforms(g, c, best_present, tf, best) == 0)
-            r.stab |= 1ull << g->cube.comp[tf][r.tag];
+    for (; tie; tie &= tie - 1) r.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(tie)][r.tag];
     for (i = 0; i < 8; i++) {
         unsigned j = g->src[best][i], t;
         uint64_t v = 0;
@@ -1448,9 +1445,9 @@ static uint32_t voxdagi_reduce_node(voxdagi_reducer *r, uint32_t level, const ui
         c.present |= 1u << j;
         c.id[j] = ref[j] >> 6;
         c.tag[j] = ref[j] & 63;
-        c.stab[j] = cs->stab[c.id[j]];
-        c.fp[j] = cs->key[c.id[j]];
-        count += voxdagi_store_count(cs, c.id[j]);
+        c.stab[j] = cs->node[c.id[j]].stab;
+        c.fp[j] = cs->node[c.id[j]].key;
+        count += cs->node[c.id[j]].count;
     }
     k = voxdagi_canon_node(r->group, &c, slots);
     id = voxdagi_store_intern(r->mem, &r->store[level], 1, k.key, slots, count, k.stab);
@@ -2051,8 +2048,8 @@ static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map,
             if (!same) {
                 /* Canonical forms do not depend on ids (fingerprints decide),
                    so W's node is already canonical in R: intern it as is. */
-                id = voxdagi_store_intern(r->mem, &r->store[l], s->child != NULL, s->key[i], s->child ? c : NULL,
-                                          s->child ? s->count[i] : 0, s->stab[i]);
+                id = voxdagi_store_intern(r->mem, &r->store[l], s->child != NULL, s->node[i].key, s->child ? c : NULL,
+                                          s->node[i].count, s->node[i].stab);
                 ref = id == VOXDAGI_NONE ? id : id << 6;
             } else { /* a fingerprint collision made the orientations differ */
                 ref = voxdagi_reduce_node(r, l, c);
@@ -2922,7 +2919,7 @@ static int voxdagi_storage_order(voxdagi_mem *m, const voxdagi_store *s, const u
     int ok = key && tmp_key && tmp_id;
     if (ok) {
         for (i = 0; i < n; i++) {
-            key[i] = s->key[i];
+            key[i] = s->node[i].key;
             order[i] = (uint32_t)i;
             if (refs[i] > max_refs) max_refs = refs[i];
         }
@@ -3043,9 +3040,9 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
     const voxdagi_cube *c = e->cube;
     unsigned u = c->comp[rp][x & 63], rc_inv = c->inv[e->orient[l + 1][x >> 6]];
     unsigned best = c->comp[u][rc_inv];
-    uint64_t stabs = e->r->store[l + 1].stab[x >> 6] & ~1ull;
+    uint64_t stabs = e->r->store[l + 1].node[x >> 6].stab & ~1ull;
     while (stabs) {
-        unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1), v = c->comp[c->comp[u][s]][rc_inv];
+        unsigned s = voxdagi_lowest_bit(stabs), v = c->comp[c->comp[u][s]][rc_inv];
         if (v < best) best = v;
         stabs &= stabs - 1;
     }
@@ -3093,9 +3090,9 @@ static int voxdagi_orient(voxdagi_encoder *e) {
             uint64_t k;
             memset(votes, 0, sizeof votes);
             for (k = first[i]; k < first[i + 1]; k++) {
-                uint64_t stabs = s->stab[i];
+                uint64_t stabs = s->node[i].stab;
                 while (stabs) {
-                    votes[c->comp[seen[k]][voxdagi_popcount64((stabs & (0 - stabs)) - 1)]]++;
+                    votes[c->comp[seen[k]][voxdagi_lowest_bit(stabs)]]++;
                     stabs &= stabs - 1;
                 }
             }
@@ -3126,7 +3123,7 @@ static void voxdagi_count_widths(voxdagi_encoder *e) {
         uint64_t max_count = 0, bits;
         size_t i;
         for (i = 0; i < s->n; i++)
-            if (s->count[i] > max_count) max_count = s->count[i];
+            if (s->node[i].count > max_count) max_count = s->node[i].count;
         for (i = 0; i < 8 * s->n; i++) estimate += s->child[i] != VOXDAGI_NONE ? 16u : 0u;
         e->count_bits[l] = l + 1 < brick_level ? voxdagi_bit_length(max_count) : 0;
         bits = (uint64_t)s->n * e->count_bits[l];
@@ -3187,7 +3184,7 @@ static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id
     unsigned tag[8], header = 0, j;
     uint64_t bits = 16 + e->count_bits[l], base, v = 0;
     voxdagi_stored_children(e, l, id, child, tag);
-    if (p) voxdagi_put_bits(p, 16, e->r->store[l].count[id], e->count_bits[l]);
+    if (p) voxdagi_put_bits(p, 16, e->r->store[l].node[id].count, e->count_bits[l]);
     base = voxdagi_private_base(e, l, child);
     if (base != UINT64_MAX) {
         if (p) voxdagi_put_bits(p, bits, base, cls->base_bits);
@@ -3381,9 +3378,9 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         const voxdagi_cube *c = e->cube;
         uint32_t x = r->root;
         unsigned best = c->comp[x & 63][c->inv[e->orient[0][x >> 6]]];
-        uint64_t stabs = r->store[0].stab[x >> 6];
+        uint64_t stabs = r->store[0].node[x >> 6].stab;
         while (stabs) {
-            unsigned s = (unsigned)voxdagi_popcount64((stabs & (0 - stabs)) - 1);
+            unsigned s = voxdagi_lowest_bit(stabs);
             unsigned v = c->comp[c->comp[x & 63][s]][c->inv[e->orient[0][x >> 6]]];
             if (v < best) best = v;
             stabs &= stabs - 1;
@@ -3431,7 +3428,7 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
     }
     for (i = 0; i < r->store[brick_level].n; i++) {
         uint32_t id = e->order[brick_level][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[brick_level].key[id], e->orient[brick_level][id]), 8);
+        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[brick_level].node[id].key, e->orient[brick_level][id]), 8);
     }
 }
 
@@ -4148,7 +4145,7 @@ static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const vox
                 unsigned a;
                 if (l == brick_level) { /* a voxel of the brick */
                     uint32_t x, y, z;
-                    if (!(s->key[i] >> k & 1)) continue;
+                    if (!(s->node[i].key >> k & 1)) continue;
                     voxdag_morton_decode(k, &x, &y, &z);
                     cb[0] = x, cb[1] = y, cb[2] = z, cb[3] = x + 1, cb[4] = y + 1, cb[5] = z + 1;
                 } else { /* a child's box, transformed and moved to its octant */
@@ -4506,7 +4503,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         if ((uint32_t)depth == brick_level) { /* a brick, in world order */
             uint64_t mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, f->at), f->mi);
             while (mask) {
-                unsigned p = (unsigned)voxdagi_popcount64((mask & (0 - mask)) - 1);
+                unsigned p = voxdagi_lowest_bit(mask);
                 uint32_t bx, by, bz;
                 voxdag_morton_decode(p, &bx, &by, &bz);
                 if (fn && fn(user, f->x + bx, f->y + by, f->z + bz, index)) return index + 1;
