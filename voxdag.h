@@ -3057,6 +3057,7 @@ static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     const voxdagi_cube *c = e->cube;
     uint32_t brick_level = e->levels - 2, l;
+    uint64_t votes[VOXDAGI_TRANSFORMS];
     for (l = 0; l <= brick_level; l++) {
         const voxdagi_store *s = &r->store[l], *ps = l ? &r->store[l - 1] : NULL;
         size_t n = s->n, i, p, total = l ? 0 : 1;
@@ -3085,20 +3086,20 @@ static int voxdagi_orient(voxdagi_encoder *e) {
         }
         for (i = n; i > 0; i--) first[i] = first[i - 1]; /* back to the starts */
         first[0] = 0;
-        for (i = 0; i < n; i++) {
-            unsigned votes[VOXDAGI_TRANSFORMS], tf, best = 0;
-            uint64_t k;
-            memset(votes, 0, sizeof votes);
-            for (k = first[i]; k < first[i + 1]; k++) {
-                uint64_t stabs = s->node[i].stab;
-                while (stabs) {
-                    votes[c->comp[seen[k]][voxdagi_lowest_bit(stabs)]]++;
-                    stabs &= stabs - 1;
+        memset(votes, 0, sizeof votes);
+        for (i = 0; i < n; i++) { /* BEST: the smallest transform with the most votes so far */
+            unsigned best = 0;
+            uint64_t k, stabs;
+            for (k = first[i]; k < first[i + 1]; k++)
+                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1) {
+                    unsigned tf = c->comp[seen[k]][voxdagi_lowest_bit(stabs)];
+                    votes[tf]++;
+                    if (votes[tf] > votes[best] || (votes[tf] == votes[best] && tf < best)) best = tf;
                 }
-            }
-            for (tf = 1; tf < VOXDAGI_TRANSFORMS; tf++)
-                if (votes[tf] > votes[best]) best = tf;
             e->orient[l][i] = (uint8_t)best;
+            for (k = first[i]; k < first[i + 1]; k++) /* back to no votes */
+                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1)
+                    votes[c->comp[seen[k]][voxdagi_lowest_bit(stabs)]] = 0;
         }
         voxdagi_free(e->mem, seen, total);
         voxdagi_free(e->mem, first, (n + 1) * sizeof *first);
