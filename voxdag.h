@@ -1253,24 +1253,34 @@ typedef struct voxdagi_canon {
 } voxdagi_canon;
 
 /* Bricks: the canonical form is the transform with the smallest occupancy
-   of its eight 2^3 cells (a table lookup), then the smallest mask; only the
-   transforms that tie on occupancy move the 64 bits. */
+   of its eight 2^3 cells (a table lookup), then the smallest mask, compared
+   a byte (a cell) at a time from the top: T puts cell T^-1(k), its bits
+   moved like octants, at byte k. Those left after the last byte give the
+   same mask. */
 static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) {
     voxdagi_canon c;
-    uint64_t cand, tie = 0, best_mask = 0; /* TIE: the candidates giving BEST_MASK */
-    unsigned tf, best = 0, occ = 0, k;
-    for (k = 0; k < 8; k++) occ |= (unsigned)((mask >> 8 * k & 0xFF) != 0) << k;
-    for (cand = g->least_by[occ]; cand; cand &= cand - 1) {
-        uint64_t r;
-        tf = voxdagi_lowest_bit(cand);
-        r = tf ? voxdagi_transform_brick(&g->cube, mask, tf) : mask;
-        if (!tie || r < best_mask) best = tf, best_mask = r, tie = 0;
-        if (r == best_mask) tie |= 1ull << tf;
+    uint64_t cand;
+    unsigned cell[8], occ = 0, k, best;
+    for (k = 0; k < 8; k++) {
+        cell[k] = (unsigned)(mask >> 8 * k & 0xFF);
+        occ |= (unsigned)(cell[k] != 0) << k;
     }
-    c.key = best_mask;
+    cand = g->least_by[occ];
+    for (k = 8; k-- > 0 && (cand & (cand - 1));) {
+        uint64_t rest, keep = 0;
+        unsigned low = 256;
+        for (rest = cand; rest; rest &= rest - 1) {
+            unsigned tf = voxdagi_lowest_bit(rest), v = g->mask8[tf][cell[g->src[tf][k]]];
+            if (v < low) low = v, keep = 0;
+            if (v == low) keep |= 1ull << tf;
+        }
+        cand = keep;
+    }
+    best = voxdagi_lowest_bit(cand);
+    c.key = best ? voxdagi_transform_brick(&g->cube, mask, best) : mask;
     c.tag = g->cube.inv[best];
     c.stab = 0;
-    for (; tie; tie &= tie - 1) c.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(tie)][c.tag];
+    for (; cand; cand &= cand - 1) c.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(cand)][c.tag];
     return c;
 }
 
