@@ -1045,19 +1045,37 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
 }
 
 #ifndef VOXDAG_NO_BUILD
+/* The Morton positions p of a 4^3 brick with bit k of p clear. */
+static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
+                                                    0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
+                                                    0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
+
 /* Reflecting a 4^3 brick by m moves Morton position p to p ^ (m | m << 3):
    one swap stage per set bit. */
 static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
-    static const uint64_t keep[6] = {0x5555555555555555ull, 0x3333333333333333ull,
-                                     0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
-                                     0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
     unsigned c = m | m << 3, k;
     for (k = 0; k < 6; k++)
         if (c >> k & 1) {
             unsigned s = 1u << k;
-            x = (x & keep[k]) << s | ((x >> s) & keep[k]);
+            uint64_t keep = voxdagi_brick_bit_clear[k];
+            x = (x & keep) << s | ((x >> s) & keep);
         }
     return x;
+}
+
+/* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
+   brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
+static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
+    unsigned a, v;
+    for (a = 0; a < 3; a++) {
+        box[a] = 4, box[a + 3] = 0;
+        for (v = 0; v < 4; v++) {
+            uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
+            if (!(mask & (v & 1 ? ~lo : lo) & (v & 2 ? ~hi : hi))) continue;
+            if (v < box[a]) box[a] = v;
+            box[a + 3] = v + 1;
+        }
+    }
 }
 
 /* Transforming a 4^3 brick by T moves the voxel at Morton position p to T(p):
@@ -4152,22 +4170,18 @@ static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const vox
             uint32_t *o = cur + 6 * i, half = 1u << (r->levels - l - 1), cb[6];
             o[0] = o[1] = o[2] = UINT32_MAX;
             o[3] = o[4] = o[5] = 0;
-            for (k = 0; k < (l == brick_level ? 64u : 8u); k++) {
+            if (l == brick_level) {
+                voxdagi_brick_box(s->node[i].key, o);
+                continue;
+            }
+            for (k = 0; k < 8; k++) { /* each child's box, transformed and moved to its octant */
+                uint32_t x = s->child[8 * i + k];
                 unsigned a;
-                if (l == brick_level) { /* a voxel of the brick */
-                    uint32_t x, y, z;
-                    if (!(s->node[i].key >> k & 1)) continue;
-                    voxdag_morton_decode(k, &x, &y, &z);
-                    cb[0] = x, cb[1] = y, cb[2] = z, cb[3] = x + 1, cb[4] = y + 1, cb[5] = z + 1;
-                } else { /* a child's box, transformed and moved to its octant */
-                    uint32_t x = s->child[8 * i + k];
-                    if (x == VOXDAGI_NONE) continue;
-                    memcpy(cb, below + 6 * (size_t)(x >> 6), sizeof cb);
-                    voxdagi_box_transform(c, cb, x & 63, half);
-                    for (a = 0; a < 3; a++)
-                        if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
-                }
+                if (x == VOXDAGI_NONE) continue;
+                memcpy(cb, below + 6 * (size_t)(x >> 6), sizeof cb);
+                voxdagi_box_transform(c, cb, x & 63, half);
                 for (a = 0; a < 3; a++) {
+                    if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
                     if (cb[a] < o[a]) o[a] = cb[a];
                     if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
                 }
