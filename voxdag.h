@@ -834,7 +834,13 @@ VOXDAGI_INLINE unsigned voxdagi_bit_length(uint64_t v) {
 }
 
 /* The position of the lowest set bit of X (X != 0). */
-VOXDAGI_INLINE unsigned voxdagi_lowest_bit(uint64_t x) { return (unsigned)voxdagi_popcount64((x & (0 - x)) - 1); }
+VOXDAGI_INLINE unsigned voxdagi_lowest_bit(uint64_t x) {
+#if defined(__GNUC__) || defined(__clang__)
+    return (unsigned)__builtin_ctzll(x);
+#else
+    return (unsigned)voxdagi_popcount64((x & (0 - x)) - 1);
+#endif
+}
 
 /* Bit i of a byte moved to bit 3i, for all 256 bytes, built by the
    preprocessor. */
@@ -2977,19 +2983,46 @@ static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigne
     return best;
 }
 
+/* The pointer bits of a level under classes X[0..2] ({target bits, code
+   bits} each; repeats allowed), every pointer in the narrowest class that
+   holds it, or UINT64_MAX when one fits none. MASS[ob][kb] counts the
+   pointers of at most ob target and kb code bits, so a class holds the
+   pointers of a rectangle anchored at (0, 0); the narrowest class takes its
+   rectangle, the next its own less the overlap, and so on (inclusion and
+   exclusion; overlaps of such rectangles are such rectangles). */
+static uint64_t voxdagi_classes_cost(uint64_t mass[58][7], const unsigned *x[3]) {
+    const unsigned *w[3], *t;
+    uint64_t m[3];
+    unsigned i, j;
+#define VOXDAGI_MASS(p, q) mass[(p)[0] < (q)[0] ? (p)[0] : (q)[0]][(p)[1] < (q)[1] ? (p)[1] : (q)[1]]
+    for (i = 0; i < 3; i++) /* by width */
+        for (w[i] = x[i], j = i; j > 0 && w[j][0] + w[j][1] < w[j - 1][0] + w[j - 1][1]; j--)
+            t = w[j], w[j] = w[j - 1], w[j - 1] = t;
+    m[0] = mass[w[0][0]][w[0][1]];
+    m[1] = mass[w[1][0]][w[1][1]] - VOXDAGI_MASS(w[0], w[1]);
+    m[2] = mass[w[2][0]][w[2][1]] - VOXDAGI_MASS(w[2], w[0]) - VOXDAGI_MASS(w[2], w[1]);
+    {
+        unsigned p = w[0][0] < w[1][0] ? w[0][0] : w[1][0], q = w[0][1] < w[1][1] ? w[0][1] : w[1][1];
+        m[2] += mass[p < w[2][0] ? p : w[2][0]][q < w[2][1] ? q : w[2][1]];
+    }
+#undef VOXDAGI_MASS
+    if (m[0] + m[1] + m[2] != mass[57][6]) return UINT64_MAX;
+    return m[0] * (w[0][0] + w[0][1]) + m[1] * (w[1][0] + w[1][1]) + m[2] * (w[2][0] + w[2][1]);
+}
+
 /* Chooses N (2 or 3) classes for the fewest pointer bits, given how many
    pointers need OB target bits and KB code bits (HIST[ob][kb]). Candidate
    classes take a target width that occurs and any code width up to the
-   largest. */
+   largest; the first cheapest set in candidate order wins. */
 static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_classes *best) {
-    unsigned cand[7 * 58][2], cell[58 * 7][2], nc = 0, ncell = 0, ob, kb, kmax = 0, a, b, c, i, widest;
-    uint64_t best_cost = UINT64_MAX;
+    unsigned cand[7 * 58][2], nc = 0, ob, kb, kmax = 0, a, b, c, widest;
+    uint64_t best_cost = UINT64_MAX, mass[58][7];
     for (ob = 0; ob < 58; ob++)
-        for (kb = 0; kb < 7; kb++)
-            if (hist[ob][kb]) {
-                cell[ncell][0] = ob, cell[ncell][1] = kb, ncell++;
-                if (kb > kmax) kmax = kb;
-            }
+        for (kb = 0; kb < 7; kb++) {
+            mass[ob][kb] = hist[ob][kb] + (ob ? mass[ob - 1][kb] : 0) + (kb ? mass[ob][kb - 1] : 0) -
+                           (ob && kb ? mass[ob - 1][kb - 1] : 0);
+            if (hist[ob][kb] && kb > kmax) kmax = kb;
+        }
     for (ob = 0; ob < 58; ob++) {
         int any = 0;
         for (kb = 0; kb < 7; kb++) any |= hist[ob][kb] != 0;
@@ -3002,30 +3035,19 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_cla
        (candidates run by target width) comes from the last KMAX + 1. */
     widest = nc ? nc - kmax - 1 : 0;
     for (a = 0; a < nc; a++)
-        for (b = a; b < nc; b++) {
-            unsigned char pair[58 * 7]; /* per cell: the narrower of classes a and b that holds it, 255 none */
-            if (n == 2 && b < widest) continue;
-            for (i = 0; i < ncell; i++) {
-                unsigned wa = cand[a][0] >= cell[i][0] && cand[a][1] >= cell[i][1] ? cand[a][0] + cand[a][1] : 255;
-                unsigned wb = cand[b][0] >= cell[i][0] && cand[b][1] >= cell[i][1] ? cand[b][0] + cand[b][1] : 255;
-                pair[i] = (unsigned char)(wa < wb ? wa : wb);
-            }
+        for (b = n == 2 && a < widest ? widest : a; b < nc; b++)
             for (c = n == 3 && b < widest ? widest : b; c < (n == 3 ? nc : b + 1); c++) {
-                uint64_t cost = 0;
-                for (i = 0; i < ncell; i++) {
-                    unsigned w = cand[c][0] >= cell[i][0] && cand[c][1] >= cell[i][1] ? cand[c][0] + cand[c][1] : 255;
-                    if (pair[i] < w) w = pair[i];
-                    if (w == 255) break;
-                    cost += hist[cell[i][0]][cell[i][1]] * w;
-                }
-                if (i == ncell && cost < best_cost) {
+                const unsigned *x[3];
+                uint64_t cost;
+                x[0] = cand[a], x[1] = cand[b], x[2] = cand[c];
+                cost = voxdagi_classes_cost(mass, x);
+                if (cost < best_cost) {
                     best_cost = cost;
                     best->target_bits[1] = (unsigned char)cand[a][0], best->code_bits[1] = (unsigned char)cand[a][1];
                     best->target_bits[2] = (unsigned char)cand[b][0], best->code_bits[2] = (unsigned char)cand[b][1];
                     best->target_bits[3] = (unsigned char)cand[c][0], best->code_bits[3] = (unsigned char)cand[c][1];
                 }
             }
-        }
     if (n == 2) best->target_bits[3] = best->code_bits[3] = 0;
 }
 
