@@ -2551,6 +2551,7 @@ static void voxdagi_chunk_free(voxdagi_chunk *c) {
    seven axes decide each of those (the box normals hold by the ranges). */
 static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxdagi_axes *x, uint32_t tri,
                               const int64_t clo[3]) {
+    int (*keep)(void *, size_t, const double *) = c->mesh->keep; /* not reloaded after each store */
     unsigned w = 2, u, v, k, j, per_voxel[7], col[3];
     int64_t first[3], last[3], i, jj, q;
     for (k = 0; k < 3; k++) {
@@ -2591,19 +2592,19 @@ static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxd
             local[u] = (uint32_t)(i - clo[u]);
             local[v] = (uint32_t)(jj - clo[v]);
             local[w] = 0;
-            uv = voxdag_morton_encode(local[0], local[1], local[2]);
+            uv = voxdagi_spread3(local[0]) | voxdagi_spread3(local[1]) << 1 | voxdagi_spread3(local[2]) << 2;
             for (q = (int64_t)-voxdagi_floor(-qlo); q <= (int64_t)voxdagi_floor(qhi); q++) {
                 uint64_t code;
                 p[w] = (double)q;
                 for (j = 0; j < 7 && voxdagi_axes_test(x, p, per_voxel[j]); j++) continue;
                 if (j < 7) continue;
-                if (c->mesh->keep) { /* the voxel centre's point on the triangle */
+                if (keep) { /* the voxel centre's point on the triangle */
                     double centre[3], bary[3];
                     for (k = 0; k < 3; k++) centre[k] = p[k] + 0.5;
                     voxdagi_tri_bary(t, centre, bary);
-                    if (!c->mesh->keep(c->mesh->user, tri, bary)) continue;
+                    if (!keep(c->mesh->user, tri, bary)) continue;
                 }
-                code = uv | voxdag_morton_encode((uint32_t)(q - clo[w]), 0, 0) << w;
+                code = uv | voxdagi_spread3((uint32_t)(q - clo[w])) << w;
                 c->bits[code >> 6] |= 1ull << (code & 63);
                 c->used[code >> 12] |= 1ull << ((code >> 6) & 63);
                 if (c->owner) c->owner[code] = tri;
