@@ -2549,11 +2549,38 @@ static void voxdagi_chunk_free(voxdagi_chunk *c) {
    axis w: the three axes without a w component are tested once per column,
    the plane bounds the column to the few voxels it crosses, and the other
    seven axes decide each of those (the box normals hold by the ranges). */
+/* Sets the voxels of column P (P[w] varies over [QLO, QHI]) that the
+   triangle's box test passes and KEEP, when not NULL, keeps; UV: the
+   column's Morton bits. */
+VOXDAGI_INLINE void voxdagi_chunk_column(voxdagi_chunk *c, const voxdagi_tri *t, const voxdagi_axes *x, uint32_t tri,
+                                         double p[3], unsigned w, double qlo, double qhi, int64_t clo_w, uint64_t uv,
+                                         const unsigned per_voxel[7],
+                                         int (*keep)(void *user, size_t triangle, const double bary[3])) {
+    int64_t q;
+    unsigned j, k;
+    for (q = (int64_t)-voxdagi_floor(-qlo); q <= (int64_t)voxdagi_floor(qhi); q++) {
+        uint64_t code;
+        p[w] = (double)q;
+        for (j = 0; j < 7 && voxdagi_axes_test(x, p, per_voxel[j]); j++) continue;
+        if (j < 7) continue;
+        if (keep) { /* the voxel centre's point on the triangle */
+            double centre[3], bary[3];
+            for (k = 0; k < 3; k++) centre[k] = p[k] + 0.5;
+            voxdagi_tri_bary(t, centre, bary);
+            if (!keep(c->mesh->user, tri, bary)) continue;
+        }
+        code = uv | voxdagi_spread3((uint32_t)(q - clo_w)) << w;
+        c->bits[code >> 6] |= 1ull << (code & 63);
+        c->used[code >> 12] |= 1ull << ((code >> 6) & 63);
+        if (c->owner) c->owner[code] = tri;
+    }
+}
+
 static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxdagi_axes *x, uint32_t tri,
                               const int64_t clo[3]) {
-    int (*keep)(void *, size_t, const double *) = c->mesh->keep; /* not reloaded after each store */
+    int (*keep)(void *, size_t, const double *) = c->mesh->keep;
     unsigned w = 2, u, v, k, j, per_voxel[7], col[3];
-    int64_t first[3], last[3], i, jj, q;
+    int64_t first[3], last[3], i, jj;
     for (k = 0; k < 3; k++) {
         int64_t lim = clo[k] + ((int64_t)1 << c->shift);
         if (!voxdagi_voxel_range(t->lo[k], t->hi[k], lim, &first[k], &last[k]) || last[k] < clo[k]) return;
@@ -2593,22 +2620,9 @@ static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxd
             local[v] = (uint32_t)(jj - clo[v]);
             local[w] = 0;
             uv = voxdagi_spread3(local[0]) | voxdagi_spread3(local[1]) << 1 | voxdagi_spread3(local[2]) << 2;
-            for (q = (int64_t)-voxdagi_floor(-qlo); q <= (int64_t)voxdagi_floor(qhi); q++) {
-                uint64_t code;
-                p[w] = (double)q;
-                for (j = 0; j < 7 && voxdagi_axes_test(x, p, per_voxel[j]); j++) continue;
-                if (j < 7) continue;
-                if (keep) { /* the voxel centre's point on the triangle */
-                    double centre[3], bary[3];
-                    for (k = 0; k < 3; k++) centre[k] = p[k] + 0.5;
-                    voxdagi_tri_bary(t, centre, bary);
-                    if (!keep(c->mesh->user, tri, bary)) continue;
-                }
-                code = uv | voxdagi_spread3((uint32_t)(q - clo[w])) << w;
-                c->bits[code >> 6] |= 1ull << (code & 63);
-                c->used[code >> 12] |= 1ull << ((code >> 6) & 63);
-                if (c->owner) c->owner[code] = tri;
-            }
+            /* the call of a keep callback would cost the loop its registers */
+            if (keep) voxdagi_chunk_column(c, t, x, tri, p, w, qlo, qhi, clo[w], uv, per_voxel, keep);
+            else voxdagi_chunk_column(c, t, x, tri, p, w, qlo, qhi, clo[w], uv, per_voxel, NULL);
         }
 }
 
