@@ -3221,49 +3221,52 @@ static void voxdagi_stored_children(const voxdagi_encoder *e, uint32_t l, uint32
         if (ch[j] != VOXDAGI_NONE) child[act[j]] = ch[j], tag[act[j]] = e->tag[l][8 * (size_t)id + j];
 }
 
-/* The base of a record with stored children CHILD: its first private
-   child's offset, or UINT64_MAX when it has none. */
-static uint64_t voxdagi_private_base(const voxdagi_encoder *e, uint32_t l, const uint32_t child[8]) {
+/* The base of the record of node ID of inner level L: the offset of its
+   first private child (in stored octant order, which is also storage order,
+   so the lowest), or UINT64_MAX when it has none. */
+static uint64_t voxdagi_private_base(const voxdagi_encoder *e, uint32_t l, uint32_t id) {
+    const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
+    uint64_t base = UINT64_MAX;
     unsigned j;
     for (j = 0; j < 8; j++)
-        if (child[j] != VOXDAGI_NONE && voxdagi_is_private(e, l, child[j])) return e->pos[l + 1][child[j] >> 6];
-    return UINT64_MAX;
-}
-
-/* The tag of pointer X with stored transform TAG in a record of inner level
-   L, and its bits in *VALUE (target << K | code) unless it is private. */
-static unsigned voxdagi_pointer(const voxdagi_encoder *e, uint32_t l, uint32_t x, unsigned tag, uint64_t *value) {
-    const voxdagi_classes *c = &e->cls[l];
-    uint64_t target = e->pos[l + 1][x >> 6];
-    unsigned code = e->code[l][tag], t;
-    if (voxdagi_is_private(e, l, x)) return 3;
-    t = e->class_of[l][voxdagi_bit_length(target)][voxdagi_bit_length(code)];
-    *value = target << c->code_bits[t] | code;
-    return t;
+        if (ch[j] != VOXDAGI_NONE && voxdagi_is_private(e, l, ch[j]) && e->pos[l + 1][ch[j] >> 6] < base)
+            base = e->pos[l + 1][ch[j] >> 6];
+    return base;
 }
 
 /* The record of node ID of inner level L under the level's plan: its bits,
    and the record itself written at P (zeroed) unless P is NULL. */
 static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint8_t *p) {
     const voxdagi_classes *cls = &e->cls[l];
-    uint32_t child[8];
-    unsigned tag[8], header = 0, j;
-    uint64_t bits = 16 + e->count_bits[l], base, v = 0;
-    voxdagi_stored_children(e, l, id, child, tag);
+    const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
+    const uint8_t *act = e->cube->act[e->orient[l][id]], *tags = e->tag[l] + 8 * (size_t)id;
+    uint64_t target[8], bits = 16 + e->count_bits[l], base = voxdagi_private_base(e, l, id);
+    unsigned code[8], present = 0, private_children = 0, header = 0, j, s;
+    for (j = 0; j < 8; j++) { /* canonical child j sits in stored octant R(j) */
+        if (ch[j] == VOXDAGI_NONE) continue;
+        s = act[j];
+        present |= 1u << s;
+        target[s] = e->pos[l + 1][ch[j] >> 6];
+        code[s] = e->code[l][tags[j]];
+        if (voxdagi_is_private(e, l, ch[j])) private_children |= 1u << s;
+    }
     if (p) voxdagi_put_bits(p, 16, e->r->store[l].node[id].count, e->count_bits[l]);
-    base = voxdagi_private_base(e, l, child);
-    if (base != UINT64_MAX) {
+    if (private_children) {
         if (p) voxdagi_put_bits(p, bits, base, cls->base_bits);
         bits += cls->base_bits;
     }
-    for (j = 0; j < 8; j++) {
-        unsigned t;
-        if (child[j] == VOXDAGI_NONE) continue;
-        t = voxdagi_pointer(e, l, child[j], tag[j], &v);
-        header |= t << (2 * j);
-        if (t == 3 && cls->classes == 2) continue;
-        if (p) voxdagi_put_bits(p, bits, v, cls->target_bits[t] + cls->code_bits[t]);
-        bits += cls->target_bits[t] + cls->code_bits[t];
+    for (s = 0; s < 8; s++) {
+        unsigned t, width;
+        if (!(present >> s & 1)) continue;
+        if (private_children >> s & 1) {
+            header |= 3u << (2 * s);
+            continue;
+        }
+        t = e->class_of[l][voxdagi_bit_length(target[s])][voxdagi_bit_length(code[s])];
+        width = cls->target_bits[t] + cls->code_bits[t];
+        header |= t << (2 * s);
+        if (p) voxdagi_put_bits(p, bits, target[s] << cls->code_bits[t] | code[s], width);
+        bits += width;
     }
     if (p) voxdagi_put_le(p, header, 2);
     return bits;
@@ -3305,11 +3308,7 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
     cls->classes = (unsigned char)n;
     for (k = 0; k < 58 * 7; k++) e->class_of[l][k / 7][k % 7] = (uint8_t)voxdagi_class_for(cls, k / 7, k % 7);
     for (i = 0; n == 2 && i < s->n; i++) {
-        uint32_t child[8];
-        unsigned tag[8];
-        uint64_t base;
-        voxdagi_stored_children(e, l, (uint32_t)i, child, tag);
-        base = voxdagi_private_base(e, l, child);
+        uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
         if (base != UINT64_MAX && base > max_base) max_base = base;
     }
     cls->base_bits = (unsigned char)voxdagi_bit_length(max_base);
