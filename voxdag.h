@@ -3028,8 +3028,9 @@ static uint64_t voxdagi_classes_cost(uint64_t mass[58][7], const unsigned *x[3])
 /* Chooses N (2 or 3) classes for the fewest pointer bits, given how many
    pointers need OB target bits and KB code bits (HIST[ob][kb]). Candidate
    classes take a target width that occurs and any code width up to the
-   largest; the first cheapest set in candidate order wins. */
-static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_classes *best) {
+   largest; the first cheapest set in candidate order wins. Returns its
+   pointer bits. */
+static uint64_t voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_classes *best) {
     unsigned cand[7 * 58][2], nc = 0, ob, kb, kmax = 0, a, b, c, widest;
     uint64_t best_cost = UINT64_MAX, mass[58][7];
     for (ob = 0; ob < 58; ob++)
@@ -3064,6 +3065,7 @@ static void voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi_cla
                 }
             }
     if (n == 2) best->target_bits[3] = best->code_bits[3] = 0;
+    return nc ? best_cost : 0;
 }
 
 typedef struct voxdagi_encoder {
@@ -3273,12 +3275,13 @@ static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id
 }
 
 /* Chooses inner level L's transform table, N pointer classes (2: private
-   children, with the base width) for the fewest bits. Returns 0 when a
-   pointer or a base needs more than 57 bits. */
-static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
+   children, with the base width) for the fewest bits; *BITS: the bits of
+   its records without padding (the level's bytes are at least an eighth of
+   them). Returns 0 when a pointer or a base needs more than 57 bits. */
+static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint64_t *bits) {
     const voxdagi_store *s = &e->r->store[l];
     voxdagi_classes *cls = &e->cls[l];
-    uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0;
+    uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0, bases = 0;
     unsigned tf, k, len = 0;
     size_t i;
     cls->classes = (unsigned char)n;
@@ -3304,14 +3307,16 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n) {
         if (ob + kb > 57) return 0;
         hist[ob][kb]++;
     }
-    voxdagi_choose_classes(hist, n, cls);
+    *bits = (16 + e->count_bits[l]) * (uint64_t)s->n + voxdagi_choose_classes(hist, n, cls);
     cls->classes = (unsigned char)n;
     for (k = 0; k < 58 * 7; k++) e->class_of[l][k / 7][k % 7] = (uint8_t)voxdagi_class_for(cls, k / 7, k % 7);
     for (i = 0; n == 2 && i < s->n; i++) {
         uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
+        if (base != UINT64_MAX) bases++;
         if (base != UINT64_MAX && base > max_base) max_base = base;
     }
     cls->base_bits = (unsigned char)voxdagi_bit_length(max_base);
+    *bits += bases * cls->base_bits;
     return cls->base_bits <= 57;
 }
 
@@ -3350,30 +3355,41 @@ static void voxdagi_plan_swap(voxdagi_encoder *e, uint32_t l, voxdagi_level_plan
 /* Plans inner level L bottom-up (pointer widths depend on where the next
    level put its nodes): with private children when the next level has
    candidates and they make the level smaller, else with three classes.
-   Returns 0 when out of memory or when no plan holds the pointers. */
+   The plan with fewer record bits is laid out first; the other only when
+   its bits (its bytes are at least an eighth of them) do not already show
+   it larger. Returns 0 when out of memory or when no plan holds the
+   pointers. */
 static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
     size_t n = e->r->store[l].n;
-    voxdagi_level_plan three;
-    uint64_t size3 = 0, size2, *pos3;
-    int ok2, ok3 = voxdagi_choose_level(e, l, 3);
-    if (ok3) size3 = voxdagi_level_offsets(e, l);
-    e->size[l] = size3;
-    if (!candidates) return ok3;
-    pos3 = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof *pos3);
-    if (!pos3) return 0;
-    if (ok3) memcpy(pos3, e->pos[l], n * sizeof *pos3);
-    memset(&three, 0, sizeof three);
-    voxdagi_plan_swap(e, l, &three); /* THREE now holds the three-class plan */
-    ok2 = voxdagi_choose_level(e, l, 2);
-    size2 = ok2 ? voxdagi_level_offsets(e, l) : 0;
-    if (ok2 && (!ok3 || size2 < size3)) {
-        e->size[l] = size2;
-    } else if (ok3) { /* back to the three-class plan and its offsets */
-        voxdagi_plan_swap(e, l, &three);
-        memcpy(e->pos[l], pos3, n * sizeof *pos3);
+    voxdagi_level_plan other;
+    uint64_t bits[4], size[4], *first_pos;
+    int ok[4], first, second;
+    ok[3] = voxdagi_choose_level(e, l, 3, &bits[3]);
+    if (!candidates) {
+        if (ok[3]) e->size[l] = voxdagi_level_offsets(e, l);
+        return ok[3];
     }
-    voxdagi_free(e->mem, pos3, n * sizeof *pos3);
-    return ok2 || ok3;
+    memset(&other, 0, sizeof other);
+    voxdagi_plan_swap(e, l, &other); /* OTHER holds the three-class plan */
+    ok[2] = voxdagi_choose_level(e, l, 2, &bits[2]);
+    if (!ok[2] && !ok[3]) return 0;
+    first = ok[2] && (!ok[3] || bits[2] <= bits[3]) ? 2 : 3;
+    second = 5 - first;
+    if (first == 3) voxdagi_plan_swap(e, l, &other);
+    e->size[l] = size[first] = voxdagi_level_offsets(e, l);
+    if (!ok[second] || 8 * size[first] < bits[second]) return 1;
+    first_pos = (uint64_t *)voxdagi_alloc(e->mem, n * sizeof *first_pos);
+    if (!first_pos) return 0;
+    memcpy(first_pos, e->pos[l], n * sizeof *first_pos);
+    voxdagi_plan_swap(e, l, &other);
+    e->size[l] = size[second] = voxdagi_level_offsets(e, l);
+    if (size[first] < size[second] || (size[first] == size[second] && first == 3)) { /* ties: three classes */
+        voxdagi_plan_swap(e, l, &other);
+        memcpy(e->pos[l], first_pos, n * sizeof *first_pos);
+        e->size[l] = size[first];
+    }
+    voxdagi_free(e->mem, first_pos, n * sizeof *first_pos);
+    return 1;
 }
 
 /* Stored transforms of every pointer, the private-child candidates (nodes
