@@ -1256,7 +1256,6 @@ static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
     }
 }
 
-
 /* The smallest tag of the coset T o S. */
 static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t stabs) {
     unsigned best = t;
@@ -2544,11 +2543,6 @@ static void voxdagi_chunk_free(voxdagi_chunk *c) {
     voxdagi_free(m, c->rgb, c->rgb_cap * sizeof *c->rgb);
 }
 
-/* Marks every voxel of triangle TRI (T, with unit-box axes X) inside the
-   chunk whose lowest voxel is CLO. Columns run along the normal's dominant
-   axis w: the three axes without a w component are tested once per column,
-   the plane bounds the column to the few voxels it crosses, and the other
-   seven axes decide each of those (the box normals hold by the ranges). */
 /* Sets the voxels of column P (P[w] varies over [QLO, QHI]) that the
    triangle's box test passes and KEEP, when not NULL, keeps; UV: the
    column's Morton bits. */
@@ -2576,6 +2570,11 @@ VOXDAGI_INLINE void voxdagi_chunk_column(voxdagi_chunk *c, const voxdagi_tri *t,
     }
 }
 
+/* Marks every voxel of triangle TRI (T, with unit-box axes X) inside the
+   chunk whose lowest voxel is CLO. Columns run along the normal's dominant
+   axis w: the three axes without a w component are tested once per column,
+   the plane bounds the column to the few voxels it crosses, and the other
+   seven axes decide each of those (the box normals hold by the ranges). */
 static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxdagi_axes *x, uint32_t tri,
                               const int64_t clo[3]) {
     int (*keep)(void *, size_t, const double *) = c->mesh->keep;
