@@ -820,7 +820,7 @@ static int voxdagi_popcount64(uint64_t x) {
 /* The number of bits of V (0 for 0). */
 VOXDAGI_INLINE unsigned voxdagi_bit_length(uint64_t v) {
 #if defined(__GNUC__) || defined(__clang__)
-    return v ? 64u - (unsigned)__builtin_clzll(v) : 0u;
+    return 64u - (unsigned)__builtin_clzll(v | 1) - (v == 0); /* no branch: zeros are common */
 #else
     unsigned n = 0;
     if (v >> 32) n += 32, v >>= 32;
@@ -978,11 +978,7 @@ typedef struct voxdagi_cube {
     uint8_t act[VOXDAGI_TRANSFORMS][8];  /* T(i) for octant i */
     uint8_t comp[VOXDAGI_TRANSFORMS][VOXDAGI_TRANSFORMS]; /* comp[A][B]: B, then A */
     uint8_t inv[VOXDAGI_TRANSFORMS];
-    uint8_t swap[6][2];    /* axis-pair swaps (0..2; 3: none) that permute like perm */
-    uint64_t delta[3][2];  /* per axis pair: delta-swap masks of the low and high bit */
 } voxdagi_cube;
-
-static const uint8_t voxdagi_axis_pair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
 
 /* The permutation numbered P: axis a goes to axis perm[a]. */
 static void voxdagi_perm(unsigned p, unsigned perm[3]) {
@@ -1000,18 +996,8 @@ static unsigned voxdagi_permute_bits(unsigned x, const unsigned perm[3]) {
     return (x & 1) << perm[0] | (x >> 1 & 1) << perm[1] | (x >> 2 & 1) << perm[2];
 }
 
-/* Swapping bits I < J of every Morton position exchanges the positions with
-   bit I set and bit J clear (this mask) with those 2^J - 2^I above them. */
-static uint64_t voxdagi_delta_mask(unsigned i, unsigned j) {
-    uint64_t m = 0;
-    unsigned p;
-    for (p = 0; p < 64; p++)
-        if ((p >> i & 1) && !(p >> j & 1)) m |= 1ull << p;
-    return m;
-}
-
 static void voxdagi_cube_init(voxdagi_cube *c) {
-    unsigned perm[6][3], tf, ta, tb, i, k, s0, s1;
+    unsigned perm[6][3], tf, ta, tb, i, k;
     for (ta = 0; ta < 6; ta++) voxdagi_perm(ta, perm[ta]);
     for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++)
         for (i = 0; i < 8; i++) c->act[tf][i] = (uint8_t)(voxdagi_permute_bits(i, perm[tf >> 3]) ^ (tf & 7));
@@ -1023,31 +1009,6 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
             c->comp[ta][tb] = (uint8_t)(p << 3 | (voxdagi_permute_bits(tb & 7, perm[ta >> 3]) ^ (ta & 7)));
             if (c->comp[ta][tb] == 0) c->inv[ta] = (uint8_t)tb;
         }
-    /* Each permutation as at most two axis swaps, found by trying them. */
-    for (ta = 0; ta < 6; ta++)
-        for (s0 = 0; s0 < 4; s0++)
-            for (s1 = 0; s1 < 4; s1++) {
-                unsigned ok = 1;
-                for (i = 0; i < 8; i++) {
-                    unsigned x = i, s[2], n;
-                    s[0] = s0, s[1] = s1;
-                    for (n = 0; n < 2; n++)
-                        if (s[n] < 3) {
-                            unsigned a = voxdagi_axis_pair[s[n]][0], b = voxdagi_axis_pair[s[n]][1];
-                            unsigned xa = x >> a & 1, xb = x >> b & 1;
-                            x = (x & ~(1u << a | 1u << b)) | xa << b | xb << a;
-                        }
-                    ok &= x == voxdagi_permute_bits(i, perm[ta]);
-                }
-                if (ok) {
-                    c->swap[ta][0] = (uint8_t)s0, c->swap[ta][1] = (uint8_t)s1;
-                    s0 = s1 = 4; /* the first found */
-                }
-            }
-    for (k = 0; k < 3; k++) {
-        c->delta[k][0] = voxdagi_delta_mask(voxdagi_axis_pair[k][0], voxdagi_axis_pair[k][1]);
-        c->delta[k][1] = voxdagi_delta_mask(voxdagi_axis_pair[k][0] + 3, voxdagi_axis_pair[k][1] + 3);
-    }
 }
 
 #ifndef VOXDAG_NO_BUILD
@@ -1055,19 +1016,6 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
 static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
                                                     0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
                                                     0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
-
-/* Reflecting a 4^3 brick by m moves Morton position p to p ^ (m | m << 3):
-   one swap stage per set bit. */
-static uint64_t voxdagi_reflect_brick(uint64_t x, unsigned m) {
-    unsigned c = m | m << 3, k;
-    for (k = 0; k < 6; k++)
-        if (c >> k & 1) {
-            unsigned s = 1u << k;
-            uint64_t keep = voxdagi_brick_bit_clear[k];
-            x = (x & keep) << s | ((x >> s) & keep);
-        }
-    return x;
-}
 
 /* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
    brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
@@ -1082,22 +1030,6 @@ static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
             box[a + 3] = v + 1;
         }
     }
-}
-
-/* Transforming a 4^3 brick by T moves the voxel at Morton position p to T(p):
-   the axis swaps of T's permutation (two delta swaps each), then its mirror. */
-static uint64_t voxdagi_transform_brick(const voxdagi_cube *c, uint64_t x, unsigned tf) {
-    unsigned n, h;
-    for (n = 0; n < 2; n++) {
-        unsigned k = c->swap[tf >> 3][n];
-        if (k > 2) continue;
-        for (h = 0; h < 2; h++) {
-            unsigned d = (1u << (voxdagi_axis_pair[k][1] + 3 * h)) - (1u << (voxdagi_axis_pair[k][0] + 3 * h));
-            uint64_t t = ((x >> d) ^ x) & c->delta[k][h];
-            x ^= t ^ (t << d);
-        }
-    }
-    return voxdagi_reflect_brick(x, tf & 7);
 }
 #endif
 
@@ -1256,6 +1188,15 @@ static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
     }
 }
 
+/* Brick MASK transformed by T (the voxel at Morton position p moves to
+   T(p)): byte k of the result is cell T^-1(k), its bits moved like octants. */
+static uint64_t voxdagi_transform_brick(const voxdagi_group *g, uint64_t mask, unsigned tf) {
+    uint64_t r = 0;
+    unsigned k;
+    for (k = 0; k < 8; k++) r |= (uint64_t)g->mask8[tf][mask >> 8 * g->src[tf][k] & 0xFF] << 8 * k;
+    return r;
+}
+
 /* The smallest tag of the coset T o S. */
 static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t stabs) {
     unsigned best = t;
@@ -1300,7 +1241,7 @@ static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) 
         cand = keep;
     }
     best = voxdagi_lowest_bit(cand);
-    c.key = best ? voxdagi_transform_brick(&g->cube, mask, best) : mask;
+    c.key = voxdagi_transform_brick(g, mask, best);
     c.tag = g->cube.inv[best];
     c.stab = 0;
     for (; cand; cand &= cand - 1) c.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(cand)][c.tag];
@@ -3070,6 +3011,7 @@ static uint64_t voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi
 typedef struct voxdagi_encoder {
     voxdagi_mem *mem;
     const voxdagi_reducer *r;
+    const voxdagi_group *group;
     const voxdagi_cube *cube;
     uint32_t levels;
     uint32_t *order[VOXDAG_MAX_LEVELS];  /* ids in storage order */
@@ -3508,7 +3450,7 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
     }
     for (i = 0; i < r->store[brick_level].n; i++) {
         uint32_t id = e->order[brick_level][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->cube, r->store[brick_level].node[id].key, e->orient[brick_level][id]), 8);
+        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->group, r->store[brick_level].node[id].key, e->orient[brick_level][id]), 8);
     }
 }
 
@@ -4260,6 +4202,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     memset(&e, 0, sizeof e);
     e.mem = &b->mem;
     e.r = r;
+    e.group = &b->group[0];
     e.cube = &b->group[0].cube;
     e.levels = b->levels;
     for (l = 0; l < brick_level; l++) { /* what an empty scene's level table says */
