@@ -1011,28 +1011,6 @@ static void voxdagi_cube_init(voxdagi_cube *c) {
         }
 }
 
-#ifndef VOXDAG_NO_BUILD
-/* The Morton positions p of a 4^3 brick with bit k of p clear. */
-static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
-                                                    0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
-                                                    0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
-
-/* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
-   brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
-static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
-    unsigned a, v;
-    for (a = 0; a < 3; a++) {
-        box[a] = 4, box[a + 3] = 0;
-        for (v = 0; v < 4; v++) {
-            uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
-            if (!(mask & (v & 1 ? ~lo : lo) & (v & 2 ? ~hi : hi))) continue;
-            if (v < box[a]) box[a] = v;
-            box[a + 3] = v + 1;
-        }
-    }
-}
-#endif
-
 #ifndef VOXDAG_NO_BUILD /* the builder, the voxelizer (up to the file image assembly) */
 
 // -- Unique node stores (one per level) with hash-consing
@@ -1043,7 +1021,7 @@ static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
 /* The unique nodes of one level. Inner nodes keep 8 child references (each
    (id << 6 | tag) into the next level, tag normalized by the child's
    stabilizer) and a fingerprint; bricks keep their 64-bit mask in KEY. What
-   a parent reads of a child sits together (one cache line). */
+   a parent reads of a child sits together (one cache miss). */
 typedef struct voxdagi_node {
     uint64_t key;   /* fingerprint (inner) or mask (brick) */
     uint64_t stab;  /* stabilizer: bit s set when transform s maps the node to itself */
@@ -2948,21 +2926,20 @@ static unsigned voxdagi_class_for(const voxdagi_classes *c, unsigned ob, unsigne
 static uint64_t voxdagi_classes_cost(uint64_t mass[58][7], const unsigned *x[3]) {
     const unsigned *w[3], *t;
     uint64_t m[3];
-    unsigned i, j;
-#define VOXDAGI_MASS(p, q) mass[(p)[0] < (q)[0] ? (p)[0] : (q)[0]][(p)[1] < (q)[1] ? (p)[1] : (q)[1]]
+    unsigned i, j, ob[4], kb[4]; /* [i]: class w[i]'s rectangle; [3]: the overlap of all three */
     for (i = 0; i < 3; i++) /* by width */
         for (w[i] = x[i], j = i; j > 0 && w[j][0] + w[j][1] < w[j - 1][0] + w[j - 1][1]; j--)
             t = w[j], w[j] = w[j - 1], w[j - 1] = t;
-    m[0] = mass[w[0][0]][w[0][1]];
-    m[1] = mass[w[1][0]][w[1][1]] - VOXDAGI_MASS(w[0], w[1]);
-    m[2] = mass[w[2][0]][w[2][1]] - VOXDAGI_MASS(w[2], w[0]) - VOXDAGI_MASS(w[2], w[1]);
-    {
-        unsigned p = w[0][0] < w[1][0] ? w[0][0] : w[1][0], q = w[0][1] < w[1][1] ? w[0][1] : w[1][1];
-        m[2] += mass[p < w[2][0] ? p : w[2][0]][q < w[2][1] ? q : w[2][1]];
-    }
-#undef VOXDAGI_MASS
+    for (i = 0; i < 3; i++) ob[i] = w[i][0], kb[i] = w[i][1];
+    ob[3] = ob[0] < ob[1] ? ob[0] : ob[1], kb[3] = kb[0] < kb[1] ? kb[0] : kb[1];
+    ob[3] = ob[3] < ob[2] ? ob[3] : ob[2], kb[3] = kb[3] < kb[2] ? kb[3] : kb[2];
+#define VOXDAGI_OVERLAP(a, b) mass[ob[a] < ob[b] ? ob[a] : ob[b]][kb[a] < kb[b] ? kb[a] : kb[b]]
+    m[0] = mass[ob[0]][kb[0]];
+    m[1] = mass[ob[1]][kb[1]] - VOXDAGI_OVERLAP(0, 1);
+    m[2] = mass[ob[2]][kb[2]] - VOXDAGI_OVERLAP(2, 0) - VOXDAGI_OVERLAP(2, 1) + mass[ob[3]][kb[3]];
+#undef VOXDAGI_OVERLAP
     if (m[0] + m[1] + m[2] != mass[57][6]) return UINT64_MAX;
-    return m[0] * (w[0][0] + w[0][1]) + m[1] * (w[1][0] + w[1][1]) + m[2] * (w[2][0] + w[2][1]);
+    return m[0] * (ob[0] + kb[0]) + m[1] * (ob[1] + kb[1]) + m[2] * (ob[2] + kb[2]);
 }
 
 /* Chooses N (2 or 3) classes for the fewest pointer bits, given how many
@@ -3012,7 +2989,6 @@ typedef struct voxdagi_encoder {
     voxdagi_mem *mem;
     const voxdagi_reducer *r;
     const voxdagi_group *group;
-    const voxdagi_cube *cube;
     uint32_t levels;
     uint32_t *order[VOXDAG_MAX_LEVELS];  /* ids in storage order */
     uint64_t *pos[VOXDAG_MAX_LEVELS];    /* per id: byte offset, or brick index */
@@ -3045,7 +3021,7 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
    to child reference X (id << 6 | t) of level L + 1: RP o t o s o RC^-1 for
    s in the child's stabilizer, the smallest of them. */
 static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigned rp, uint32_t x) {
-    const voxdagi_cube *c = e->cube;
+    const voxdagi_cube *c = &e->group->cube;
     unsigned u = c->comp[rp][x & 63], rc_inv = c->inv[e->orient[l + 1][x >> 6]];
     unsigned best = c->comp[u][rc_inv];
     uint64_t stabs = e->r->store[l + 1].node[x >> 6].stab & ~1ull;
@@ -3063,7 +3039,7 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
    RP o t o S(n). The references into a level are gathered per node first. */
 static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
-    const voxdagi_cube *c = e->cube;
+    const voxdagi_cube *c = &e->group->cube;
     uint32_t brick_level = e->levels - 2, l;
     uint64_t votes[VOXDAGI_TRANSFORMS];
     for (l = 0; l <= brick_level; l++) {
@@ -3157,7 +3133,7 @@ static int voxdagi_is_private(const voxdagi_encoder *e, uint32_t l, uint32_t x) 
 static void voxdagi_stored_children(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint32_t child[8],
                                     unsigned tag[8]) {
     const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
-    const uint8_t *act = e->cube->act[e->orient[l][id]];
+    const uint8_t *act = e->group->cube.act[e->orient[l][id]];
     unsigned j;
     for (j = 0; j < 8; j++) child[j] = VOXDAGI_NONE, tag[j] = 0;
     for (j = 0; j < 8; j++)
@@ -3182,7 +3158,7 @@ static uint64_t voxdagi_private_base(const voxdagi_encoder *e, uint32_t l, uint3
 static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint8_t *p) {
     const voxdagi_classes *cls = &e->cls[l];
     const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
-    const uint8_t *act = e->cube->act[e->orient[l][id]], *tags = e->tag[l] + 8 * (size_t)id;
+    const uint8_t *act = e->group->cube.act[e->orient[l][id]], *tags = e->tag[l] + 8 * (size_t)id;
     uint64_t target[8], bits = 16 + e->count_bits[l], base = voxdagi_private_base(e, l, id);
     unsigned code[8], present = 0, private_children = 0, header = 0, j, s;
     for (j = 0; j < 8; j++) { /* canonical child j sits in stored octant R(j) */
@@ -3397,7 +3373,7 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         ok = voxdagi_orient(e);
     }
     if (ok) { /* the root's transform: world = root tag o R^-1 (stored root) */
-        const voxdagi_cube *c = e->cube;
+        const voxdagi_cube *c = &e->group->cube;
         uint32_t x = r->root;
         unsigned best = c->comp[x & 63][c->inv[e->orient[0][x >> 6]]];
         uint64_t stabs = r->store[0].node[x >> 6].stab;
@@ -4145,6 +4121,26 @@ static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned
     }
 }
 
+/* The Morton positions p of a 4^3 brick with bit k of p clear. */
+static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
+                                                    0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
+                                                    0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
+
+/* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
+   brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
+static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
+    unsigned a, v;
+    for (a = 0; a < 3; a++) {
+        box[a] = 4, box[a + 3] = 0;
+        for (v = 0; v < 4; v++) {
+            uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
+            if (!(mask & (v & 1 ? ~lo : lo) & (v & 2 ? ~hi : hi))) continue;
+            if (v < box[a]) box[a] = v;
+            box[a + 3] = v + 1;
+        }
+    }
+}
+
 /* The occupied voxel box of the scene, bottom-up over the unique nodes (each
    box in its node's canonical frame). Returns 0 when out of memory. */
 static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const voxdagi_cube *c, uint32_t box[6]) {
@@ -4203,7 +4199,6 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     e.mem = &b->mem;
     e.r = r;
     e.group = &b->group[0];
-    e.cube = &b->group[0].cube;
     e.levels = b->levels;
     for (l = 0; l < brick_level; l++) { /* what an empty scene's level table says */
         unsigned t;
@@ -4221,7 +4216,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     sc.root_transform = e.root_transform;
     sc.symmetry = b->symmetry;
     sc.voxels = b->voxels;
-    if (!voxdagi_voxel_box(&b->mem, r, e.cube, sc.voxel_box)) {
+    if (!voxdagi_voxel_box(&b->mem, r, &e.group->cube, sc.voxel_box)) {
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
