@@ -836,7 +836,10 @@ static VOXCOLORI_ALWAYS_INLINE uint32_t voxcolori_get(const voxcolor_view *view,
     ends = p.block_ends + ((7 * g) << wide);
     n = p.last - (g << VOXCOLORI_GROUP_SHIFT) < 7 ? (unsigned)(p.last - (g << VOXCOLORI_GROUP_SHIFT)) : 7;
     r = voxcolori_count_below(voxcolori_load64(ends), j, n, wide);
-    if (wide) r += voxcolori_count_below(voxcolori_load64(ends + 8), j, n > 4 ? n - 4 : 0, wide);
+    /* Wide ends take two words; the second is read only when the group has
+       more than 4 of them, since a short page may end with the first (the 8
+       closing zero bytes cover one word past a directory entry, not two). */
+    if (wide && n > 4) r += voxcolori_count_below(voxcolori_load64(ends + 8), j, n - 4, wide);
     /* Its payload: the group's checkpoint plus the payloads of the r blocks
        before it in the group. */
     pos = p.payload;

@@ -2,8 +2,10 @@
      bit 7 clear: an untrusted stream. It is validated; when accepted, every
        colour (up to a cap) is decoded singly and by ranges, which must agree.
      bit 7 set: RGB8 colours to encode with options from bits 0..6 (error
-       bound, metric, weight width, page size; the effort from the colour
-       count). The stream must validate and every decoded colour must be
+       bound, metric, weight width; bit 6 set: the next byte picks the page
+       shift, 4..10 or the default; the effort from the colour count). The
+       stream must validate and every decoded colour, looked up singly, in a
+       batch and by range from a copy of the stream's exact size, must be
        within the bound; the encoder on 2..4 threads into a buffer of the
        exact size, and the streaming encoder (on those threads too), fed in
        chunks of a size taken from the input, must make the same bytes.
@@ -125,14 +127,24 @@ static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
     static const double bounds[8] = {0, 0.004, 0.01, 0.02, 0.04, 0.08, 0.2, 1.0};
     voxcolor_encode_opts o;
     voxcolor_view v;
-    size_t n = size / 3, cap = voxcolor_encode_bound(n), len, i;
-    uint8_t *s = (uint8_t *)malloc(cap), *d = (uint8_t *)malloc(3 * n + 3);
+    size_t n, cap, len, i;
+    uint8_t *s, *d, *exact, *one;
+    uint64_t *backwards;
+    uint32_t page_shift = 0;
+    if ((sel >> 6) & 1 && size) { /* 0 (the default), 4..10 */
+        page_shift = rgb[0] % 8 ? 3 + rgb[0] % 8 : 0;
+        rgb++, size--;
+    }
+    n = size / 3;
+    cap = voxcolor_encode_bound(n);
+    s = (uint8_t *)malloc(cap);
+    d = (uint8_t *)malloc(3 * n + 3);
     memset(&o, 0, sizeof o);
     o.max_error = bounds[sel & 7];
     o.metric = (sel >> 3) & 1 ? VOXCOLOR_METRIC_CIELAB : VOXCOLOR_METRIC_RGB;
     if (o.metric == VOXCOLOR_METRIC_CIELAB) o.max_error *= 20; /* delta E units */
     o.weight_bits = ((sel >> 4) & 3) == 3 ? 0 : (sel >> 4) & 3;
-    o.page_shift = (sel >> 6) & 1 ? 4 : 0;
+    o.page_shift = page_shift;
     o.effort = n & 1 ? VOXCOLOR_EFFORT_FAST : VOXCOLOR_EFFORT_SMALLEST;
     len = voxcolor_encode(s, cap, rgb, n, &o, NULL);
     require(len > 0 && len <= cap, "encode failed");
@@ -144,14 +156,30 @@ static void fuzz_roundtrip(unsigned sel, const uint8_t *rgb, size_t size) {
                 "threads change the stream");
         free(t);
     }
-    require(voxcolor_view_init(&v, s, len, NULL) == VOXCOLOR_OK, "own stream rejected");
-    require(v.count == n, "count");
     fuzz_stream(rgb, n, &o, s, len);
+    /* Decoded from a copy of the exact size: a read past the stream is out
+       of bounds. */
+    exact = (uint8_t *)malloc(len);
+    memcpy(exact, s, len);
+    require(voxcolor_view_init(&v, exact, len, NULL) == VOXCOLOR_OK, "own stream rejected");
+    require(v.count == n, "count");
     voxcolor_view_get_range(&v, 0, n, d);
     for (i = 0; i < n; i++)
         require(distance(rgb + 3 * i, d + 3 * i, o.metric == VOXCOLOR_METRIC_CIELAB) <=
                     o.max_error + 1e-9,
                 "colour over the error bound");
+    one = (uint8_t *)malloc(3 * n + 3);
+    backwards = (uint64_t *)malloc(n * sizeof *backwards + 1);
+    for (i = 0; i < n; i++) {
+        voxcolor_view_get(&v, i, one);
+        require(memcmp(one, d + 3 * i, 3) == 0, "get and get_range differ");
+        backwards[i] = n - 1 - i;
+    }
+    voxcolor_view_get_many(&v, backwards, n, one);
+    for (i = 0; i < n; i++) require(memcmp(one + 3 * i, d + 3 * (n - 1 - i), 3) == 0, "get_many differs");
+    free(backwards);
+    free(one);
+    free(exact);
     free(s);
     free(d);
 }

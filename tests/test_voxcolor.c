@@ -248,6 +248,55 @@ static void test_options(void) {
     free(c);
 }
 
+/* Every page shift, at counts around page boundaries (a page that ends
+   short), with one block per page or many, decoded from a buffer of exactly
+   the stream's size (AddressSanitizer watches its end) by every lookup call,
+   against the reference reader. */
+static void test_page_boundaries_exact_size(void) {
+    static const int kinds[] = {KIND_RANDOM, KIND_FLAT, KIND_SMOOTH};
+    static const double bounds[] = {0, 0.05};
+    uint32_t shift;
+    size_t k, b, m, i;
+    for (shift = 4; shift <= 10; shift++)
+        for (k = 0; k < sizeof kinds / sizeof kinds[0]; k++)
+            for (b = 0; b < sizeof bounds / sizeof bounds[0]; b++)
+                for (m = 1; m <= 3; m++) {
+                    size_t page = (size_t)1 << shift, counts[4], c;
+                    counts[0] = m * page - 1, counts[1] = m * page, counts[2] = m * page + 1;
+                    counts[3] = m == 1 ? 1 : (m - 1) * page + 2;
+                    for (c = 0; c < 4; c++) {
+                        size_t n = counts[c], size;
+                        uint8_t *src = make_colors(kinds[k], n, 30 + n), *s, *exact, *want, *got;
+                        uint64_t *backwards = (uint64_t *)malloc(n * sizeof *backwards);
+                        voxcolor_encode_opts o;
+                        voxcolor_view v;
+                        int ok = 1;
+                        memset(&o, 0, sizeof o);
+                        o.max_error = bounds[b];
+                        o.page_shift = shift;
+                        size = encode_new(src, n, &o, &s);
+                        exact = (uint8_t *)malloc(size);
+                        memcpy(exact, s, size);
+                        want = (uint8_t *)malloc(3 * n);
+                        got = (uint8_t *)malloc(3 * n);
+                        ref_decode(exact, want, NULL, NULL);
+                        CHECK(voxcolor_view_init(&v, exact, size, NULL) == VOXCOLOR_OK);
+                        for (i = 0; i < n && ok; i++) {
+                            voxcolor_view_get(&v, i, got + 3 * i);
+                            ok = memcmp(got + 3 * i, want + 3 * i, 3) == 0;
+                        }
+                        for (i = 0; i < n; i++) backwards[i] = n - 1 - i;
+                        voxcolor_view_get_many(&v, backwards, n, got);
+                        for (i = 0; i < n && ok; i++) ok = memcmp(got + 3 * i, want + 3 * (n - 1 - i), 3) == 0;
+                        voxcolor_view_get_range(&v, 0, n, got);
+                        ok = ok && memcmp(got, want, 3 * n) == 0;
+                        if (bounds[b] == 0) ok = ok && memcmp(want, src, 3 * n) == 0;
+                        CHECK_MSG(ok, "shift %u %s e_t=%g n=%zu", shift, kind_names[kinds[k]], bounds[b], n);
+                        free(src), free(s), free(exact), free(want), free(got), free(backwards);
+                    }
+                }
+}
+
 static void test_lossless(void) {
     int kind;
     for (kind = 0; kind < KIND_COUNT; kind++) {
@@ -1141,6 +1190,7 @@ const test_case test_voxcolor_cases[] = {
     {"voxcolor/options", test_options},
     {"voxcolor/real_images", test_real_images},
     {"voxcolor/lossless", test_lossless},
+    {"voxcolor/page_boundaries_exact_size", test_page_boundaries_exact_size},
     {"voxcolor/cielab", test_cielab},
     {"voxcolor/bound_and_small_buffers", test_bound_and_small_buffers},
     {"voxcolor/deterministic", test_deterministic},

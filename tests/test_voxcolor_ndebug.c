@@ -10,6 +10,7 @@
 #ifndef NDEBUG
 #error "tests/test_voxcolor_ndebug.c is built with -DNDEBUG"
 #endif
+#define _DEFAULT_SOURCE /* mmap's MAP_ANONYMOUS under -std=c99 */
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
 
@@ -19,6 +20,59 @@
 #include <string.h>
 
 #include "tally.h"
+
+#if defined(__unix__) || defined(__APPLE__)
+#include <sys/mman.h>
+#include <unistd.h>
+/* Streams of every page shift decoded in place from memory that ends where
+   the stream ends, followed by a page that cannot be read: any read past the
+   end faults (in this release build as in the user's, sanitizers or not). */
+static void guard_page_reads(void) {
+    static const size_t extra[] = {0, 1, 2, 3, 17};
+    size_t pagesize = (size_t)sysconf(_SC_PAGESIZE), n, i, e;
+    uint32_t shift;
+    for (shift = 4; shift <= 10; shift++)
+        for (e = 0; e < sizeof extra / sizeof extra[0]; e++) {
+            voxcolor_encode_opts o;
+            voxcolor_view v;
+            uint8_t *rgb, *s, *map, *at, *one, *all;
+            uint64_t *idx;
+            size_t cap, size, span;
+            int ok = 1;
+            n = ((size_t)1 << shift) + extra[e];
+            rgb = (uint8_t *)malloc(3 * n);
+            one = (uint8_t *)malloc(3 * n);
+            all = (uint8_t *)malloc(3 * n);
+            idx = (uint64_t *)malloc(n * sizeof *idx);
+            for (i = 0; i < 3 * n; i++) rgb[i] = (uint8_t)(i * 131 ^ i >> 2);
+            for (i = 0; i < n; i++) idx[i] = n - 1 - i;
+            memset(&o, 0, sizeof o);
+            o.page_shift = shift;
+            cap = voxcolor_encode_bound(n);
+            s = (uint8_t *)malloc(cap);
+            size = voxcolor_encode(s, cap, rgb, n, &o, NULL);
+            span = (size + pagesize - 1) / pagesize * pagesize;
+            map = (uint8_t *)mmap(NULL, span + pagesize, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
+            if (map == MAP_FAILED || mprotect(map + span, pagesize, PROT_NONE)) {
+                check(0, "guard page mapped", shift);
+                continue;
+            }
+            at = map + span - size;
+            memcpy(at, s, size);
+            if (size == 0 || voxcolor_view_init(&v, at, size, NULL) != VOXCOLOR_OK) ok = 0;
+            for (i = 0; ok && i < n; i++) voxcolor_view_get(&v, i, one + 3 * i);
+            if (ok) voxcolor_view_get_many(&v, idx, n, all);
+            for (i = 0; ok && i < n; i++) ok = memcmp(all + 3 * i, rgb + 3 * (n - 1 - i), 3) == 0;
+            if (ok) voxcolor_view_get_range(&v, 0, n, all);
+            check(ok && memcmp(one, rgb, 3 * n) == 0 && memcmp(all, rgb, 3 * n) == 0,
+                  "lossless stream decoded up to a guard page", shift * 100 + e);
+            munmap(map, span + pagesize);
+            free(rgb), free(one), free(all), free(idx), free(s);
+        }
+}
+#else
+static void guard_page_reads(void) {}
+#endif
 
 static int no_writes(void *user, uint64_t offset, const void *bytes, size_t size) {
     (void)offset, (void)bytes, (void)size;
@@ -125,6 +179,7 @@ int main(void) {
               voxcolor_encoder_push(enc, rgb, N) == VOXCOLOR_OK &&
               voxcolor_encoder_push(enc, rgb, 1) == VOXCOLOR_ERR_INVALID_ARGUMENT,
           "push past the count", 0);
+    guard_page_reads();
     check(voxcolor_view_init(NULL, buf, cap, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT, "NULL view", 0);
     check(voxcolor_view_init(&v, NULL, 100, &err) == VOXCOLOR_ERR_INVALID_ARGUMENT, "NULL stream", 0);
     free(buf);
