@@ -236,17 +236,18 @@ static int vi_integer_syntax(vi_span tok) {
 }
 
 /* Parses TOK as a decimal integer with an optional sign and a magnitude of at
-   most 2^62; 0 otherwise. */
+   most 2^62; 0 otherwise (a larger one is refused before it could wrap). */
 static int vi_int(vi_span tok, int64_t *out) {
+    const uint64_t max = (uint64_t)1 << 62;
     const char *s = tok.s;
     uint64_t v = 0;
     int neg = 0;
     if (s < tok.e && (*s == '-' || *s == '+')) neg = *s++ == '-';
     if (s == tok.e) return 0;
     for (; s < tok.e; s++) {
-        if (*s < '0' || *s > '9') return 0;
-        v = v * 10 + (uint64_t)(*s - '0');
-        if (v > ((uint64_t)1 << 62)) return 0;
+        uint64_t d = (uint64_t)(*s - '0');
+        if (*s < '0' || *s > '9' || v > (max - d) / 10) return 0;
+        v = v * 10 + d;
     }
     *out = neg ? -(int64_t)v : (int64_t)v;
     return 1;

@@ -1377,6 +1377,40 @@ static void test_vox_errors(void) {
     free(b.p);
 }
 
+
+/* Integers past the parser's range are refused, never wrapped at 2^64:
+   2^64 + 1 would read as 1 and 2^64 as 0. */
+static void test_integer_overflow(void) {
+    static const char *const big[] = {"18446744073709551617", "18446744073709551616", "-18446744073709551617",
+                                      "99999999999999999999", "4611686018427387905"};
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0};
+    vox_model m = {{2, 2, 2}, 1, {{1, 1, 1, 5}}};
+    char text[512];
+    size_t i;
+    for (i = 0; i < sizeof big / sizeof big[0]; i++) {
+        snprintf(text, sizeof text, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf %s 2 3\n", big[i]);
+        expect_error_text("obj", text, "bad face corner");
+        snprintf(text, sizeof text, "ply\nformat ascii 1.0\nelement vertex %s\nproperty float x\n"
+                                    "property float y\nproperty float z\nend_header\n0 0 0\n", big[i]);
+        expect_error_text("ply", text, "expected \"element NAME COUNT\"");
+        snprintf(text, sizeof text, "OFF\n%s 0 0\n0 0 0\n", big[i]);
+        expect_error_text("off", text, "expected vertex and face counts");
+        snprintf(text, sizeof text, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n%s 0 1 2\n", big[i]);
+        expect_error_text("off", text, "bad corner count");
+        snprintf(text, sizeof text, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 %s 1 2\n", big[i]);
+        expect_error_text("off", text, "out-of-range vertex index");
+        snprintf(text, sizeof text, "0 0 %s", big[i]);
+        body.n = file.n = 0;
+        vox_models(&body, &m, 1);
+        vox_transform(&body, 0, 1, NULL, text);
+        vox_shape(&body, 1, 0);
+        vox_file(&file, &body, 200);
+        expect_error("vox", &file, "malformed nTRN chunk");
+    }
+    free(body.p);
+    free(file.p);
+}
+
 const test_case test_import_cases[] = {
     {"import/xyz roundtrip", test_xyz_roundtrip},
     {"import/xyz errors", test_xyz_errors},
@@ -1403,5 +1437,6 @@ const test_case test_import_cases[] = {
     {"import/vox default palette", test_vox_default_palette},
     {"import/vox scene graph", test_vox_scene_graph},
     {"import/vox errors", test_vox_errors},
+    {"import/integers out of range refused", test_integer_overflow},
     {NULL, NULL},
 };
