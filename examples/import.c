@@ -2,11 +2,17 @@
    top of shared helpers: error messages, growable arrays, a text cursor and a
    bounds-checked binary reader. Every size read from a file is checked
    against the bytes that remain before anything is allocated for it. */
-#define _POSIX_C_SOURCE 200809L /* fileno, fstat */
+#define _POSIX_C_SOURCE 200809L /* fileno, fstat, open, fdopen */
 #include "import.h"
 
 #include <sys/stat.h>
 #include <errno.h>
+#ifdef _WIN32
+#include <stdlib.h> /* _fullpath */
+#else
+#include <fcntl.h>
+#include <unistd.h>
+#endif
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -59,6 +65,8 @@ static void vi_ctx_init(vi_ctx *c, const char *format, char *err, size_t err_siz
     if (!c->limits.max_points) c->limits.max_points = VDAG_IMPORT_MAX_POINTS;
     if (!c->limits.max_vertices) c->limits.max_vertices = VDAG_IMPORT_MAX_VERTICES;
     if (!c->limits.max_triangles) c->limits.max_triangles = VDAG_IMPORT_MAX_TRIANGLES;
+    if (!c->limits.max_texture_pixels) c->limits.max_texture_pixels = VDAG_IMPORT_MAX_TEXTURE_PIXELS;
+    if (!c->limits.max_vox_voxels) c->limits.max_vox_voxels = VDAG_IMPORT_MAX_VOX_VOXELS;
 }
 
 /* Writes "FORMAT: message" to the caller's buffer; returns 0 so that parsers
@@ -1057,38 +1065,30 @@ static uint64_t vi_hash_u64(uint64_t x) { /* splitmix64 finaliser */
 
 // -- Files and paths
 
-/* Reads the whole file at PATH into *DATA (malloc'd) and *SIZE. */
-static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
+/* Reads F to its end into *DATA (malloc'd) and *SIZE: at most MAX bytes
+   (else an error naming WHAT, the limit); KNOWN (or -1) reserves the size. */
+static int vi_read_stream(vi_ctx *c, FILE *f, long known, uint64_t max, const char *what, char **data,
+                          size_t *size) {
     enum { CHUNK = 1 << 16 };
     vi_buf b = {NULL, 0, 0};
     int ok = 1, too_big = 0;
-    FILE *f = fopen(path, "rb");
-    long known;
-    struct stat st;
-    if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
-    if (!fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
-        fclose(f);
-        return vi_fail(c, "is a directory, not a file");
-    }
     /* Reserve the size when it is known, so that big files are not copied. */
-    if (!fseek(f, 0, SEEK_END) && (known = ftell(f)) > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
-        too_big = (uint64_t)known > c->limits.max_input_bytes;
+    if (known > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
+        too_big = (uint64_t)known > max;
         ok = !too_big && vi_push(c, &b, 1, (size_t)known + CHUNK) != NULL;
         b.count = 0;
     }
-    rewind(f);
     while (ok) {
         char *chunk = (char *)vi_push(c, &b, 1, CHUNK);
         size_t got;
         if (!(ok = chunk != NULL)) break;
         got = fread(chunk, 1, CHUNK, f);
         b.count -= CHUNK - got;
-        if ((too_big = b.count > c->limits.max_input_bytes) != 0) ok = 0;
+        if ((too_big = b.count > max) != 0) ok = 0;
         if (got < CHUNK) break;
     }
-    if (too_big) vi_fail(c, "file larger than max_input_bytes (%llu)", (vi_ull)c->limits.max_input_bytes);
+    if (too_big) vi_fail(c, "file larger than %s (%llu)", what, (vi_ull)max);
     if (ok && ferror(f)) ok = vi_fail(c, "cannot read the file (%s)", strerror(errno));
-    fclose(f);
     if (!ok) {
         vi_buf_free(&b);
         return 0;
@@ -1096,6 +1096,130 @@ static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) 
     *data = (char *)b.data;
     *size = b.count;
     return 1;
+}
+
+/* Reads the whole file at PATH into *DATA (malloc'd) and *SIZE. */
+static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
+    FILE *f = fopen(path, "rb");
+    long known = -1;
+    struct stat st;
+    int ok;
+    if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
+    if (!fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return vi_fail(c, "is a directory, not a file");
+    }
+    if (!fseek(f, 0, SEEK_END)) known = ftell(f);
+    rewind(f);
+    ok = vi_read_stream(c, f, known, c->limits.max_input_bytes, "max_input_bytes", data, size);
+    fclose(f);
+    return ok;
+}
+
+/* The identity of an open file, so that one file named under several
+   spellings is read once: its device and inode, or (Windows, where these
+   are not kept) its full path. */
+typedef struct vi_file_id {
+    uint64_t dev, ino;
+    char *full; /* malloc'd; NULL but on Windows */
+} vi_file_id;
+
+static int vi_same_file(const vi_file_id *a, const vi_file_id *b) {
+    if (a->full || b->full) return a->full && b->full && !strcmp(a->full, b->full);
+    return a->dev == b->dev && a->ino == b->ino;
+}
+
+/* Opens side file PATH (a material library or a texture) for reading, into
+   *F with its identity in ID and its size in *SIZE. Only a regular file of
+   at most VDAG_IMPORT_MAX_SIDE_FILE_BYTES (and max_input_bytes) is opened:
+   the check comes before any read, and a FIFO is never waited on (POSIX:
+   opened without blocking, then checked through its descriptor). Returns
+   1; -1 when PATH cannot be opened (the reason in WHY); 0 when it is
+   refused or on an allocation failure (a message naming PATH in C). */
+static uint64_t vi_side_max(const vi_ctx *c) {
+    return c->limits.max_input_bytes < VDAG_IMPORT_MAX_SIDE_FILE_BYTES ? c->limits.max_input_bytes
+                                                                      : VDAG_IMPORT_MAX_SIDE_FILE_BYTES;
+}
+
+static int vi_open_side(vi_ctx *c, const char *path, FILE **f, vi_file_id *id, uint64_t *size, char *why,
+                        size_t why_size) {
+    uint64_t max = vi_side_max(c);
+    vi_ctx named = *c;
+    int regular;
+#ifdef _WIN32
+    struct _stat64 st;
+#else
+    struct stat st;
+    int fd;
+#endif
+    named.format = path;
+    *f = NULL;
+    memset(id, 0, sizeof *id);
+#ifdef _WIN32
+    /* No FIFOs in Windows' file system; devices (NUL, CON) are not regular. */
+    if (_stat64(path, &st)) {
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+    regular = (st.st_mode & _S_IFMT) == _S_IFREG;
+#else
+    if ((fd = open(path, O_RDONLY | O_NONBLOCK)) < 0) {
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, &st)) {
+        snprintf(why, why_size, "%s: cannot read the file (%s)", path, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    regular = S_ISREG(st.st_mode) != 0;
+#endif
+    if (!regular || st.st_size < 0 || (uint64_t)st.st_size > max) {
+#ifndef _WIN32
+        close(fd);
+#endif
+        if (!regular)
+            return vi_fail(&named, "not a regular file (a directory, FIFO or device): material libraries "
+                                   "and textures are read only from regular files");
+        return vi_fail(&named, "file larger than %llu bytes, the most read from a material library or texture",
+                       (vi_ull)max);
+    }
+    *size = (uint64_t)st.st_size;
+#ifdef _WIN32
+    if (!(id->full = _fullpath(NULL, path, 0))) return vi_fail(c, "out of memory");
+    if (!(*f = fopen(path, "rb"))) {
+        free(id->full);
+        id->full = NULL;
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+#else
+    id->dev = (uint64_t)st.st_dev;
+    id->ino = (uint64_t)st.st_ino;
+    /* O_NONBLOCK has no effect on reads of a regular file. */
+    if (!(*f = fdopen(fd, "rb"))) {
+        close(fd);
+        return vi_fail(c, "out of memory");
+    }
+#endif
+    return 1;
+}
+
+/* Reads side file PATH whole into *DATA (malloc'd) and *SIZE, as
+   vi_open_side allows; returns as it does. */
+static int vi_read_side(vi_ctx *c, const char *path, char **data, size_t *size, char *why, size_t why_size) {
+    FILE *f;
+    vi_file_id id;
+    uint64_t known;
+    vi_ctx named = *c;
+    int ok = vi_open_side(c, path, &f, &id, &known, why, why_size);
+    if (ok <= 0) return ok;
+    free(id.full);
+    named.format = path;
+    /* The limit holds also for a file that grows while it is read. */
+    ok = vi_read_stream(&named, f, (long)known, vi_side_max(c), "VDAG_IMPORT_MAX_SIDE_FILE_BYTES", data, size);
+    fclose(f);
+    return ok;
 }
 
 /* Directory part of PATH ("." if none), malloc'd. */
@@ -1194,42 +1318,83 @@ static int vi_mtl_parse(vi_ctx *c, vi_text *t, vi_buf *mtls) {
     return 1;
 }
 
-/* Textures loaded so far, by path, so that each file is read once. */
+/* Textures loaded so far, by file identity, so that each file is read (and
+   counted against max_texture_pixels) once however it is named; by the
+   name too, so that a name seen before needs no system call. */
 typedef struct vi_tex {
-    char *path;
-    int32_t image; /* -1: could not be decoded */
+    char *path;     /* the name as resolved by vi_path */
+    vi_file_id id;  /* valid when opened */
+    int opened;
+    int32_t image;  /* -1: could not be decoded */
 } vi_tex;
 
-static void vi_tex_free(vi_buf *cache) {
+typedef struct vi_texcache {
+    vi_buf entries; /* vi_tex */
+    uint64_t pixels; /* of the textures decoded so far */
+} vi_texcache;
+
+static void vi_tex_free(vi_texcache *cache) {
     size_t i;
-    for (i = 0; i < cache->count; i++) free(((vi_tex *)cache->data)[i].path);
-    vi_buf_free(cache);
+    for (i = 0; i < cache->entries.count; i++) {
+        free(((vi_tex *)cache->entries.data)[i].path);
+        free(((vi_tex *)cache->entries.data)[i].id.full);
+    }
+    vi_buf_free(&cache->entries);
+    cache->pixels = 0;
 }
 
 /* Sets *IMAGE to the scene image of texture FILE (named in a file in DIR),
-   decoding it on first use; -1, with a warning, if it cannot be decoded, or
-   -1 when the caller skips textures: the material then keeps its Kd colour. */
-static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, vi_span file, int32_t *image) {
+   decoding it on first use; -1, with a warning, if it cannot be opened or
+   decoded, or -1 when the caller skips textures: the material then keeps its
+   Kd colour. A texture that is not a regular file or is too large, or whose
+   pixels would take the textures past max_texture_pixels, is an error. */
+static int vi_texture(vi_ctx *c, vdag_scene *s, vi_texcache *cache, const char *dir, vi_span file, int32_t *image) {
     char *path, why[512];
-    vi_tex *e;
+    vi_tex *e, *all;
     vdag_image img;
     size_t i;
+    uint64_t bytes;
+    FILE *f;
+    int got;
     *image = -1;
     if (c->limits.skip_textures) return 1;
     if (!(path = vi_path(c, dir, file))) return 0;
-    for (i = 0; i < cache->count; i++)
-        if (!strcmp(((vi_tex *)cache->data)[i].path, path)) {
+    all = (vi_tex *)cache->entries.data;
+    for (i = 0; i < cache->entries.count; i++)
+        if (!strcmp(all[i].path, path)) {
             free(path);
-            *image = ((vi_tex *)cache->data)[i].image;
+            *image = all[i].image;
             return 1;
         }
-    if (!(e = (vi_tex *)vi_push(c, cache, sizeof *e, 1))) {
+    if (!(e = (vi_tex *)vi_push(c, &cache->entries, sizeof *e, 1))) {
         free(path);
         return 0;
     }
+    memset(e, 0, sizeof *e);
     e->path = path;
     e->image = -1;
-    if (vdag_image_load(path, &img, why, sizeof why)) {
+    if ((got = vi_open_side(c, path, &f, &e->id, &bytes, why, sizeof why)) <= 0) {
+        if (got < 0 && !c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
+        return got < 0;
+    }
+    e->opened = 1;
+    all = (vi_tex *)cache->entries.data;
+    for (i = 0; i + 1 < cache->entries.count; i++)
+        if (all[i].opened && vi_same_file(&all[i].id, &e->id)) {
+            fclose(f);
+            *image = e->image = all[i].image;
+            return 1;
+        }
+    got = vdag_image_load_file(f, path, c->limits.max_texture_pixels - cache->pixels, &img, why, sizeof why);
+    fclose(f);
+    if (got < 0) {
+        vi_ctx named = *c;
+        named.format = path;
+        return vi_fail(&named, "a %lux%lu texture takes the textures past max_texture_pixels (%llu) pixels in all "
+                               "(vdag build --max-texture-pixels N)",
+                       (unsigned long)img.width, (unsigned long)img.height, (vi_ull)c->limits.max_texture_pixels);
+    }
+    if (got) {
         vdag_image *grown = (vdag_image *)VDAG_IMPORT_REALLOC(s->images, (s->image_count + 1) * sizeof *grown);
         if (!grown) {
             vdag_image_free(&img);
@@ -1238,6 +1403,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
         s->images = grown;
         s->images[s->image_count] = img;
         e->image = (int32_t)s->image_count++;
+        cache->pixels += (uint64_t)img.width * img.height;
     } else {
         if (!c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
     }
@@ -1247,7 +1413,8 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
 
 /* A material library on its own: every material, in file order. */
 static int vi_parse_mtl(vi_ctx *c, vi_text *t, vdag_scene *out) {
-    vi_buf mtls = {NULL, 0, 0}, cache = {NULL, 0, 0};
+    vi_buf mtls = {NULL, 0, 0};
+    vi_texcache cache = {{NULL, 0, 0}, 0};
     size_t i;
     int ok = vi_mtl_parse(c, t, &mtls);
     if (ok && !(out->materials = (vdag_material *)vi_alloc(c, mtls.count, sizeof *out->materials))) ok = 0;
@@ -1496,7 +1663,7 @@ done:
 
 /* Applies material library FILE (named in the .obj) to the used materials.
    Returns 1 when done, 0 on an error, -1 when the file cannot be read. */
-static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file, char *why, size_t why_size) {
+static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span file, char *why, size_t why_size) {
     vi_ctx sub = *o->c;
     vi_buf mtls = {NULL, 0, 0};
     char *path = vi_path(o->c, o->c->base_dir, file), *data = NULL, *dir = NULL;
@@ -1505,14 +1672,11 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file
     int ok = 0;
     if (!path) return 0;
     sub.format = path; /* messages name the library */
-    sub.err = why;
-    sub.err_size = why_size;
-    if (!vi_read_file(&sub, path, &data, &size)) {
+    if ((ok = vi_read_side(&sub, path, &data, &size, why, why_size)) <= 0) {
         free(path);
-        return -1;
+        return ok;
     }
-    sub.err = o->c->err;
-    sub.err_size = o->c->err_size;
+    ok = 0;
     if (!vi_text_start(&sub, data, size, &t) || !(dir = vi_dirname(&sub, path)) || !vi_mtl_parse(&sub, &t, &mtls))
         goto done;
     for (i = 0; i < mtls.count; i++) {
@@ -1536,7 +1700,7 @@ done:
 }
 
 /* vi_obj_mtllib, where a library that cannot be read only gets a warning. */
-static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file) {
+static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span file) {
     char why[512];
     int r = vi_obj_mtllib(o, out, cache, file, why, sizeof why);
     if (r < 0 && !o->c->limits.quiet) fprintf(stderr, "vdag: warning: %s; its materials stay white\n", why);
@@ -1546,7 +1710,7 @@ static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_s
 /* One material per name given to usemtl: white until a library says more.
    An mtllib line names one file, spaces included, or else several. */
 static int vi_obj_materials(vi_obj *o, vdag_scene *out) {
-    vi_buf cache = {NULL, 0, 0};
+    vi_texcache cache = {{NULL, 0, 0}, 0};
     size_t i;
     int ok = 1;
     if (!o->names.count || !out->triangle_count) return 1;
