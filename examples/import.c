@@ -1769,6 +1769,7 @@ typedef struct vi_xform {
 
 typedef struct vi_vox_model {
     uint32_t size[3], count;
+    uint32_t solid; /* voxels of a colour index other than 0 */
     const uint8_t *voxels; /* count * (x, y, z, colour index) */
 } vi_vox_model;
 
@@ -1970,9 +1971,12 @@ static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, in
 
 /* Walks the scene graph from node 0, placing each shape's model; hidden
    nodes, and transforms on hidden layers (HIDDEN: sorted ids), are left out
-   with what lies below them, as MagicaVoxel leaves them out of exports. */
+   with what lies below them, as MagicaVoxel leaves them out of exports.
+   Without PTS it only counts what it would place: the voxels the models
+   list (in *LISTED, refused past max_vox_voxels) and the solid ones among
+   them (in *SOLID). */
 static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *hidden, const vi_buf *models,
-                       const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb) {
+                       const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb, uint64_t *listed, uint64_t *solid) {
     const vi_vox_node *all = (const vi_vox_node *)nodes->data;
     vi_buf stack = {NULL, 0, 0};
     vi_vox_visit *v;
@@ -2005,8 +2009,19 @@ static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *hidden, con
                 vi_fail(c, "shape node %ld shows missing model %ld", (long)n->id, (long)n->model);
                 goto done;
             }
-            if (n->model >= 0 && !vi_vox_place(c, &((const vi_vox_model *)models->data)[n->model], &at.xf, 1, pal, pts, rgb))
+            if (n->model < 0) continue;
+            if (!pts) {
+                const vi_vox_model *m = &((const vi_vox_model *)models->data)[n->model];
+                *listed += m->count;
+                *solid += m->solid;
+                if (*listed > c->limits.max_vox_voxels) {
+                    vi_fail(c, "scene graph places more than max_vox_voxels (%llu) voxels "
+                               "(vdag build --max-vox-voxels N)", (vi_ull)c->limits.max_vox_voxels);
+                    goto done;
+                }
+            } else if (!vi_vox_place(c, &((const vi_vox_model *)models->data)[n->model], &at.xf, 1, pal, pts, rgb)) {
                 goto done;
+            }
             continue;
         }
         if (n->kind == 'T') at.xf = vi_compose(&at.xf, &n->xf);
@@ -2027,6 +2042,19 @@ done:
     return ok;
 }
 
+/* Gives PTS and RGB room for SOLID voxels, exactly (none for none);
+   refused past max_points. */
+static int vi_vox_reserve(vi_ctx *c, uint64_t solid, vi_buf *pts, vi_buf *rgb) {
+    if (solid > c->limits.max_points)
+        return vi_fail(c, "scene holds more than max_points (%llu) voxels", (vi_ull)c->limits.max_points);
+    if (!solid) return 1;
+    if (solid > SIZE_MAX / 3 || !(pts->data = vi_alloc(c, (size_t)solid * 3, sizeof(double))) ||
+        !(rgb->data = vi_alloc(c, (size_t)solid * 3, 1)))
+        return solid > SIZE_MAX / 3 ? vi_fail(c, "out of memory") : 0;
+    pts->cap = rgb->cap = (size_t)solid * 3;
+    return 1;
+}
+
 static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
     vi_buf models = {NULL, 0, 0}, nodes = {NULL, 0, 0}, hidden = {NULL, 0, 0}, pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
@@ -2034,6 +2062,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     size_t palette_entries = 0;
     uint8_t pal[256][3];
     uint32_t version, n, m, size_xyz[3];
+    uint64_t listed = 0, solid = 0;
     int have_size = 0, ok = 0;
     size_t end, i;
     r.data = data;
@@ -2092,6 +2121,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             memcpy(model->size, size_xyz, sizeof size_xyz);
             model->count = count;
             model->voxels = vi_take(&body, (size_t)count * 4);
+            for (model->solid = 0, i = 0; i < count; i++) model->solid += model->voxels[4 * i + 3] != 0;
             have_size = 0;
         } else if (!memcmp(id, "RGBA", 4)) { /* 256 entries; shorter ones, as some tools write, are padded */
             palette = body.data;
@@ -2133,10 +2163,18 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                 goto done;
             }
         if (hidden.count) qsort(hidden.data, hidden.count, sizeof(int32_t), vi_i32_order);
-        if (!vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb)) goto done;
+        /* Counted first, so that a scene graph that instances a model many
+           times is refused before anything is placed, and the voxels kept
+           get memory once, of their exact size. */
+        if (!vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, NULL, NULL, &listed, &solid) ||
+            !vi_vox_reserve(c, solid, &pts, &rgb) ||
+            !vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb, &listed, &solid))
+            goto done;
     } else { /* no scene graph: every model at the origin */
         vi_xform id;
         vi_identity(&id);
+        for (i = 0; i < models.count; i++) solid += ((const vi_vox_model *)models.data)[i].solid;
+        if (!vi_vox_reserve(c, solid, &pts, &rgb)) goto done;
         for (i = 0; i < models.count; i++)
             if (!vi_vox_place(c, &((const vi_vox_model *)models.data)[i], &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
                 goto done;

@@ -1508,6 +1508,67 @@ static void test_vox_errors(void) {
 }
 
 
+/* A scene graph that places a model many times is refused at
+   max_vox_voxels before any voxel is placed: at the default budget (2^31)
+   a model of 65536 empty voxels shown 2^16 times (2^32 voxels to walk),
+   and a small budget on 64 copies of a 2x2x2 cube (512 voxels). */
+static void test_vox_voxel_budget(void) {
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
+    vox_model cube = {{2, 2, 2}, 8, {{0}}};
+    int32_t children[64];
+    vdag_import_limits lim;
+    vdag_scene s;
+    char err[256];
+    int32_t i;
+    int k;
+    for (i = 0; i < 3; i++) put_le32(&c, i < 2 ? 256 : 1);
+    vox_chunk(&body, "SIZE", &c, 0);
+    c.n = 0;
+    put_le32(&c, 65536);
+    for (i = 0; i < 65536; i++) {
+        uint8_t v[4] = {(uint8_t)i, (uint8_t)(i >> 8), 0, 0}; /* colour index 0: empty */
+        put(&c, v, 4);
+    }
+    vox_chunk(&body, "XYZI", &c, 0);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    for (i = 1; i <= 16; i++) {
+        int32_t next[2];
+        next[0] = next[1] = i + 1;
+        vox_group(&body, i, next, 2);
+    }
+    vox_shape(&body, 17, 0);
+    vox_file(&file, &body, 200);
+    expect_error("vox", &file, "max_vox_voxels (2147483648)");
+
+    body.n = file.n = 0;
+    for (i = 0; i < 8; i++) {
+        cube.v[i][0] = (uint8_t)(i & 1);
+        cube.v[i][1] = (uint8_t)(i >> 1 & 1);
+        cube.v[i][2] = (uint8_t)(i >> 2 & 1);
+        cube.v[i][3] = 7;
+    }
+    vox_models(&body, &cube, 1);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    for (i = 0; i < 64; i++) children[i] = 2;
+    vox_group(&body, 1, children, 64);
+    vox_transform(&body, 2, 3, NULL, NULL);
+    vox_shape(&body, 3, 0);
+    vox_file(&file, &body, 200);
+    for (k = 0; k < 2; k++) {
+        memset(&lim, 0, sizeof lim);
+        lim.max_vox_voxels = 512 - (uint64_t)k;
+        if (vdag_import_memory("vox", file.p, file.n, NULL, &lim, &s, err, sizeof err)) {
+            CHECK(!k && s.point_count == 512);
+            vdag_scene_free(&s);
+        } else {
+            CHECK_MSG(k && strstr(err, "max_vox_voxels (511)") && strstr(err, "--max-vox-voxels"), "%s", err);
+        }
+    }
+    free(body.p);
+    free(file.p);
+    free(c.p);
+}
+
 /* Integers past the parser's range are refused, never wrapped at 2^64:
    2^64 + 1 would read as 1 and 2^64 as 0. */
 static void test_integer_overflow(void) {
@@ -1570,5 +1631,6 @@ const test_case test_import_cases[] = {
     {"import/integers out of range refused", test_integer_overflow},
     {"import/side files: regular files only", test_side_files},
     {"import/textures by file identity, pixel budget", test_texture_budget},
+    {"import/vox voxel budget", test_vox_voxel_budget},
     {NULL, NULL},
 };
