@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #ifdef __cplusplus
 extern "C" {
@@ -27,6 +28,16 @@ typedef struct vdag_image {
    ERR (when err_size > 0) and OUT zeroed otherwise. Release with
    vdag_image_free. Thread-safe. */
 int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size);
+
+/* Like vdag_image_load, from F (open for reading at the image's first byte;
+   left open) with NAME in messages, refusing an image of more than
+   MAX_PIXELS pixels before decoding it. Returns 1 on success; 0 with a
+   reason in ERR when the image cannot be decoded (or is larger than
+   VDAG_IMAGE_MAX_PIXELS); -1 when it holds more than MAX_PIXELS pixels
+   (but at most VDAG_IMAGE_MAX_PIXELS): OUT then has only its width and
+   height set. Thread-safe. */
+int vdag_image_load_file(FILE *f, const char *name, uint64_t max_pixels, vdag_image *out, char *err,
+                         size_t err_size);
 
 /* Frees the pixels of IMAGE (NULL-safe) and zeroes it. */
 void vdag_image_free(vdag_image *image);

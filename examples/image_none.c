@@ -11,6 +11,13 @@ int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_siz
     return 0;
 }
 
+int vdag_image_load_file(FILE *f, const char *name, uint64_t max_pixels, vdag_image *out, char *err,
+                         size_t err_size) {
+    (void)f;
+    (void)max_pixels;
+    return vdag_image_load(name, out, err, err_size);
+}
+
 void vdag_image_free(vdag_image *image) {
     if (!image) return;
     free(image->rgb);

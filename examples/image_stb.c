@@ -21,24 +21,23 @@ static int image_fail(const char *path, const char *why, char *err, size_t err_s
     return 0;
 }
 
-int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size) {
+int vdag_image_load_file(FILE *f, const char *path, uint64_t max_pixels, vdag_image *out, char *err,
+                         size_t err_size) {
     int w, h, channels;
     size_t i, n;
     uint8_t *rgba, *rgb, *alpha = NULL;
-    FILE *f;
     memset(out, 0, sizeof *out);
-    if (!(f = fopen(path, "rb"))) return image_fail(path, "cannot open the file", err, err_size);
     /* The size comes first, so that a small file cannot force a large allocation. */
-    if (!stbi_info_from_file(f, &w, &h, &channels)) {
-        fclose(f);
+    if (!stbi_info_from_file(f, &w, &h, &channels))
         return image_fail(path, "not a PNG, JPEG, TGA, BMP or PNM image, or a corrupt one", err, err_size);
-    }
-    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > VDAG_IMAGE_MAX_PIXELS) {
-        fclose(f);
+    if (w <= 0 || h <= 0 || (uint64_t)w * (uint64_t)h > VDAG_IMAGE_MAX_PIXELS)
         return image_fail(path, "image too large", err, err_size);
+    if ((uint64_t)w * (uint64_t)h > max_pixels) {
+        out->width = (uint32_t)w;
+        out->height = (uint32_t)h;
+        return -1;
     }
     rgba = stbi_load_from_file(f, &w, &h, &channels, 4);
-    fclose(f);
     if (!rgba) return image_fail(path, stbi_failure_reason(), err, err_size);
     n = (size_t)w * (size_t)h;
     rgb = (uint8_t *)malloc(3 * n);
@@ -58,6 +57,16 @@ int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_siz
     out->rgb = rgb;
     out->alpha = alpha;
     return 1;
+}
+
+int vdag_image_load(const char *path, vdag_image *out, char *err, size_t err_size) {
+    FILE *f;
+    int ok;
+    memset(out, 0, sizeof *out);
+    if (!(f = fopen(path, "rb"))) return image_fail(path, "cannot open the file", err, err_size);
+    ok = vdag_image_load_file(f, path, VDAG_IMAGE_MAX_PIXELS, out, err, err_size);
+    fclose(f);
+    return ok;
 }
 
 void vdag_image_free(vdag_image *image) {

@@ -2,11 +2,17 @@
    top of shared helpers: error messages, growable arrays, a text cursor and a
    bounds-checked binary reader. Every size read from a file is checked
    against the bytes that remain before anything is allocated for it. */
-#define _POSIX_C_SOURCE 200809L /* fileno, fstat */
+#define _POSIX_C_SOURCE 200809L /* fileno, fstat, open, fdopen */
 #include "import.h"
 
 #include <sys/stat.h>
 #include <errno.h>
+#ifdef _WIN32
+#include <stdlib.h> /* _fullpath */
+#else
+#include <fcntl.h>
+#include <unistd.h>
+#endif
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -59,6 +65,8 @@ static void vi_ctx_init(vi_ctx *c, const char *format, char *err, size_t err_siz
     if (!c->limits.max_points) c->limits.max_points = VDAG_IMPORT_MAX_POINTS;
     if (!c->limits.max_vertices) c->limits.max_vertices = VDAG_IMPORT_MAX_VERTICES;
     if (!c->limits.max_triangles) c->limits.max_triangles = VDAG_IMPORT_MAX_TRIANGLES;
+    if (!c->limits.max_texture_pixels) c->limits.max_texture_pixels = VDAG_IMPORT_MAX_TEXTURE_PIXELS;
+    if (!c->limits.max_vox_voxels) c->limits.max_vox_voxels = VDAG_IMPORT_MAX_VOX_VOXELS;
 }
 
 /* Writes "FORMAT: message" to the caller's buffer; returns 0 so that parsers
@@ -236,17 +244,18 @@ static int vi_integer_syntax(vi_span tok) {
 }
 
 /* Parses TOK as a decimal integer with an optional sign and a magnitude of at
-   most 2^62; 0 otherwise. */
+   most 2^62; 0 otherwise (a larger one is refused before it could wrap). */
 static int vi_int(vi_span tok, int64_t *out) {
+    const uint64_t max = (uint64_t)1 << 62;
     const char *s = tok.s;
     uint64_t v = 0;
     int neg = 0;
     if (s < tok.e && (*s == '-' || *s == '+')) neg = *s++ == '-';
     if (s == tok.e) return 0;
     for (; s < tok.e; s++) {
-        if (*s < '0' || *s > '9') return 0;
-        v = v * 10 + (uint64_t)(*s - '0');
-        if (v > ((uint64_t)1 << 62)) return 0;
+        uint64_t d = (uint64_t)(*s - '0');
+        if (*s < '0' || *s > '9' || v > (max - d) / 10) return 0;
+        v = v * 10 + d;
     }
     *out = neg ? -(int64_t)v : (int64_t)v;
     return 1;
@@ -1056,38 +1065,30 @@ static uint64_t vi_hash_u64(uint64_t x) { /* splitmix64 finaliser */
 
 // -- Files and paths
 
-/* Reads the whole file at PATH into *DATA (malloc'd) and *SIZE. */
-static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
+/* Reads F to its end into *DATA (malloc'd) and *SIZE: at most MAX bytes
+   (else an error naming WHAT, the limit); KNOWN (or -1) reserves the size. */
+static int vi_read_stream(vi_ctx *c, FILE *f, long known, uint64_t max, const char *what, char **data,
+                          size_t *size) {
     enum { CHUNK = 1 << 16 };
     vi_buf b = {NULL, 0, 0};
     int ok = 1, too_big = 0;
-    FILE *f = fopen(path, "rb");
-    long known;
-    struct stat st;
-    if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
-    if (!fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
-        fclose(f);
-        return vi_fail(c, "is a directory, not a file");
-    }
     /* Reserve the size when it is known, so that big files are not copied. */
-    if (!fseek(f, 0, SEEK_END) && (known = ftell(f)) > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
-        too_big = (uint64_t)known > c->limits.max_input_bytes;
+    if (known > 0 && (unsigned long)known < SIZE_MAX - CHUNK) {
+        too_big = (uint64_t)known > max;
         ok = !too_big && vi_push(c, &b, 1, (size_t)known + CHUNK) != NULL;
         b.count = 0;
     }
-    rewind(f);
     while (ok) {
         char *chunk = (char *)vi_push(c, &b, 1, CHUNK);
         size_t got;
         if (!(ok = chunk != NULL)) break;
         got = fread(chunk, 1, CHUNK, f);
         b.count -= CHUNK - got;
-        if ((too_big = b.count > c->limits.max_input_bytes) != 0) ok = 0;
+        if ((too_big = b.count > max) != 0) ok = 0;
         if (got < CHUNK) break;
     }
-    if (too_big) vi_fail(c, "file larger than max_input_bytes (%llu)", (vi_ull)c->limits.max_input_bytes);
+    if (too_big) vi_fail(c, "file larger than %s (%llu)", what, (vi_ull)max);
     if (ok && ferror(f)) ok = vi_fail(c, "cannot read the file (%s)", strerror(errno));
-    fclose(f);
     if (!ok) {
         vi_buf_free(&b);
         return 0;
@@ -1095,6 +1096,130 @@ static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) 
     *data = (char *)b.data;
     *size = b.count;
     return 1;
+}
+
+/* Reads the whole file at PATH into *DATA (malloc'd) and *SIZE. */
+static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
+    FILE *f = fopen(path, "rb");
+    long known = -1;
+    struct stat st;
+    int ok;
+    if (!f) return vi_fail(c, "cannot open the file (%s)", strerror(errno));
+    if (!fstat(fileno(f), &st) && S_ISDIR(st.st_mode)) {
+        fclose(f);
+        return vi_fail(c, "is a directory, not a file");
+    }
+    if (!fseek(f, 0, SEEK_END)) known = ftell(f);
+    rewind(f);
+    ok = vi_read_stream(c, f, known, c->limits.max_input_bytes, "max_input_bytes", data, size);
+    fclose(f);
+    return ok;
+}
+
+/* The identity of an open file, so that one file named under several
+   spellings is read once: its device and inode, or (Windows, where these
+   are not kept) its full path. */
+typedef struct vi_file_id {
+    uint64_t dev, ino;
+    char *full; /* malloc'd; NULL but on Windows */
+} vi_file_id;
+
+static int vi_same_file(const vi_file_id *a, const vi_file_id *b) {
+    if (a->full || b->full) return a->full && b->full && !strcmp(a->full, b->full);
+    return a->dev == b->dev && a->ino == b->ino;
+}
+
+/* Opens side file PATH (a material library or a texture) for reading, into
+   *F with its identity in ID and its size in *SIZE. Only a regular file of
+   at most VDAG_IMPORT_MAX_SIDE_FILE_BYTES (and max_input_bytes) is opened:
+   the check comes before any read, and a FIFO is never waited on (POSIX:
+   opened without blocking, then checked through its descriptor). Returns
+   1; -1 when PATH cannot be opened (the reason in WHY); 0 when it is
+   refused or on an allocation failure (a message naming PATH in C). */
+static uint64_t vi_side_max(const vi_ctx *c) {
+    return c->limits.max_input_bytes < VDAG_IMPORT_MAX_SIDE_FILE_BYTES ? c->limits.max_input_bytes
+                                                                      : VDAG_IMPORT_MAX_SIDE_FILE_BYTES;
+}
+
+static int vi_open_side(vi_ctx *c, const char *path, FILE **f, vi_file_id *id, uint64_t *size, char *why,
+                        size_t why_size) {
+    uint64_t max = vi_side_max(c);
+    vi_ctx named = *c;
+    int regular;
+#ifdef _WIN32
+    struct _stat64 st;
+#else
+    struct stat st;
+    int fd;
+#endif
+    named.format = path;
+    *f = NULL;
+    memset(id, 0, sizeof *id);
+#ifdef _WIN32
+    /* No FIFOs in Windows' file system; devices (NUL, CON) are not regular. */
+    if (_stat64(path, &st)) {
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+    regular = (st.st_mode & _S_IFMT) == _S_IFREG;
+#else
+    if ((fd = open(path, O_RDONLY | O_NONBLOCK)) < 0) {
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+    if (fstat(fd, &st)) {
+        snprintf(why, why_size, "%s: cannot read the file (%s)", path, strerror(errno));
+        close(fd);
+        return -1;
+    }
+    regular = S_ISREG(st.st_mode) != 0;
+#endif
+    if (!regular || st.st_size < 0 || (uint64_t)st.st_size > max) {
+#ifndef _WIN32
+        close(fd);
+#endif
+        if (!regular)
+            return vi_fail(&named, "not a regular file (a directory, FIFO or device): material libraries "
+                                   "and textures are read only from regular files");
+        return vi_fail(&named, "file larger than %llu bytes, the most read from a material library or texture",
+                       (vi_ull)max);
+    }
+    *size = (uint64_t)st.st_size;
+#ifdef _WIN32
+    if (!(id->full = _fullpath(NULL, path, 0))) return vi_fail(c, "out of memory");
+    if (!(*f = fopen(path, "rb"))) {
+        free(id->full);
+        id->full = NULL;
+        snprintf(why, why_size, "%s: cannot open the file (%s)", path, strerror(errno));
+        return -1;
+    }
+#else
+    id->dev = (uint64_t)st.st_dev;
+    id->ino = (uint64_t)st.st_ino;
+    /* O_NONBLOCK has no effect on reads of a regular file. */
+    if (!(*f = fdopen(fd, "rb"))) {
+        close(fd);
+        return vi_fail(c, "out of memory");
+    }
+#endif
+    return 1;
+}
+
+/* Reads side file PATH whole into *DATA (malloc'd) and *SIZE, as
+   vi_open_side allows; returns as it does. */
+static int vi_read_side(vi_ctx *c, const char *path, char **data, size_t *size, char *why, size_t why_size) {
+    FILE *f;
+    vi_file_id id;
+    uint64_t known;
+    vi_ctx named = *c;
+    int ok = vi_open_side(c, path, &f, &id, &known, why, why_size);
+    if (ok <= 0) return ok;
+    free(id.full);
+    named.format = path;
+    /* The limit holds also for a file that grows while it is read. */
+    ok = vi_read_stream(&named, f, (long)known, vi_side_max(c), "VDAG_IMPORT_MAX_SIDE_FILE_BYTES", data, size);
+    fclose(f);
+    return ok;
 }
 
 /* Directory part of PATH ("." if none), malloc'd. */
@@ -1193,42 +1318,83 @@ static int vi_mtl_parse(vi_ctx *c, vi_text *t, vi_buf *mtls) {
     return 1;
 }
 
-/* Textures loaded so far, by path, so that each file is read once. */
+/* Textures loaded so far, by file identity, so that each file is read (and
+   counted against max_texture_pixels) once however it is named; by the
+   name too, so that a name seen before needs no system call. */
 typedef struct vi_tex {
-    char *path;
-    int32_t image; /* -1: could not be decoded */
+    char *path;     /* the name as resolved by vi_path */
+    vi_file_id id;  /* valid when opened */
+    int opened;
+    int32_t image;  /* -1: could not be decoded */
 } vi_tex;
 
-static void vi_tex_free(vi_buf *cache) {
+typedef struct vi_texcache {
+    vi_buf entries; /* vi_tex */
+    uint64_t pixels; /* of the textures decoded so far */
+} vi_texcache;
+
+static void vi_tex_free(vi_texcache *cache) {
     size_t i;
-    for (i = 0; i < cache->count; i++) free(((vi_tex *)cache->data)[i].path);
-    vi_buf_free(cache);
+    for (i = 0; i < cache->entries.count; i++) {
+        free(((vi_tex *)cache->entries.data)[i].path);
+        free(((vi_tex *)cache->entries.data)[i].id.full);
+    }
+    vi_buf_free(&cache->entries);
+    cache->pixels = 0;
 }
 
 /* Sets *IMAGE to the scene image of texture FILE (named in a file in DIR),
-   decoding it on first use; -1, with a warning, if it cannot be decoded, or
-   -1 when the caller skips textures: the material then keeps its Kd colour. */
-static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, vi_span file, int32_t *image) {
+   decoding it on first use; -1, with a warning, if it cannot be opened or
+   decoded, or -1 when the caller skips textures: the material then keeps its
+   Kd colour. A texture that is not a regular file or is too large, or whose
+   pixels would take the textures past max_texture_pixels, is an error. */
+static int vi_texture(vi_ctx *c, vdag_scene *s, vi_texcache *cache, const char *dir, vi_span file, int32_t *image) {
     char *path, why[512];
-    vi_tex *e;
+    vi_tex *e, *all;
     vdag_image img;
     size_t i;
+    uint64_t bytes;
+    FILE *f;
+    int got;
     *image = -1;
     if (c->limits.skip_textures) return 1;
     if (!(path = vi_path(c, dir, file))) return 0;
-    for (i = 0; i < cache->count; i++)
-        if (!strcmp(((vi_tex *)cache->data)[i].path, path)) {
+    all = (vi_tex *)cache->entries.data;
+    for (i = 0; i < cache->entries.count; i++)
+        if (!strcmp(all[i].path, path)) {
             free(path);
-            *image = ((vi_tex *)cache->data)[i].image;
+            *image = all[i].image;
             return 1;
         }
-    if (!(e = (vi_tex *)vi_push(c, cache, sizeof *e, 1))) {
+    if (!(e = (vi_tex *)vi_push(c, &cache->entries, sizeof *e, 1))) {
         free(path);
         return 0;
     }
+    memset(e, 0, sizeof *e);
     e->path = path;
     e->image = -1;
-    if (vdag_image_load(path, &img, why, sizeof why)) {
+    if ((got = vi_open_side(c, path, &f, &e->id, &bytes, why, sizeof why)) <= 0) {
+        if (got < 0 && !c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
+        return got < 0;
+    }
+    e->opened = 1;
+    all = (vi_tex *)cache->entries.data;
+    for (i = 0; i + 1 < cache->entries.count; i++)
+        if (all[i].opened && vi_same_file(&all[i].id, &e->id)) {
+            fclose(f);
+            *image = e->image = all[i].image;
+            return 1;
+        }
+    got = vdag_image_load_file(f, path, c->limits.max_texture_pixels - cache->pixels, &img, why, sizeof why);
+    fclose(f);
+    if (got < 0) {
+        vi_ctx named = *c;
+        named.format = path;
+        return vi_fail(&named, "a %lux%lu texture takes the textures past max_texture_pixels (%llu) pixels in all "
+                               "(vdag build --max-texture-pixels N)",
+                       (unsigned long)img.width, (unsigned long)img.height, (vi_ull)c->limits.max_texture_pixels);
+    }
+    if (got) {
         vdag_image *grown = (vdag_image *)VDAG_IMPORT_REALLOC(s->images, (s->image_count + 1) * sizeof *grown);
         if (!grown) {
             vdag_image_free(&img);
@@ -1237,6 +1403,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
         s->images = grown;
         s->images[s->image_count] = img;
         e->image = (int32_t)s->image_count++;
+        cache->pixels += (uint64_t)img.width * img.height;
     } else {
         if (!c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
     }
@@ -1246,7 +1413,8 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
 
 /* A material library on its own: every material, in file order. */
 static int vi_parse_mtl(vi_ctx *c, vi_text *t, vdag_scene *out) {
-    vi_buf mtls = {NULL, 0, 0}, cache = {NULL, 0, 0};
+    vi_buf mtls = {NULL, 0, 0};
+    vi_texcache cache = {{NULL, 0, 0}, 0};
     size_t i;
     int ok = vi_mtl_parse(c, t, &mtls);
     if (ok && !(out->materials = (vdag_material *)vi_alloc(c, mtls.count, sizeof *out->materials))) ok = 0;
@@ -1495,7 +1663,7 @@ done:
 
 /* Applies material library FILE (named in the .obj) to the used materials.
    Returns 1 when done, 0 on an error, -1 when the file cannot be read. */
-static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file, char *why, size_t why_size) {
+static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span file, char *why, size_t why_size) {
     vi_ctx sub = *o->c;
     vi_buf mtls = {NULL, 0, 0};
     char *path = vi_path(o->c, o->c->base_dir, file), *data = NULL, *dir = NULL;
@@ -1504,14 +1672,11 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file
     int ok = 0;
     if (!path) return 0;
     sub.format = path; /* messages name the library */
-    sub.err = why;
-    sub.err_size = why_size;
-    if (!vi_read_file(&sub, path, &data, &size)) {
+    if ((ok = vi_read_side(&sub, path, &data, &size, why, why_size)) <= 0) {
         free(path);
-        return -1;
+        return ok;
     }
-    sub.err = o->c->err;
-    sub.err_size = o->c->err_size;
+    ok = 0;
     if (!vi_text_start(&sub, data, size, &t) || !(dir = vi_dirname(&sub, path)) || !vi_mtl_parse(&sub, &t, &mtls))
         goto done;
     for (i = 0; i < mtls.count; i++) {
@@ -1535,7 +1700,7 @@ done:
 }
 
 /* vi_obj_mtllib, where a library that cannot be read only gets a warning. */
-static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file) {
+static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span file) {
     char why[512];
     int r = vi_obj_mtllib(o, out, cache, file, why, sizeof why);
     if (r < 0 && !o->c->limits.quiet) fprintf(stderr, "vdag: warning: %s; its materials stay white\n", why);
@@ -1545,7 +1710,7 @@ static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_s
 /* One material per name given to usemtl: white until a library says more.
    An mtllib line names one file, spaces included, or else several. */
 static int vi_obj_materials(vi_obj *o, vdag_scene *out) {
-    vi_buf cache = {NULL, 0, 0};
+    vi_texcache cache = {{NULL, 0, 0}, 0};
     size_t i;
     int ok = 1;
     if (!o->names.count || !out->triangle_count) return 1;
@@ -1604,6 +1769,7 @@ typedef struct vi_xform {
 
 typedef struct vi_vox_model {
     uint32_t size[3], count;
+    uint32_t solid; /* voxels of a colour index other than 0 */
     const uint8_t *voxels; /* count * (x, y, z, colour index) */
 } vi_vox_model;
 
@@ -1805,9 +1971,12 @@ static int vi_vox_place(vi_ctx *c, const vi_vox_model *m, const vi_xform *xf, in
 
 /* Walks the scene graph from node 0, placing each shape's model; hidden
    nodes, and transforms on hidden layers (HIDDEN: sorted ids), are left out
-   with what lies below them, as MagicaVoxel leaves them out of exports. */
+   with what lies below them, as MagicaVoxel leaves them out of exports.
+   Without PTS it only counts what it would place: the voxels the models
+   list (in *LISTED, refused past max_vox_voxels) and the solid ones among
+   them (in *SOLID). */
 static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *hidden, const vi_buf *models,
-                       const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb) {
+                       const uint8_t pal[256][3], vi_buf *pts, vi_buf *rgb, uint64_t *listed, uint64_t *solid) {
     const vi_vox_node *all = (const vi_vox_node *)nodes->data;
     vi_buf stack = {NULL, 0, 0};
     vi_vox_visit *v;
@@ -1840,8 +2009,19 @@ static int vi_vox_walk(vi_ctx *c, const vi_buf *nodes, const vi_buf *hidden, con
                 vi_fail(c, "shape node %ld shows missing model %ld", (long)n->id, (long)n->model);
                 goto done;
             }
-            if (n->model >= 0 && !vi_vox_place(c, &((const vi_vox_model *)models->data)[n->model], &at.xf, 1, pal, pts, rgb))
+            if (n->model < 0) continue;
+            if (!pts) {
+                const vi_vox_model *m = &((const vi_vox_model *)models->data)[n->model];
+                *listed += m->count;
+                *solid += m->solid;
+                if (*listed > c->limits.max_vox_voxels) {
+                    vi_fail(c, "scene graph places more than max_vox_voxels (%llu) voxels "
+                               "(vdag build --max-vox-voxels N)", (vi_ull)c->limits.max_vox_voxels);
+                    goto done;
+                }
+            } else if (!vi_vox_place(c, &((const vi_vox_model *)models->data)[n->model], &at.xf, 1, pal, pts, rgb)) {
                 goto done;
+            }
             continue;
         }
         if (n->kind == 'T') at.xf = vi_compose(&at.xf, &n->xf);
@@ -1862,6 +2042,19 @@ done:
     return ok;
 }
 
+/* Gives PTS and RGB room for SOLID voxels, exactly (none for none);
+   refused past max_points. */
+static int vi_vox_reserve(vi_ctx *c, uint64_t solid, vi_buf *pts, vi_buf *rgb) {
+    if (solid > c->limits.max_points)
+        return vi_fail(c, "scene holds more than max_points (%llu) voxels", (vi_ull)c->limits.max_points);
+    if (!solid) return 1;
+    if (solid > SIZE_MAX / 3 || !(pts->data = vi_alloc(c, (size_t)solid * 3, sizeof(double))) ||
+        !(rgb->data = vi_alloc(c, (size_t)solid * 3, 1)))
+        return solid > SIZE_MAX / 3 ? vi_fail(c, "out of memory") : 0;
+    pts->cap = rgb->cap = (size_t)solid * 3;
+    return 1;
+}
+
 static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
     vi_buf models = {NULL, 0, 0}, nodes = {NULL, 0, 0}, hidden = {NULL, 0, 0}, pts = {NULL, 0, 0}, rgb = {NULL, 0, 0};
@@ -1869,6 +2062,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     size_t palette_entries = 0;
     uint8_t pal[256][3];
     uint32_t version, n, m, size_xyz[3];
+    uint64_t listed = 0, solid = 0;
     int have_size = 0, ok = 0;
     size_t end, i;
     r.data = data;
@@ -1927,6 +2121,7 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             memcpy(model->size, size_xyz, sizeof size_xyz);
             model->count = count;
             model->voxels = vi_take(&body, (size_t)count * 4);
+            for (model->solid = 0, i = 0; i < count; i++) model->solid += model->voxels[4 * i + 3] != 0;
             have_size = 0;
         } else if (!memcmp(id, "RGBA", 4)) { /* 256 entries; shorter ones, as some tools write, are padded */
             palette = body.data;
@@ -1968,10 +2163,18 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                 goto done;
             }
         if (hidden.count) qsort(hidden.data, hidden.count, sizeof(int32_t), vi_i32_order);
-        if (!vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb)) goto done;
+        /* Counted first, so that a scene graph that instances a model many
+           times is refused before anything is placed, and the voxels kept
+           get memory once, of their exact size. */
+        if (!vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, NULL, NULL, &listed, &solid) ||
+            !vi_vox_reserve(c, solid, &pts, &rgb) ||
+            !vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb, &listed, &solid))
+            goto done;
     } else { /* no scene graph: every model at the origin */
         vi_xform id;
         vi_identity(&id);
+        for (i = 0; i < models.count; i++) solid += ((const vi_vox_model *)models.data)[i].solid;
+        if (!vi_vox_reserve(c, solid, &pts, &rgb)) goto done;
         for (i = 0; i < models.count; i++)
             if (!vi_vox_place(c, &((const vi_vox_model *)models.data)[i], &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
                 goto done;

@@ -72,12 +72,23 @@ extern "C" {
    zero field means the default below. While parsing, memory stays within a
    small multiple of the input bytes (every count read from a file is checked
    against the bytes that remain first), except for .vox scene graphs, which
-   can instance one model many times: their expansion stops at max_points. */
+   can instance one model many times: the voxels they place are counted
+   before any is placed, and refused past max_vox_voxels (every voxel a
+   shape's model lists, empty ones included, once per shape showing it) or
+   past max_points (the voxels kept). Textures: their pixels in all (each
+   file counted once, however it is named) are refused past
+   max_texture_pixels, before decoding the image that would exceed it.
+   Side files (material libraries, textures) are read only when they are
+   regular files of at most VDAG_IMPORT_MAX_SIDE_FILE_BYTES (and at most
+   max_input_bytes): a device, FIFO or directory is refused with a message
+   naming it, without reading or waiting on it. */
 typedef struct vdag_import_limits {
     uint64_t max_input_bytes; /* 0: VDAG_IMPORT_MAX_INPUT_BYTES */
     uint64_t max_points;      /* 0: VDAG_IMPORT_MAX_POINTS */
     uint64_t max_vertices;    /* 0: VDAG_IMPORT_MAX_VERTICES */
     uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
+    uint64_t max_texture_pixels; /* 0: VDAG_IMPORT_MAX_TEXTURE_PIXELS (all textures) */
+    uint64_t max_vox_voxels;  /* 0: VDAG_IMPORT_MAX_VOX_VOXELS (a .vox scene graph) */
     int skip_textures;        /* 1: do not decode texture images (materials keep
                                  their colours; for callers that need no colours) */
     int quiet;                /* 1: no warnings on stderr (what an import
@@ -95,6 +106,16 @@ typedef struct vdag_import_limits {
 #endif
 #ifndef VDAG_IMPORT_MAX_TRIANGLES
 #define VDAG_IMPORT_MAX_TRIANGLES ((uint64_t)1 << 28)
+#endif
+#ifndef VDAG_IMPORT_MAX_TEXTURE_PIXELS
+#define VDAG_IMPORT_MAX_TEXTURE_PIXELS ((uint64_t)1 << 28)
+#endif
+#ifndef VDAG_IMPORT_MAX_VOX_VOXELS
+#define VDAG_IMPORT_MAX_VOX_VOXELS ((uint64_t)1 << 31)
+#endif
+/* The largest side file (a material library or a texture) read, in bytes. */
+#ifndef VDAG_IMPORT_MAX_SIDE_FILE_BYTES
+#define VDAG_IMPORT_MAX_SIDE_FILE_BYTES ((uint64_t)256 << 20) /* 256 MiB */
 #endif
 
 typedef struct vdag_material {

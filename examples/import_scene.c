@@ -37,11 +37,17 @@
 
 // -- Shared: texture lookup, little-endian scalars
 
-/* 1 if a regular file can be opened at PATH. */
+/* 1 if something is at PATH (a file that vi_texture then opens, or refuses
+   if it is not a regular file): looked up without opening it, as opening a
+   FIFO would wait for a writer. */
 static int vs_exists(const char *path) {
-    FILE *f = fopen(path, "rb");
-    if (f) fclose(f);
-    return f != NULL;
+#ifdef _WIN32
+    struct _stat64 st;
+    return _stat64(path, &st) == 0;
+#else
+    struct stat st;
+    return stat(path, &st) == 0;
+#endif
 }
 
 /* DIR/SUB/NAME if that file exists (malloc'd in *FOUND), else *FOUND = NULL.
@@ -132,7 +138,8 @@ typedef struct vs_spm_mat {
 static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
     vi_buf mats = {NULL, 0, 0}, pos = {NULL, 0, 0}, uv = {NULL, 0, 0}, rgb = {NULL, 0, 0};
-    vi_buf tris = {NULL, 0, 0}, tmat = {NULL, 0, 0}, cache = {NULL, 0, 0};
+    vi_buf tris = {NULL, 0, 0}, tmat = {NULL, 0, 0};
+    vi_texcache cache = {{NULL, 0, 0}, 0};
     const uint8_t *h;
     uint32_t nmat, nmesh, mesh, flags, i;
     int ok = 0, any_tex = 0;
@@ -326,7 +333,8 @@ typedef struct vs_ac {
     vdag_scene *out;
     vi_buf mats;  /* 3 bytes per MATERIAL line */
     vi_buf pairs; /* per scene material: int32 MATERIAL index (-1 none), int32 image */
-    vi_buf pos, uv, tris, tmat, verts, cache;
+    vi_buf pos, uv, tris, tmat, verts;
+    vi_texcache cache;
     int32_t last; /* scene material of the last surface, or -1 */
 } vs_ac;
 

@@ -3,8 +3,8 @@
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
-              [--chunk-levels C] [--threads T] [--max-memory MIB] [--force] [--stats]
-              [--quiet]
+              [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
+              [--max-vox-voxels N] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -148,6 +148,11 @@ static const struct {
      "  --threads T        worker threads, >= 1 (default: the processors online)\n"
      "  --max-memory MIB   the most memory the builder may hold, in MiB (2^20 bytes), >= 1;\n"
      "                     a build that needs more stops with a limit error (default: no limit)\n"
+     "  --max-texture-pixels N  the most pixels of all textures together (each file counted\n"
+     "                     once), >= 1; a scene past it is refused (default: 268435456, 2^28)\n"
+     "  --max-vox-voxels N the most voxels a .vox scene graph may place (a model once per\n"
+     "                     shape showing it), >= 1; past it the file is refused (default:\n"
+     "                     2147483648, 2^31)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
      "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
      "  --stats            also count the nodes per level under all three symmetry groups\n"
@@ -210,6 +215,19 @@ static int parse_u32(const char *s, uint32_t *out) {
     return 1;
 }
 
+/* A count 1..2^64-1 in decimal; 0 for anything else (a sign, trailing text,
+   a number past 2^64 - 1). */
+static int parse_count(const char *s, uint64_t *out) {
+    char *end;
+    unsigned long long v;
+    errno = 0;
+    if (s[0] < '0' || s[0] > '9') return 0;
+    v = strtoull(s, &end, 10);
+    if (errno || end == s || *end || !v) return 0;
+    *out = (uint64_t)v;
+    return 1;
+}
+
 static int parse_double(const char *s, double *out) {
     char *end;
     *out = strtod(s, &end);
@@ -244,6 +262,8 @@ typedef struct build_args {
     int force;              /* --force: build even past the machine's memory */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
     uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
+    uint64_t max_texture_pixels; /* --max-texture-pixels; 0: the importer's default */
+    uint64_t max_vox_voxels;     /* --max-vox-voxels; 0: the importer's default */
 } build_args;
 
 /* Progress of a build: on a terminal, one line per stage updated in place
@@ -789,6 +809,12 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--max-memory") && k + 1 < argc) {
             if (!parse_u32(argv[++k], &a.max_memory) || !a.max_memory)
                 return vdag_fail("build: --max-memory takes MiB >= 1");
+        } else if (!strcmp(argv[k], "--max-texture-pixels") && k + 1 < argc) {
+            if (!parse_count(argv[++k], &a.max_texture_pixels))
+                return vdag_fail("build: --max-texture-pixels takes a pixel count >= 1");
+        } else if (!strcmp(argv[k], "--max-vox-voxels") && k + 1 < argc) {
+            if (!parse_count(argv[++k], &a.max_vox_voxels))
+                return vdag_fail("build: --max-vox-voxels takes a voxel count >= 1");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
         } else if (!strcmp(argv[k], "--quiet")) {
@@ -842,6 +868,8 @@ static int cmd_build(int argc, char **argv) {
     memset(&limits, 0, sizeof limits);
     /* Textures give colours and the alpha test: without both, nothing to decode them for. */
     limits.skip_textures = a.no_colors && a.no_alpha_test;
+    limits.max_texture_pixels = a.max_texture_pixels;
+    limits.max_vox_voxels = a.max_vox_voxels;
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
     if (!a.up) a.up = default_up(a.in);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
@@ -1066,7 +1094,8 @@ static int usage(FILE *f) {
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
           "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
-          "                    [--threads T] [--max-memory MIB] [--force] [--stats] [--quiet]\n"
+          "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
+          "                    [--max-vox-voxels N] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

@@ -182,6 +182,41 @@ check "--max-memory 1 fails as a limit, one line naming it" sh -c "! '$VDAG' bui
 check "--max-memory 512 builds" "$VDAG" build "$T/alpha.obj" "$T/mm.vdag" --levels 8 --max-memory 512 --quiet
 check "--max-memory 0 is refused" sh -c "! '$VDAG' build '$T/alpha.obj' '$T/mm0.vdag' --max-memory 0 2>/dev/null"
 
+# -- import limits: --max-texture-pixels (all textures, one file counted once
+# however it is named) and --max-vox-voxels (a .vox scene graph's placed
+# voxels) refuse past them with one line naming the option; side files must
+# be regular files (a FIFO as material library is refused, not waited on)
+python3 - "$T" <<'EOF'
+import struct, sys
+t = sys.argv[1]
+open(t + "/lim.ppm", "wb").write(b"P6\n3 2\n255\n" + bytes(range(18)))
+open(t + "/lim.mtl", "w").write("newmtl a\nmap_Kd lim.ppm\nnewmtl b\nmap_Kd ./lim.ppm\n")
+open(t + "/lim.obj", "w").write("mtllib lim.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                                "usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 3/3 2/2 1/1\n")
+def chunk(i, body): return i + struct.pack("<II", len(body), 0) + body
+def string(s): return struct.pack("<I", len(s)) + s
+def dict_(*kv): return struct.pack("<I", len(kv) // 2) + b"".join(string(x) for x in kv)
+body = chunk(b"SIZE", struct.pack("<III", 2, 2, 2))
+body += chunk(b"XYZI", struct.pack("<I", 8) + bytes(b for i in range(8) for b in (i & 1, i >> 1 & 1, i >> 2, 7)))
+body += chunk(b"nTRN", struct.pack("<i", 0) + dict_() + struct.pack("<iiiI", 1, -1, 0, 1) + dict_())
+body += chunk(b"nGRP", struct.pack("<i", 1) + dict_() + struct.pack("<I", 64) + struct.pack("<i", 2) * 64)
+body += chunk(b"nTRN", struct.pack("<i", 2) + dict_() + struct.pack("<iiiI", 3, -1, 0, 1) + dict_())
+body += chunk(b"nSHP", struct.pack("<i", 3) + dict_() + struct.pack("<Ii", 1, 0) + dict_())
+open(t + "/lim.vox", "wb").write(b"VOX " + struct.pack("<I", 200) + b"MAIN" + struct.pack("<II", 0, len(body)) + body)
+EOF
+check "--max-texture-pixels 6 builds (one 3x2 texture named twice)" "$VDAG" build "$T/lim.obj" "$T/lim.vdag" --levels 3 --max-texture-pixels 6 --quiet
+check "--max-texture-pixels 5 is refused, one line naming it" sh -c "! '$VDAG' build '$T/lim.obj' '$T/lim5.vdag' --levels 3 --max-texture-pixels 5 --quiet 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && grep -q 'max_texture_pixels (5)' '$T/err' && grep -q -- '--max-texture-pixels' '$T/err' && [ ! -e '$T/lim5.vdag' ]"
+check "--max-vox-voxels 512 builds 64 instances of 8 voxels" "$VDAG" build "$T/lim.vox" "$T/limv.vdag" --max-vox-voxels 512 --quiet
+check "--max-vox-voxels 511 is refused, one line naming it" sh -c "! '$VDAG' build '$T/lim.vox' '$T/limv1.vdag' --max-vox-voxels 511 --quiet 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && grep -q 'max_vox_voxels (511)' '$T/err' && grep -q -- '--max-vox-voxels' '$T/err' && [ ! -e '$T/limv1.vdag' ]"
+check "--max-texture-pixels and --max-vox-voxels take counts >= 1" sh -c "! '$VDAG' build '$T/lim.vox' '$T/l0.vdag' --max-vox-voxels 0 2>/dev/null &&
+    ! '$VDAG' build '$T/lim.obj' '$T/l0.vdag' --max-texture-pixels -1 2>/dev/null &&
+    ! '$VDAG' build '$T/lim.obj' '$T/l0.vdag' --max-texture-pixels 18446744073709551616 2>/dev/null && [ ! -e '$T/l0.vdag' ]"
+mkfifo "$T/fifo.mtl" && printf 'mtllib fifo.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nusemtl a\nf 1 2 3\n' >"$T/fifo.obj"
+check "a FIFO as material library is refused at once, naming it" sh -c "! timeout 20 '$VDAG' build '$T/fifo.obj' '$T/fifo.vdag' --quiet 2>'$T/err' &&
+    grep -q 'fifo.mtl: not a regular file' '$T/err'"
+
 # -- more formats: STL (ASCII and binary) give the same square; a float .xyz
 # is a point cloud fitted into the grid (voxel = floor((p - lo) * 2^L / extent),
 # the top face clamped), computed here

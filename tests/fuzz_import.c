@@ -51,6 +51,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (!size) return 0;
     memset(&limits, 0, sizeof limits);
     limits.max_points = 65536; /* .vox instancing: small scenes keep the runs fast */
+    limits.max_vox_voxels = (uint64_t)1 << 20;
     limits.quiet = 1;
     if (vdag_import_memory(formats[data[0] % 9], data + 1, size - 1, NULL, &limits, &scene, err, sizeof err)) {
         check_scene(&scene);

@@ -671,6 +671,136 @@ static void test_obj_file(void) {
     free(ppm.p);
 }
 
+
+/* Side files (material libraries, textures) are read only when they are
+   regular files of at most VDAG_IMPORT_MAX_SIDE_FILE_BYTES: a device (no
+   4 GiB read of /dev/zero), a FIFO (no wait for a writer) or an oversized
+   file is refused at once, with a message naming it. */
+static void test_side_files(void) {
+    static const char *const tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n";
+    char dir[] = "/tmp/vdag-side-XXXXXX", path[256], fifo[256], big[256], text[512], err[512];
+    vdag_scene s;
+    FILE *f;
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/scene.obj", dir);
+    snprintf(fifo, sizeof fifo, "%s/fifo.mtl", dir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    snprintf(big, sizeof big, "%s/big.mtl", dir);
+    CHECK((f = fopen(big, "wb")) != NULL); /* sparse: one byte past the limit */
+    if (f) CHECK(fseek(f, (long)VDAG_IMPORT_MAX_SIDE_FILE_BYTES, SEEK_SET) == 0 && fputc('\n', f) == '\n' && !fclose(f));
+
+    snprintf(text, sizeof text, "mtllib /dev/zero\n%s", tri);
+    CHECK(write_file(path, text, strlen(text)));
+    CHECK(!vdag_import_file(path, NULL, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "/dev/zero") && strstr(err, "not a regular file"), "%s", err);
+
+    snprintf(text, sizeof text, "mtllib fifo.mtl\n%s", tri);
+    CHECK(write_file(path, text, strlen(text)));
+    CHECK(!vdag_import_file(path, NULL, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "fifo.mtl") && strstr(err, "not a regular file"), "%s", err);
+
+    snprintf(text, sizeof text, "mtllib big.mtl\n%s", tri);
+    CHECK(write_file(path, text, strlen(text)));
+    CHECK(!vdag_import_file(path, NULL, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "big.mtl") && strstr(err, "larger than 268435456 bytes"), "%s", err);
+
+    /* A texture that is a FIFO, and a material library that is a directory. */
+    snprintf(text, sizeof text, "mtllib lib.mtl\n%s", tri);
+    CHECK(write_file(path, text, strlen(text)));
+    snprintf(text, sizeof text, "%s/lib.mtl", dir);
+    CHECK(write_file(text, "newmtl m\nmap_Kd fifo.mtl\n", 25));
+    CHECK(!vdag_import_file(path, NULL, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "fifo.mtl") && strstr(err, "not a regular file"), "%s", err);
+    remove(text);
+    CHECK(mkdir(text, 0700) == 0);
+    CHECK(!vdag_import_file(path, NULL, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "lib.mtl") && strstr(err, "not a regular file"), "%s", err);
+    rmdir(text);
+
+    /* A library that does not exist still only gets a warning. */
+    snprintf(text, sizeof text, "mtllib none.mtl\n%s", tri);
+    CHECK(write_file(path, text, strlen(text)));
+    {
+        vdag_import_limits quiet;
+        memset(&quiet, 0, sizeof quiet);
+        quiet.quiet = 1;
+        if (!vdag_import_file(path, &quiet, &s, err, sizeof err)) CHECK_MSG(0, "%s", err);
+        else vdag_scene_free(&s);
+    }
+    remove(path);
+    remove(fifo);
+    remove(big);
+    rmdir(dir);
+}
+
+/* Textures are cached by file identity: one file named under several
+   spellings is decoded once and counted once against max_texture_pixels,
+   the pixel budget of all textures of an import. */
+static void test_texture_budget(void) {
+    char dir[] = "/tmp/vdag-tex-XXXXXX", path[256], lib[256], sub[256], tex[256], tex2[256], mtl[1024], err[512];
+    const char *obj = "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+                      "usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 2/2 3/3\nusemtl c\nf 1/1 2/2 3/3\n"
+                      "usemtl d\nf 1/1 2/2 3/3\n";
+    bytes ppm = {NULL, 0, 0};
+    vdag_import_limits lim;
+    vdag_scene s;
+    vdag_image probe;
+    int decodes, k;
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/scene.obj", dir);
+    CHECK(write_file(path, obj, strlen(obj)));
+    snprintf(sub, sizeof sub, "%s/sub", dir);
+    CHECK(mkdir(sub, 0700) == 0);
+    snprintf(tex, sizeof tex, "%s/a.ppm", dir);
+    snprintf(tex2, sizeof tex2, "%s/b.ppm", dir);
+    putf(&ppm, "P6\n3 2\n255\n");
+    put(&ppm, test_pixels, sizeof test_pixels);
+    CHECK(write_file(tex, ppm.p, ppm.n) && write_file(tex2, ppm.p, ppm.n));
+    decodes = vdag_image_load(tex, &probe, err, sizeof err);
+    vdag_image_free(&probe);
+    snprintf(lib, sizeof lib, "%s/lib.mtl", dir);
+    /* a.ppm four ways: plain, "./", through "sub/..", and absolute. */
+    snprintf(mtl, sizeof mtl, "newmtl a\nmap_Kd a.ppm\nnewmtl b\nmap_Kd ./a.ppm\nnewmtl c\nmap_Kd sub/../a.ppm\n"
+                              "newmtl d\nmap_Kd %s\n", tex);
+    CHECK(write_file(lib, mtl, strlen(mtl)));
+    for (k = 0; k < 2; k++) { /* 6 pixels: within a budget of 6, not of 5 */
+        memset(&lim, 0, sizeof lim);
+        lim.quiet = 1;
+        lim.max_texture_pixels = 6 - (uint64_t)k;
+        if (!decodes) break;
+        if (vdag_import_file(path, &lim, &s, err, sizeof err)) {
+            CHECK(!k);
+            CHECK_MSG(s.image_count == 1, "%zu images", s.image_count);
+            CHECK(s.material_count == 4 && s.materials[0].image == 0 && s.materials[1].image == 0 &&
+                  s.materials[2].image == 0 && s.materials[3].image == 0);
+            vdag_scene_free(&s);
+        } else {
+            CHECK_MSG(k && strstr(err, "max_texture_pixels") && strstr(err, "--max-texture-pixels"), "%s", err);
+        }
+    }
+    /* Two files of 6 pixels each: 12 in all. */
+    snprintf(mtl, sizeof mtl, "newmtl a\nmap_Kd a.ppm\nnewmtl b\nmap_Kd b.ppm\nnewmtl c\nmap_Kd ./b.ppm\n");
+    CHECK(write_file(lib, mtl, strlen(mtl)));
+    for (k = 0; decodes && k < 2; k++) {
+        memset(&lim, 0, sizeof lim);
+        lim.quiet = 1;
+        lim.max_texture_pixels = 12 - (uint64_t)k;
+        if (vdag_import_file(path, &lim, &s, err, sizeof err)) {
+            CHECK(!k && s.image_count == 2);
+            vdag_scene_free(&s);
+        } else {
+            CHECK_MSG(k && strstr(err, "b.ppm") && strstr(err, "max_texture_pixels (11)"), "%s", err);
+        }
+    }
+    remove(lib);
+    remove(tex);
+    remove(tex2);
+    remove(path);
+    rmdir(sub);
+    rmdir(dir);
+    free(ppm.p);
+}
+
 // -- .stl
 
 /* ASCII: one facet per polygon (more than three vertices are fanned), with
@@ -1377,6 +1507,101 @@ static void test_vox_errors(void) {
     free(b.p);
 }
 
+
+/* A scene graph that places a model many times is refused at
+   max_vox_voxels before any voxel is placed: at the default budget (2^31)
+   a model of 65536 empty voxels shown 2^16 times (2^32 voxels to walk),
+   and a small budget on 64 copies of a 2x2x2 cube (512 voxels). */
+static void test_vox_voxel_budget(void) {
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
+    vox_model cube = {{2, 2, 2}, 8, {{0}}};
+    int32_t children[64];
+    vdag_import_limits lim;
+    vdag_scene s;
+    char err[256];
+    int32_t i;
+    int k;
+    for (i = 0; i < 3; i++) put_le32(&c, i < 2 ? 256 : 1);
+    vox_chunk(&body, "SIZE", &c, 0);
+    c.n = 0;
+    put_le32(&c, 65536);
+    for (i = 0; i < 65536; i++) {
+        uint8_t v[4] = {(uint8_t)i, (uint8_t)(i >> 8), 0, 0}; /* colour index 0: empty */
+        put(&c, v, 4);
+    }
+    vox_chunk(&body, "XYZI", &c, 0);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    for (i = 1; i <= 16; i++) {
+        int32_t next[2];
+        next[0] = next[1] = i + 1;
+        vox_group(&body, i, next, 2);
+    }
+    vox_shape(&body, 17, 0);
+    vox_file(&file, &body, 200);
+    expect_error("vox", &file, "max_vox_voxels (2147483648)");
+
+    body.n = file.n = 0;
+    for (i = 0; i < 8; i++) {
+        cube.v[i][0] = (uint8_t)(i & 1);
+        cube.v[i][1] = (uint8_t)(i >> 1 & 1);
+        cube.v[i][2] = (uint8_t)(i >> 2 & 1);
+        cube.v[i][3] = 7;
+    }
+    vox_models(&body, &cube, 1);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    for (i = 0; i < 64; i++) children[i] = 2;
+    vox_group(&body, 1, children, 64);
+    vox_transform(&body, 2, 3, NULL, NULL);
+    vox_shape(&body, 3, 0);
+    vox_file(&file, &body, 200);
+    for (k = 0; k < 2; k++) {
+        memset(&lim, 0, sizeof lim);
+        lim.max_vox_voxels = 512 - (uint64_t)k;
+        if (vdag_import_memory("vox", file.p, file.n, NULL, &lim, &s, err, sizeof err)) {
+            CHECK(!k && s.point_count == 512);
+            vdag_scene_free(&s);
+        } else {
+            CHECK_MSG(k && strstr(err, "max_vox_voxels (511)") && strstr(err, "--max-vox-voxels"), "%s", err);
+        }
+    }
+    free(body.p);
+    free(file.p);
+    free(c.p);
+}
+
+/* Integers past the parser's range are refused, never wrapped at 2^64:
+   2^64 + 1 would read as 1 and 2^64 as 0. */
+static void test_integer_overflow(void) {
+    static const char *const big[] = {"18446744073709551617", "18446744073709551616", "-18446744073709551617",
+                                      "99999999999999999999", "4611686018427387905"};
+    bytes body = {NULL, 0, 0}, file = {NULL, 0, 0};
+    vox_model m = {{2, 2, 2}, 1, {{1, 1, 1, 5}}};
+    char text[512];
+    size_t i;
+    for (i = 0; i < sizeof big / sizeof big[0]; i++) {
+        snprintf(text, sizeof text, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf %s 2 3\n", big[i]);
+        expect_error_text("obj", text, "bad face corner");
+        snprintf(text, sizeof text, "ply\nformat ascii 1.0\nelement vertex %s\nproperty float x\n"
+                                    "property float y\nproperty float z\nend_header\n0 0 0\n", big[i]);
+        expect_error_text("ply", text, "expected \"element NAME COUNT\"");
+        snprintf(text, sizeof text, "OFF\n%s 0 0\n0 0 0\n", big[i]);
+        expect_error_text("off", text, "expected vertex and face counts");
+        snprintf(text, sizeof text, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n%s 0 1 2\n", big[i]);
+        expect_error_text("off", text, "bad corner count");
+        snprintf(text, sizeof text, "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 %s 1 2\n", big[i]);
+        expect_error_text("off", text, "out-of-range vertex index");
+        snprintf(text, sizeof text, "0 0 %s", big[i]);
+        body.n = file.n = 0;
+        vox_models(&body, &m, 1);
+        vox_transform(&body, 0, 1, NULL, text);
+        vox_shape(&body, 1, 0);
+        vox_file(&file, &body, 200);
+        expect_error("vox", &file, "malformed nTRN chunk");
+    }
+    free(body.p);
+    free(file.p);
+}
+
 const test_case test_import_cases[] = {
     {"import/xyz roundtrip", test_xyz_roundtrip},
     {"import/xyz errors", test_xyz_errors},
@@ -1403,5 +1628,9 @@ const test_case test_import_cases[] = {
     {"import/vox default palette", test_vox_default_palette},
     {"import/vox scene graph", test_vox_scene_graph},
     {"import/vox errors", test_vox_errors},
+    {"import/integers out of range refused", test_integer_overflow},
+    {"import/side files: regular files only", test_side_files},
+    {"import/textures by file identity, pixel budget", test_texture_budget},
+    {"import/vox voxel budget", test_vox_voxel_budget},
     {NULL, NULL},
 };

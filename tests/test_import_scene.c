@@ -440,6 +440,9 @@ static void test_ac_errors(void) {
     expect_error_text("ac", "AC3Db\nOBJECT world\nkids 1\nnumvert 1\n", "expected OBJECT");
     expect_error_text("ac", "AC3Db\nOBJECT world\nkids 99999999\n", "bad kids count");
     expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 4000000000\n0 0 0\n", "bad numvert count");
+    /* Integers past 2^64 are refused, not wrapped (2^64 + 1 would read as 1). */
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 18446744073709551617\n0 0 0\nkids 0\n", "bad numvert count");
+    expect_error_text("ac", "AC3Db\nOBJECT world\nkids 18446744073709551617\nOBJECT poly\nkids 0\n", "bad kids count");
     expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 nan 0\nkids 0\n", "a vertex needs 3 numbers");
     expect_error_text("ac", "AC3Db\nOBJECT poly\nnumvert 1\n0 0\nkids 0\n", "a vertex needs 3 numbers");
     expect_error_text("ac", "AC3Db\nOBJECT poly\nrot 1 0 0 0 1 0 0 0\n", "rot needs 9 numbers");
