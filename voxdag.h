@@ -375,7 +375,9 @@ VOXDAG_API const void *voxdag_image(const voxdag *dag, size_t *size);
 VOXDAG_API void voxdag_free(voxdag *dag);
 
 #ifndef VOXDAG_NO_STDIO
-/* Reads and validates the file at PATH (as voxdag_load_memory with a copy). */
+/* Reads and validates the file at PATH (as voxdag_load_memory with a copy).
+   The header is read and checked first (magic, version, checksum, declared
+   size against the file's): a file that is not a .vdag costs one 96-byte read. */
 VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_opts *opts,
                                           voxdag **out, voxdag_error *err);
 /* Writes the DAG's image to PATH atomically: to a temporary file beside it
@@ -3820,6 +3822,129 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
     return st == VOXDAG_OK ? VOXDAG_OK : voxdagi_fail(err, st, msg, where, node);
 }
 
+/* The Morton positions p of a 4^3 brick with bit k of p clear. */
+static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
+                                                    0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
+                                                    0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
+
+/* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
+   brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
+static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
+    unsigned a, v;
+    for (a = 0; a < 3; a++) {
+        box[a] = 4, box[a + 3] = 0;
+        for (v = 0; v < 4; v++) {
+            uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
+            if (!(mask & (v & 1 ? ~lo : lo) & (v & 2 ? ~hi : hi))) continue;
+            if (v < box[a]) box[a] = v;
+            box[a + 3] = v + 1;
+        }
+    }
+}
+
+/* A set of (node, transform) pairs, keys offset << 6 | MI, as an open
+   addressing table (0 marks an empty slot, so keys are stored plus one). */
+typedef struct voxdagi_ref_set {
+    uint64_t *slot;
+    size_t cap, n;
+} voxdagi_ref_set;
+
+/* Adds KEY to S (growing it when half full). Returns 0 when out of memory. */
+static int voxdagi_ref_set_add(voxdagi_mem *m, voxdagi_ref_set *s, uint64_t key) {
+    size_t i;
+    if (2 * (s->n + 1) > s->cap) {
+        voxdagi_ref_set g;
+        g.cap = s->cap ? 2 * s->cap : 64, g.n = 0;
+        g.slot = (uint64_t *)voxdagi_alloc(m, g.cap * sizeof *g.slot);
+        if (!g.slot) return 0;
+        memset(g.slot, 0, g.cap * sizeof *g.slot);
+        for (i = 0; i < s->cap; i++)
+            if (s->slot[i]) voxdagi_ref_set_add(m, &g, s->slot[i] - 1);
+        voxdagi_free(m, s->slot, s->cap * sizeof *s->slot);
+        *s = g;
+    }
+    for (i = (size_t)((key + 1) * 0x9E3779B97F4A7C15ull >> 20) & (s->cap - 1); s->slot[i]; i = (i + 1) & (s->cap - 1))
+        if (s->slot[i] == key + 1) return 1;
+    s->slot[i] = key + 1;
+    s->n++;
+    return 1;
+}
+
+static void voxdagi_ref_set_free(voxdagi_mem *m, voxdagi_ref_set *s) {
+    voxdagi_free(m, s->slot, s->cap * sizeof *s->slot);
+    memset(s, 0, sizeof *s);
+}
+
+/* The extreme coordinate along world axis A of the voxels of a non-empty,
+   structurally valid DAG: the lowest (HIGH 0) or one past the highest (HIGH
+   1). Walks only the extreme slab: at each level the distinct (node,
+   transform) pairs whose cells lie in the lowest (highest) slab that holds a
+   voxel, so the cost is that of the nodes on the scene's face, not of the
+   scene. Returns 0 when out of memory. */
+static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned high, uint32_t *out) {
+    uint32_t brick_level = d->levels - 2, l, at = high ? 1u << d->levels : 0, best = high ? 0 : 4;
+    voxdagi_ref_set cur, next;
+    size_t i;
+    unsigned w;
+    memset(&cur, 0, sizeof cur);
+    memset(&next, 0, sizeof next);
+    if (!voxdagi_ref_set_add(m, &cur, d->cube.inv[d->root_transform])) return 0;
+    for (l = 0; l < brick_level; l++) {
+        unsigned side; /* the half of each cell on the wanted side, then the other */
+        for (side = 0; side < 2 && !next.n; side++) {
+            unsigned half = high ^ side;
+            for (i = 0; i < cur.cap; i++) {
+                uint64_t key = cur.slot[i] - 1, off = key >> 6;
+                unsigned mi = (unsigned)(key & 63), header;
+                const uint8_t *rec;
+                if (!cur.slot[i]) continue;
+                rec = d->level[l].data + off;
+                header = voxdagi_le16(rec);
+                for (w = 0; w < 8; w++) {
+                    unsigned v = d->cube.act[mi][w];
+                    uint64_t ref;
+                    if ((w >> a & 1) != half || !(header >> (2 * v) & 3)) continue;
+                    ref = voxdagi_child_ref(d, l, rec, header, v, 1);
+                    if (!voxdagi_ref_set_add(m, &next, (ref >> 6) << 6 | d->cube.comp[ref & 63][mi])) {
+                        voxdagi_ref_set_free(m, &cur);
+                        voxdagi_ref_set_free(m, &next);
+                        return 0;
+                    }
+                }
+            }
+            if (!next.n) at = high ? at - (1u << (d->levels - 1 - l)) : at + (1u << (d->levels - 1 - l));
+        }
+        voxdagi_ref_set_free(m, &cur);
+        cur = next;
+        memset(&next, 0, sizeof next);
+    }
+    for (i = 0; i < cur.cap; i++) { /* the bricks of the slab, in world order */
+        uint32_t box[6];
+        if (!cur.slot[i]) continue;
+        voxdagi_brick_box(voxdagi_brick_to_world(d, voxdagi_brick(d, (cur.slot[i] - 1) >> 6), (unsigned)((cur.slot[i] - 1) & 63)), box);
+        if (high ? box[a + 3] > best : box[a] < best) best = high ? box[a + 3] : box[a];
+    }
+    voxdagi_ref_set_free(m, &cur);
+    *out = high ? at - 4 + best : at + best;
+    return 1;
+}
+
+/* Checks that the stored voxel box is the box of the voxels (queries clip
+   rays to it, so a wrong box would make rays and lookups disagree). */
+static voxdag_status voxdagi_validate_box(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
+    unsigned k;
+    if (!d->voxels) return VOXDAG_OK; /* the box is checked to be zero */
+    for (k = 0; k < 6; k++) {
+        uint32_t v;
+        if (!voxdagi_extreme(d, m, k % 3, k / 3, &v))
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the voxel box check");
+        if (v != d->voxel_box[k])
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxel box differs from the box of the voxels",
+                                VOXDAG_FILE_OFF_VOXEL_BOX + 4 * k, UINT64_MAX);
+    }
+    return VOXDAG_OK;
+}
+
 static int voxdagi_all_zero(const uint8_t *p, uint64_t n) {
     while (n--)
         if (*p++) return 0;
@@ -3876,6 +4001,34 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
     return NULL;
 }
 
+/* Checks the header at IMG (its first VOXDAG_FILE_HEADER_SIZE bytes, when
+   SIZE, the file's size, has them): magic, version, checksum and declared
+   size, so that a file loader reads no more than the header of a file that
+   is not one or whose size differs. */
+static voxdag_status voxdagi_check_header(const uint8_t *img, uint64_t size, voxdag_error *err) {
+    uint8_t h[VOXDAG_FILE_HEADER_SIZE];
+    uint64_t version, end;
+    if (size < VOXDAG_FILE_HEADER_SIZE)
+        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its header", size, UINT64_MAX);
+    if (memcmp(img, voxdagi_magic, 8)) return voxdagi_fail(err, VOXDAG_ERR_BAD_MAGIC, "bad magic bytes", 0, UINT64_MAX);
+    version = voxdagi_le(img + VOXDAG_FILE_OFF_VERSION, 4);
+    if (version != VOXDAG_FORMAT_VERSION)
+        return voxdagi_fail(err, VOXDAG_ERR_VERSION,
+                            version < VOXDAG_FORMAT_VERSION
+                                ? "format version 1 or 2 (an older voxdag): rebuild the file, this reader needs version 3"
+                                : "format version newer than 3 (a newer voxdag): this reader needs version 3",
+                            VOXDAG_FILE_OFF_VERSION, UINT64_MAX);
+    memcpy(h, img, sizeof h);
+    voxdagi_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
+    if (voxdagi_crc32c(h, sizeof h) != voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_CRC, 4))
+        return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "header checksum mismatch", VOXDAG_FILE_OFF_HEADER_CRC, UINT64_MAX);
+    end = voxdagi_le(img + VOXDAG_FILE_OFF_FILE_SIZE, 8);
+    if (end > size)
+        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its declared size", size, UINT64_MAX);
+    if (end < size) return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the file", end, UINT64_MAX);
+    return VOXDAG_OK;
+}
+
 /* Parses header and sections of IMG into D. DEEP: also verify checksums and
    every record (skipped only for images this library just wrote). */
 static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, int deep,
@@ -3885,29 +4038,10 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     uint64_t end, node_sum = 0, level_at = 0;
     const uint8_t *levels = NULL, *nodes = NULL;
     uint64_t nodes_size = 0;
+    voxdag_status st = voxdagi_check_header(img, size, err);
     d->image = img;
     d->image_size = size;
-    if (size < VOXDAG_FILE_HEADER_SIZE)
-        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its header", size, UINT64_MAX);
-    if (memcmp(img, voxdagi_magic, 8))
-        return voxdagi_fail(err, VOXDAG_ERR_BAD_MAGIC, "bad magic bytes", 0, UINT64_MAX);
-    {
-        uint64_t version = voxdagi_le(img + VOXDAG_FILE_OFF_VERSION, 4);
-        if (version != VOXDAG_FORMAT_VERSION)
-            return voxdagi_fail(err, VOXDAG_ERR_VERSION,
-                                version < VOXDAG_FORMAT_VERSION
-                                    ? "format version 1 or 2 (an older voxdag): rebuild the file, this reader needs version 3"
-                                    : "format version newer than 3 (a newer voxdag): this reader needs version 3",
-                                VOXDAG_FILE_OFF_VERSION, UINT64_MAX);
-    }
-    {
-        uint8_t h[VOXDAG_FILE_HEADER_SIZE];
-        memcpy(h, img, sizeof h);
-        voxdagi_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
-        if (voxdagi_crc32c(h, sizeof h) != voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_CRC, 4))
-            return voxdagi_fail(err, VOXDAG_ERR_CHECKSUM, "header checksum mismatch",
-                                VOXDAG_FILE_OFF_HEADER_CRC, UINT64_MAX);
-    }
+    if (st != VOXDAG_OK) return st;
     if (voxdagi_le(img + VOXDAG_FILE_OFF_ENDIAN, 4) != VOXDAG_FILE_ENDIAN_TAG ||
         voxdagi_le(img + VOXDAG_FILE_OFF_HEADER_SIZE, 4) != VOXDAG_FILE_HEADER_SIZE ||
         img[VOXDAG_FILE_OFF_SYMMETRY + 1] || !voxdagi_all_zero(img + VOXDAG_FILE_OFF_RESERVED, VOXDAG_FILE_HEADER_SIZE - VOXDAG_FILE_OFF_RESERVED))
@@ -3919,11 +4053,6 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "unknown symmetry group", VOXDAG_FILE_OFF_SYMMETRY, UINT64_MAX);
     voxdagi_cube_init(&d->cube);
     voxdagi_occupancy_init(d);
-    end = voxdagi_le(img + VOXDAG_FILE_OFF_FILE_SIZE, 8);
-    if (end > size)
-        return voxdagi_fail(err, VOXDAG_ERR_TRUNCATED, "file shorter than its declared size", size, UINT64_MAX);
-    if (end < size)
-        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bytes trail the file", end, UINT64_MAX);
     d->voxels = voxdagi_le(img + VOXDAG_FILE_OFF_VOXELS, 8);
     d->levels = img[VOXDAG_FILE_OFF_LEVELS];
     d->root_transform = img[VOXDAG_FILE_OFF_ROOT_TRANSFORM];
@@ -4029,7 +4158,8 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more nodes than max_nodes");
     if (voxdagi_open_colors(d, err) != VOXDAG_OK) return VOXDAG_ERR_CORRUPT;
     if (!deep) return VOXDAG_OK;
-    return voxdagi_validate_nodes(d, m, err);
+    st = voxdagi_validate_nodes(d, m, err);
+    return st == VOXDAG_OK ? voxdagi_validate_box(d, m, err) : st;
 }
 
 static voxdag_status voxdagi_new_dag(voxdagi_mem *m, voxdag **out) {
@@ -4118,26 +4248,6 @@ static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned
     for (a = 0; a < 3; a++) {
         if (tf >> a & 1) b[a] = side - t[a + 3], b[a + 3] = side - t[a];
         else b[a] = t[a], b[a + 3] = t[a + 3];
-    }
-}
-
-/* The Morton positions p of a 4^3 brick with bit k of p clear. */
-static const uint64_t voxdagi_brick_bit_clear[6] = {0x5555555555555555ull, 0x3333333333333333ull,
-                                                    0x0F0F0F0F0F0F0F0Full, 0x00FF00FF00FF00FFull,
-                                                    0x0000FFFF0000FFFFull, 0x00000000FFFFFFFFull};
-
-/* The box (lo x, y, z, hi x, y, z; half-open) of the voxels of a non-empty
-   brick MASK: coordinate a of position p is bit a of p plus twice bit a+3. */
-static void voxdagi_brick_box(uint64_t mask, uint32_t box[6]) {
-    unsigned a, v;
-    for (a = 0; a < 3; a++) {
-        box[a] = 4, box[a + 3] = 0;
-        for (v = 0; v < 4; v++) {
-            uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
-            if (!(mask & (v & 1 ? ~lo : lo) & (v & 2 ? ~hi : hi))) continue;
-            if (v < box[a]) box[a] = v;
-            box[a + 3] = v + 1;
-        }
     }
 }
 
@@ -4751,6 +4861,46 @@ VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
            (c[2] & 2) << 4;
 }
 
+/* The world octants a ray can still reach in a node from octant W, moving
+   only towards the AHEAD halves (bit b set: it has yet to cross mid plane b). */
+VOXDAGI_INLINE unsigned voxdagi_reach8(unsigned w, unsigned ahead) {
+    unsigned r = 1u << w;
+    if (ahead & 1) r |= (r & 0x55u) << 1 | (r & 0xAAu) >> 1;
+    if (ahead & 2) r |= (r & 0x33u) << 2 | (r & 0xCCu) >> 2;
+    if (ahead & 4) r |= (r & 0x0Fu) << 4 | (r & 0xF0u) >> 4;
+    return r;
+}
+
+/* The positions of a 4^3 brick whose coordinate A is at least V (0..4). */
+VOXDAGI_INLINE uint64_t voxdagi_brick_at_least(unsigned a, uint32_t v) {
+    uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
+    return v == 0 ? ~0ull : v == 1 ? ~(lo & hi) : v == 2 ? ~hi : v == 3 ? ~(lo | hi) : 0;
+}
+
+/* Whether a full cell of the node at level L (a brick's voxels when VOXELS,
+   else its children, 2^3 cells or a 2^3 cell's voxels) lies on the ray's side
+   of every mid plane it has yet to cross from cell C: its full cells are
+   OCC, or those of the brick MASK (world order). */
+VOXDAGI_INLINE int voxdagi_full_ahead(uint32_t l, uint32_t brick_level, int voxels, unsigned occ, uint64_t mask,
+                                      const uint32_t c[3], const int sgn[3]) {
+    unsigned ahead = 0, w, b;
+    if (l == brick_level && voxels) { /* a box of the brick's voxels */
+        uint64_t reach = ~0ull;
+        for (b = 0; b < 3; b++) {
+            if (sgn[b] >= 0) reach &= voxdagi_brick_at_least(b, c[b] & 3);
+            if (sgn[b] <= 0) reach &= ~voxdagi_brick_at_least(b, (c[b] & 3) + 1);
+        }
+        return (mask & reach) != 0;
+    }
+    if (l == brick_level) { /* 2^3 cells of a brick */
+        for (occ = 0, w = 0; w < 8; w++) occ |= (unsigned)((mask >> 8 * w & 0xFF) != 0) << w;
+    } else if (l > brick_level) { /* voxels of a 2^3 cell */
+        occ = (unsigned)(mask >> 8 * ((c[0] >> 1 & 1) | (c[1] >> 1 & 1) << 1 | (c[2] >> 1 & 1) << 2) & 0xFF);
+    }
+    for (b = 0; b < 3; b++) ahead |= (unsigned)(sgn[b] > 0 ? !(c[b] & 1) : sgn[b] < 0 && (c[b] & 1)) << b;
+    return (occ & voxdagi_reach8((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2, ahead)) != 0;
+}
+
 /* Index of the first voxel of cell C at cell level Q: the voxels of all
    preceding siblings on the path (FORMAT.md, Voxel index), read from the frames. */
 static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint64_t mask,
@@ -4770,16 +4920,18 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
     return idx;
 }
 
-/* The traversal shared by both queries; HIT NULL means any hit will do. */
-static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index,
-                         voxdag_hit *hit) {
+/* The traversal shared by both queries; HIT NULL means any hit will do.
+   *STEPS counts the cells stepped through (for tests; the queries pass a
+   local that the compiler drops). */
+VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index,
+                                 voxdag_hit *hit, uint64_t *steps) {
     const uint32_t nlevels = d->levels, brick_level = nlevels - 2, side = 1u << nlevels;
     voxdagi_frame f[VOXDAG_MAX_LEVELS];
     double ox[3], ix[3], te = -HUGE_VAL, tx = HUGE_VAL, t_stop;
     uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
     int sgn[3];
     unsigned ae = 0, ax = 0, a, mi = d->cube.inv[d->root_transform], header = 0, occ = 0;
-    int split;
+    int split, probe;
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
 
@@ -4846,16 +4998,30 @@ static int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int
             q++;
         }
         /* Step through the node's cells until a full one. */
-        for (;;) {
+        for (probe = 1;; probe = 0) {
             double t, t1, t2;
             uint32_t old, sh;
             int k;
+            ++*steps;
             if (l < brick_level) {
                 if (occ >> ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 1) break;
             } else if (q == nlevels) {
                 if (mask >> voxdagi_brick_pos(c) & 1) break;
             } else if (mask >> 8 * ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 0xFF) {
                 break; /* a 2^3 cell: one byte of the brick, any bit */
+            }
+            /* Empty space skipped where it is coarsest: when the node was
+               entered through an empty cell and no full cell lies on the
+               ray's side of the mid planes it has yet to cross, the ray
+               leaves from the node's own cell one level up, at the plane and
+               t at which stepping through the empty cells would leave it
+               (those steps change only bits that the move up drops). */
+            if (probe && !voxdagi_full_ahead(l, brick_level, q == nlevels, occ, mask, c, sgn)) {
+                uint32_t up_by = l == brick_level && q == nlevels ? 2 : 1;
+                if (l == 0) return 0;
+                c[0] >>= up_by, c[1] >>= up_by, c[2] >>= up_by;
+                q -= up_by, l--;
+                rec = f[l].rec, header = f[l].header, mi = f[l].mi, occ = f[l].occ;
             }
             sh = nlevels - q;
             t = voxdagi_plane_t((double)((c[0] + up[0]) << sh), ox[0], ix[0]);
@@ -4905,6 +5071,7 @@ static int voxdagi_finite_nonneg(double v) { return v >= 0 && v <= 1.79769313486
 VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
                               voxdag_hit *hit) {
     double lod = 0;
+    uint64_t steps = 0;
     int r;
 #ifdef VOXDAGI_X87
     unsigned cw;
@@ -4919,7 +5086,7 @@ VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const vo
 #ifdef VOXDAGI_X87
     cw = voxdagi_x87_begin();
 #endif
-    r = voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit);
+    r = voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit, &steps);
 #ifdef VOXDAGI_X87
     voxdagi_x87_end(cw);
 #endif
@@ -4927,6 +5094,7 @@ VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const vo
 }
 
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
+    uint64_t steps = 0;
     int r;
 #ifdef VOXDAGI_X87
     unsigned cw;
@@ -4935,7 +5103,7 @@ VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
 #ifdef VOXDAGI_X87
     cw = voxdagi_x87_begin();
 #endif
-    r = voxdagi_trace(dag, ray, 0, 0, NULL);
+    r = voxdagi_trace(dag, ray, 0, 0, NULL, &steps);
 #ifdef VOXDAGI_X87
     voxdagi_x87_end(cw);
 #endif
@@ -4985,6 +5153,17 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     if (o.max_input_bytes && (uint64_t)len > o.max_input_bytes) {
         fclose(f);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "input larger than max_input_bytes");
+    }
+    { /* the header first: nothing more is read of a file that is not one */
+        uint8_t h[VOXDAG_FILE_HEADER_SIZE];
+        size_t got = fread(h, 1, sizeof h, f);
+        if (got < sizeof h && ferror(f)) st = voxdagi_fail_io(err, "cannot read the file");
+        else st = voxdagi_check_header(h, got < sizeof h ? got : (uint64_t)len, err);
+        if (st == VOXDAG_OK && fseek(f, 0, SEEK_SET)) st = voxdagi_fail_io(err, "cannot read the file");
+        if (st != VOXDAG_OK) {
+            fclose(f);
+            return st;
+        }
     }
     voxdagi_mem_init(&m, &o.allocator, o.max_memory); /* the buffer counts against max_memory */
     buf = (uint8_t *)voxdagi_alloc(&m, (size_t)len);

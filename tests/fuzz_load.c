@@ -11,12 +11,18 @@
    queries consistently: voxdag_for_each_voxel (stopped early) visits voxels
    in strictly increasing Morton order whose voxdag_lookup gives the same
    index; lookups at coordinates taken from the input stay within the voxel
-   count; colours exist for every index. Any violation aborts.
+   count; colours of either kind decode for every visited index and the last
+   one; a ray aimed at a visited voxel from outside the grid hits it or a
+   voxel before it, and every hit (of those rays and of rays taken from the
+   input) is a full voxel with lookup's index, and voxdag_occluded agrees.
+   Any violation aborts.
 
    Built with -DFUZZ_LIBFUZZER and -fsanitize=fuzzer this is a libFuzzer
    target (make fuzz-load). Otherwise main() replays the files and folders
    given on the command line (make test replays tests/data/fuzz/load) and
    prints "N passed, N failed". */
+#define VOXCOLOR_IMPLEMENTATION /* voxdag_color then decodes voxcolor sections */
+#include "voxcolor.h"
 #define VOXDAG_IMPLEMENTATION
 #include "voxdag.h"
 #include "golden.h"
@@ -28,6 +34,7 @@
 #include <string.h>
 
 #define FUZZ_MAX_VISIT 512 /* voxels walked by voxdag_for_each_voxel */
+#define FUZZ_MAX_AIMED 64  /* of those, voxels that rays are aimed at */
 
 /* Allocation failure sweeps of the replay main (fuzz_replay.h). */
 #define FUZZ_ALLOC_SWEEP
@@ -40,7 +47,48 @@ typedef struct walk {
     uint32_t levels;
     uint64_t visited, last_morton;
     int color;
+    const uint8_t *file; /* the input, for ray directions */
+    size_t size;
 } walk;
+
+/* Checks HIT, a hit of RAY (R = voxdag_raycast's result): a full voxel whose
+   index is lookup's, inside the grid, and occluded agrees. */
+static void check_hit(const voxdag *d, uint32_t levels, const voxdag_ray *ray, int r, const voxdag_hit *hit) {
+    uint64_t index = UINT64_MAX;
+    require(r == 0 || r == 1, "raycast failed");
+    require(voxdag_occluded(d, ray) == r, "occluded and raycast disagree");
+    if (!r) return;
+    require(hit->level == levels && ((hit->xyz[0] | hit->xyz[1] | hit->xyz[2]) >> levels) == 0, "hit outside");
+    require(voxdag_lookup(d, hit->xyz[0], hit->xyz[1], hit->xyz[2], &index) == 1, "a ray hit an empty voxel");
+    require(index == hit->index, "ray and lookup disagree on an index");
+}
+
+/* A ray from outside the grid at voxel (X, Y, Z)'s centre, its direction
+   from the input (never zero): it must stop at that voxel or before. */
+static void aim(walk *w, uint32_t x, uint32_t y, uint32_t z) {
+    voxdag_ray ray;
+    voxdag_ray_opts o;
+    voxdag_hit hit;
+    double side = (double)(1u << w->levels), far = 0, target[3];
+    unsigned k;
+    int r;
+    memset(&ray, 0, sizeof ray);
+    memset(&o, 0, sizeof o);
+    o.want_index = 1;
+    target[0] = x + 0.5, target[1] = y + 0.5, target[2] = z + 0.5;
+    for (k = 0; k < 3; k++) {
+        uint8_t b = w->file[(w->visited * 3 + k) % w->size];
+        ray.dir[k] = (double)(int)(b % 7) - 3;
+    }
+    if (ray.dir[0] == 0 && ray.dir[1] == 0 && ray.dir[2] == 0) ray.dir[w->visited % 3] = 1;
+    for (k = 0; k < 3; k++) far += ray.dir[k] * ray.dir[k];
+    far = 2 * side / far; /* the origin lies 2 grid sides back along the ray */
+    for (k = 0; k < 3; k++) ray.origin[k] = target[k] - far * ray.dir[k];
+    r = voxdag_raycast(w->dag, &ray, &o, &hit);
+    require(r == 1, "a ray aimed at a voxel missed");
+    require(hit.t <= far + 1e-9 * far, "a ray passed the voxel it was aimed at");
+    check_hit(w->dag, w->levels, &ray, r, &hit);
+}
 
 static int visit(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
     walk *w = (walk *)user;
@@ -52,6 +100,7 @@ static int visit(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index)
     require(voxdag_lookup(w->dag, x, y, z, &found) == 1, "a visited voxel is empty to lookup");
     require(found == index, "lookup and for_each_voxel disagree on an index");
     if (w->color) require(voxdag_color(w->dag, index, rgb) == 1, "no colour for a visited voxel");
+    if (w->visited < FUZZ_MAX_AIMED) aim(w, x, y, z);
     w->last_morton = morton;
     w->visited++;
     return w->visited >= FUZZ_MAX_VISIT;
@@ -83,16 +132,36 @@ static void query(const voxdag *d, const uint8_t *file, size_t size) {
         if (voxdag_lookup(d, c[0], c[1], c[2], &index)) {
             require(index < info.voxels, "lookup index past the voxel count");
             require(voxdag_lookup(d, c[0], c[1], c[2], NULL) == 1, "lookup without index differs");
-            if (kind == VOXDAG_COLORS_RGB8) require(voxdag_color(d, index, rgb) == 1, "no colour");
+            if (kind != VOXDAG_COLORS_NONE) require(voxdag_color(d, index, rgb) == 1, "no colour");
         }
         require(voxdag_lookup(d, c[0] | (mask + 1), c[1], c[2], NULL) == 0, "voxel outside the grid");
     }
     require(voxdag_color(d, info.voxels, rgb) == 0, "colour past the last voxel");
+    if (info.voxels && kind != VOXDAG_COLORS_NONE)
+        require(voxdag_color(d, info.voxels - 1, rgb) == 1, "no colour for the last voxel");
+    /* Rays from the input's first bytes: origins in and around the grid. */
+    for (i = 0; i < 8 && size >= 6; i++) {
+        voxdag_ray ray;
+        voxdag_ray_opts o;
+        voxdag_hit hit;
+        double side = (double)(1u << info.levels);
+        unsigned k;
+        memset(&ray, 0, sizeof ray);
+        memset(&o, 0, sizeof o);
+        o.want_index = 1;
+        for (k = 0; k < 3; k++) {
+            ray.origin[k] = (file[(6 * i + k) % size] / 255.0) * 1.5 * side - 0.25 * side;
+            ray.dir[k] = (double)file[(6 * i + 3 + k) % size] - 127.5;
+        }
+        check_hit(d, info.levels, &ray, voxdag_raycast(d, &ray, &o, &hit), &hit);
+    }
     /* Walk the first voxels (all of them in small scenes). */
     memset(&w, 0, sizeof w);
     w.dag = d;
     w.levels = info.levels;
-    w.color = kind == VOXDAG_COLORS_RGB8;
+    w.color = kind != VOXDAG_COLORS_NONE;
+    w.file = file;
+    w.size = size;
     n = voxdag_for_each_voxel(d, visit, &w);
     require(n == w.visited, "for_each_voxel count");
     require(n == (info.voxels < FUZZ_MAX_VISIT ? info.voxels : FUZZ_MAX_VISIT), "voxel count differs from the walk");

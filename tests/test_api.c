@@ -509,11 +509,169 @@ static void test_brick_feed(void) {
     }
 }
 
+// -- The stored voxel box
+
+/* Scenes whose voxels sit in a few small clusters anywhere in the grid (so
+   that the extremes lie under transformed, shared nodes): the stored box
+   must be the box of the voxels computed here, and a file whose box misses
+   its voxels by one voxel on any side, or holds more, is refused (checksums
+   resealed, so the box check itself must catch it). */
+static void test_voxel_box_checked(void) {
+    uint32_t levels, seed;
+    for (levels = 2; levels <= 9; levels++)
+        for (seed = 0; seed < 6; seed++) {
+            vox_set s;
+            uint64_t r = 100 * levels + seed;
+            uint32_t side = 1u << levels, box[6] = {UINT32_MAX, UINT32_MAX, UINT32_MAX, 0, 0, 0}, k;
+            size_t i, size;
+            voxdag *d;
+            voxdag_info info;
+            uint8_t *copy;
+            const uint8_t *img;
+            s.levels = levels;
+            s.n = 1 + test_rand_below(&r, 40);
+            s.xyz = (uint32_t *)malloc(3 * s.n * sizeof *s.xyz);
+            s.rgb = (uint8_t *)calloc(3 * s.n, 1);
+            for (i = 0; i < s.n; i++)
+                for (k = 0; k < 3; k++) {
+                    uint32_t centre = i % 3 == 0 ? test_rand_below(&r, side) : (seed * 37 + k * 11) % side;
+                    s.xyz[3 * i + k] = (centre + test_rand_below(&r, 3)) % side;
+                }
+            for (i = 0; i < s.n; i++)
+                for (k = 0; k < 3; k++) {
+                    if (s.xyz[3 * i + k] < box[k]) box[k] = s.xyz[3 * i + k];
+                    if (s.xyz[3 * i + k] + 1 > box[k + 3]) box[k + 3] = s.xyz[3 * i + k] + 1;
+                }
+            d = build_voxels(&s, 0, NULL, 0);
+            free_voxels(&s);
+            if (!d) {
+                CHECK(0);
+                continue;
+            }
+            voxdag_get_info(d, &info);
+            CHECK_MSG(!memcmp(info.voxel_box, box, sizeof box), "L=%u seed %u: box", levels, seed);
+            img = (const uint8_t *)voxdag_image(d, &size);
+            copy = (uint8_t *)malloc(size);
+            for (k = 0; k < 6; k++) {
+                int delta;
+                for (delta = -1; delta <= 1; delta += 2) {
+                    uint32_t v = box[k] + (uint32_t)delta;
+                    voxdag *e = NULL;
+                    voxdag_error err;
+                    if (v > side || (k < 3 ? v >= box[k + 3] : v <= box[k - 3])) continue; /* refused anyway */
+                    memcpy(copy, img, size);
+                    golden_put_le(copy + VOXDAG_FILE_OFF_VOXEL_BOX + 4 * k, v, 4);
+                    golden_reseal(copy, size);
+                    CHECK_MSG(voxdag_load_memory(copy, size, NULL, &e, &err) == VOXDAG_ERR_CORRUPT && !e &&
+                                  strstr(err.message, "voxel box") &&
+                                  err.byte_offset == VOXDAG_FILE_OFF_VOXEL_BOX + 4 * k,
+                              "L=%u seed %u: box field %u moved by %d accepted", levels, seed, k, delta);
+                    voxdag_free(e);
+                }
+            }
+            free(copy);
+            voxdag_free(d);
+        }
+}
+
+
+// -- Rays skip empty space at coarse levels
+
+/* Cells at levels 1..L (L: voxels) that hold a voxel of S and that the ray
+   from ORIGIN along DIR crosses inside the grid (interiors, t > 0): what a
+   miss may cost, by brute force over S. */
+static uint64_t full_cells_crossed(const vox_set *s, const double origin[3], const double dir[3]) {
+    uint64_t count = 0, *seen = (uint64_t *)malloc(s->n * sizeof *seen);
+    uint32_t q;
+    for (q = 1; q <= s->levels; q++) {
+        uint32_t sh = s->levels - q;
+        size_t i, j, n = 0;
+        for (i = 0; i < s->n; i++) {
+            uint64_t key = voxdag_morton_encode(s->xyz[3 * i] >> sh, s->xyz[3 * i + 1] >> sh, s->xyz[3 * i + 2] >> sh);
+            for (j = 0; j < n && seen[j] != key; j++) continue;
+            if (j < n) continue;
+            seen[n++] = key;
+            {
+                double lo = 0, hi = HUGE_VAL;
+                int k;
+                for (k = 0; k < 3; k++) {
+                    double a = (double)((s->xyz[3 * i + k] >> sh) << sh), b = a + (double)(1u << sh), t0, t1;
+                    double g = (double)(1u << s->levels);
+                    if (a < 0) a = 0;
+                    if (b > g) b = g;
+                    if (dir[k] == 0) {
+                        if (!(origin[k] > a && origin[k] < b)) lo = HUGE_VAL;
+                        continue;
+                    }
+                    t0 = (a - origin[k]) / dir[k], t1 = (b - origin[k]) / dir[k];
+                    if (t0 > t1) { double x = t0; t0 = t1; t1 = x; }
+                    if (t0 > lo) lo = t0;
+                    if (t1 < hi) hi = t1;
+                }
+                if (lo < hi) count++;
+            }
+        }
+    }
+    free(seen);
+    return count;
+}
+
+/* A lattice of single voxels, one in a corner of every 4^3 brick, and rays
+   between its planes (axis-aligned, both ways, and one slowly across): each
+   misses, and it steps through (counted inside the traversal) at most two
+   cells per full cell it crosses (by brute force) and one per level: the
+   full cell, and the step past a node whose full cells are all behind the
+   ray, so empty space costs nothing where it is coarse. */
+static void test_miss_cost(void) {
+    vox_set s;
+    voxdag *d;
+    uint32_t i, j, k, a, lane;
+    s.levels = 6;
+    s.n = 16 * 16 * 16;
+    s.xyz = (uint32_t *)malloc(3 * s.n * sizeof *s.xyz);
+    s.rgb = (uint8_t *)calloc(3 * s.n, 1);
+    for (i = 0; i < 16; i++)
+        for (j = 0; j < 16; j++)
+            for (k = 0; k < 16; k++) {
+                uint32_t *p = s.xyz + 3 * (256 * i + 16 * j + k);
+                p[0] = 4 * i + (i & 1), p[1] = 4 * j + (j & 1), p[2] = 4 * k + (k & 1);
+            }
+    d = build_voxels(&s, 0, NULL, 0);
+    if (!d) {
+        CHECK(0);
+        free_voxels(&s);
+        return;
+    }
+    for (a = 0; a < 3; a++)
+        for (lane = 0; lane < 8; lane++) {
+            int sign;
+            for (sign = -1; sign <= 1; sign += 2) {
+                voxdag_ray ray;
+                voxdag_hit hit;
+                uint64_t steps = 0, full;
+                memset(&ray, 0, sizeof ray);
+                ray.origin[a] = sign > 0 ? -3.0 : 67.0;
+                ray.dir[a] = sign;
+                ray.origin[(a + 1) % 3] = 8.0 * lane + 2.5 + (lane & 1); /* between the lattice planes */
+                ray.origin[(a + 2) % 3] = 8.0 * (7 - lane) + 3.5;
+                if (lane == 7) ray.dir[(a + 1) % 3] = 0.01 * sign; /* across the lattice, slowly */
+                CHECK_MSG(voxdagi_trace(d, &ray, 0, 0, &hit, &steps) == 0, "axis %u lane %u: a hit", a, lane);
+                full = full_cells_crossed(&s, ray.origin, ray.dir);
+                CHECK_MSG(steps <= 2 * full + s.levels, "axis %u lane %u sign %d: %llu steps for %llu full cells crossed",
+                          a, lane, sign, (unsigned long long)steps, (unsigned long long)full);
+            }
+        }
+    voxdag_free(d);
+    free_voxels(&s);
+}
+
 const test_case test_api_cases[] = {
     {"api/crc32c", test_crc32c},
     {"api/skip_checksums", test_skip_checksums},
     {"api/world_space", test_world_space},
     {"api/color_voxcolor", test_color_voxcolor},
     {"api/brick_feed", test_brick_feed},
+    {"api/voxel_box_checked", test_voxel_box_checked},
+    {"api/miss_cost", test_miss_cost},
     {NULL, NULL},
 };

@@ -372,6 +372,43 @@ static void test_build_allocation_failures(void) {
     }
 }
 
+/* voxdag_load_file reads the header before the rest: a large file that is
+   not a .vdag, or whose header declares another size, is refused having
+   allocated nothing near its size (a counting allocator watches; the files
+   are sparse, so they take no disk space). */
+static void test_load_file_header_first(void) {
+    static const uint64_t big = (uint64_t)64 << 20;
+    size_t size = 0;
+    uint8_t *g = read_golden(GOLDEN_MIRRORED_BLOB, &size), h[VOXDAG_FILE_HEADER_SIZE];
+    char path[256];
+    int k;
+    if (!g) {
+        CHECK_MSG(0, "mirrored blob golden missing");
+        return;
+    }
+    snprintf(path, sizeof path, "build/test_header_first_%u.bin", (unsigned)time(NULL) % 100000u);
+    for (k = 0; k < 3; k++) {
+        voxdag_load_opts o;
+        count_alloc ca;
+        voxdag *d = NULL;
+        voxdag_error err;
+        voxdag_status want = k == 0 ? VOXDAG_ERR_BAD_MAGIC : k == 1 ? VOXDAG_ERR_CORRUPT : VOXDAG_ERR_VERSION;
+        FILE *fp = fopen(path, "wb");
+        memcpy(h, g, sizeof h);
+        if (k == 0) memcpy(h, "not a voxdag file", 8);
+        if (k == 2) golden_put_le(h + VOXDAG_FILE_OFF_VERSION, 2, 4);
+        CHECK(fp && fwrite(h, 1, sizeof h, fp) == sizeof h && fseek(fp, (long)big - 1, SEEK_SET) == 0 &&
+              fputc(0, fp) == 0 && fclose(fp) == 0);
+        opts_with(&o, &ca, -1);
+        CHECK_MSG(voxdag_load_file(path, &o, &d, &err) == want && !d, "case %d: status %d (%s)", k,
+                  (int)err.status, err.message);
+        CHECK_MSG(ca.peak < 65536, "case %d: %llu bytes allocated before the header was refused", k,
+                  (unsigned long long)ca.peak);
+    }
+    remove(path);
+    free(g);
+}
+
 // -- (e) Load limits refuse what exceeds them
 
 static void test_limits(void) {
@@ -1216,6 +1253,7 @@ const test_case test_format_cases[] = {
     {"format/allocation_failures", test_allocation_failures},
     {"format/build_allocation_failures", test_build_allocation_failures},
     {"format/limits", test_limits},
+    {"format/load_file_header_first", test_load_file_header_first},
     {"format/hostile_files", test_hostile_files},
     {"format/version3_fields", test_version3_fields},
     {"format/save_file", test_save_file},
