@@ -1056,6 +1056,13 @@ static uint64_t vi_hash_u64(uint64_t x) { /* splitmix64 finaliser */
 
 // -- Files and paths
 
+/* 1 when the caller lets the import read PATH (limits.on_file), else 0
+   with a message. */
+static int vi_may_read(vi_ctx *c, const char *path) {
+    if (!c->limits.on_file || c->limits.on_file(c->limits.on_file_user, path)) return 1;
+    return vi_fail(c, "%s: not read (refused by the caller)", path);
+}
+
 /* Reads the whole file at PATH into *DATA (malloc'd) and *SIZE. */
 static int vi_read_file(vi_ctx *c, const char *path, char **data, size_t *size) {
     enum { CHUNK = 1 << 16 };
@@ -1228,6 +1235,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_buf *cache, const char *dir, 
     }
     e->path = path;
     e->image = -1;
+    if (!vi_may_read(c, path)) return 0;
     if (vdag_image_load(path, &img, why, sizeof why)) {
         vdag_image *grown = (vdag_image *)VDAG_IMPORT_REALLOC(s->images, (s->image_count + 1) * sizeof *grown);
         if (!grown) {
@@ -1503,6 +1511,10 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_buf *cache, vi_span file
     vi_text t;
     int ok = 0;
     if (!path) return 0;
+    if (!vi_may_read(o->c, path)) {
+        free(path);
+        return 0;
+    }
     sub.format = path; /* messages name the library */
     sub.err = why;
     sub.err_size = why_size;
@@ -2071,7 +2083,8 @@ int vdag_import_file(const char *path, const vdag_import_limits *limits, vdag_sc
     int ok;
     vi_ctx_init(&c, path, err, err_size, limits); /* messages start with the file name */
     memset(out, 0, sizeof *out);
-    ok = vi_read_file(&c, path, &data, &size) && (c.base_dir = dir = vi_dirname(&c, path)) != NULL &&
+    ok = vi_may_read(&c, path) && vi_read_file(&c, path, &data, &size) &&
+         (c.base_dir = dir = vi_dirname(&c, path)) != NULL &&
          vi_import(&c, dot ? vi_format(dot + 1) : -1, data ? data : vi_empty, size, out);
     free(data);
     free(dir);
