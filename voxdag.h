@@ -380,12 +380,40 @@ VOXDAG_API void voxdag_free(voxdag *dag);
    size against the file's): a file that is not a .vdag costs one 96-byte read. */
 VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_opts *opts,
                                           voxdag **out, voxdag_error *err);
-/* Writes the DAG's image to PATH atomically: to a temporary file beside it
-   (PATH.tmpN), then renamed over PATH, so a failed save (full disk, no
-   permission) leaves an existing file intact and no temporary file behind.
+/* Writes the DAG's image to PATH atomically: to a temporary file beside it,
+   then renamed over PATH, so a failed save (full disk, quota, a file-size
+   limit, no permission) leaves an existing file as it was and removes the
+   temporary file. The temporary's name is PATH + ".vdag-tmp-" + the process
+   id in decimal (voxdag_save_temp_path gives it); it is created exclusively
+   (POSIX open with O_CREAT | O_EXCL, and O_NOFOLLOW where defined; Windows
+   _open with _O_EXCL, that is CREATE_NEW), so a file or a link planted at
+   that name is never written through. A name already taken is a stale
+   temporary (left by a save that was killed, in a process of the same id):
+   it is removed (a link itself, never its target) and the file created
+   exclusively once more; if the name is taken again in between, the save
+   fails (VOXDAG_ERR_IO, os_error EEXIST). The library
+   installs no signal handlers: a program that wants its temporary removed
+   when a signal stops a save unlinks voxdag_save_temp_path's name in its
+   handler (examples/vdag.c does so for SIGINT, SIGTERM, SIGHUP, SIGXFSZ).
+   A directory at PATH is refused (VOXDAG_ERR_IO, os_error EISDIR) and left
+   as it is. The permission bits of an existing regular file at PATH are kept
+   (POSIX; not its owner or group); a new file gets 0666 less the umask.
+   Where rename does not replace a file (Windows), PATH is removed just
+   before the rename, and only when it is a file open for writing.
+   Where neither POSIX (__unix__, __APPLE__) nor Windows is detected, plain
+   C99 stdio is all there is: the temporary (PATH + ".vdag-tmp") is probed
+   with fopen "rb" and then opened "wb", which a link planted in between
+   can redirect, and permissions are not kept.
+   Thread-safe for different PATHs; two saves of one PATH at once in one
+   process share the temporary name, and one of them may fail.
    On VOXDAG_ERR_IO, err->os_error holds errno. */
 VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path,
                                           voxdag_error *err);
+/* Writes the name of the temporary file voxdag_save_file uses for PATH in
+   this process (PATH + ".vdag-tmp-" + the process id) to BUF, zero-ended.
+   Returns VOXDAG_OK, or VOXDAG_ERR_INVALID_ARGUMENT when PATH or BUF is NULL
+   or SIZE is too small (PATH's length + 32 always suffices). Thread-safe. */
+VOXDAG_API voxdag_status voxdag_save_temp_path(const char *path, char *buf, size_t size);
 #endif
 
 // -- Colours
@@ -605,6 +633,20 @@ enum {
 #ifndef VOXDAG_NO_STDIO
 #include <errno.h>
 #include <stdio.h>
+#if defined(_WIN32)
+#include <fcntl.h> /* the CRT's _open, _write: saving (no <windows.h> needed) */
+#include <io.h>
+#include <process.h>
+#include <sys/stat.h>
+#elif defined(__unix__) || defined(__APPLE__)
+#include <fcntl.h> /* open, write, fchmod: saving */
+#include <sys/stat.h>
+#include <sys/types.h>
+#include <unistd.h>
+#if !defined(__cplusplus)
+int fchmod(int fd, mode_t mode); /* POSIX; strict C99 headers (-std=c99) leave it out */
+#endif
+#endif
 #endif
 #ifndef VOXDAG_NO_THREADS
 #if defined(_WIN32)
@@ -5193,45 +5235,147 @@ VOXDAG_API voxdag_status voxdag_load_file(const char *path, const voxdag_load_op
     return st;
 }
 
-/* Writes the image to PATH + ".tmp" + a number beside the target (the first
-   name not taken), then renames it over PATH: a failed save leaves an
-   existing file as it was and removes its temporary file. Where rename does
-   not replace (Windows), the old file is removed just before the rename. */
+/* Saving: the temporary file is created exclusively where the platform
+   allows it (POSIX open, Windows _open), else with stdio. */
+#if defined(_WIN32)
+#define VOXDAGI_SAVE_WIN32 1
+#elif defined(__unix__) || defined(__APPLE__)
+#define VOXDAGI_SAVE_POSIX 1
+#endif
+
+VOXDAG_API voxdag_status voxdag_save_temp_path(const char *path, char *buf, size_t size) {
+    size_t n;
+    if (!path || !buf) return VOXDAG_ERR_INVALID_ARGUMENT;
+    n = strlen(path);
+    if (size < 32 || n > size - 32) return VOXDAG_ERR_INVALID_ARGUMENT;
+#if defined(VOXDAGI_SAVE_WIN32)
+    sprintf(buf, "%s.vdag-tmp-%lu", path, (unsigned long)_getpid());
+#elif defined(VOXDAGI_SAVE_POSIX)
+    sprintf(buf, "%s.vdag-tmp-%lu", path, (unsigned long)getpid());
+#else
+    sprintf(buf, "%s.vdag-tmp", path);
+#endif
+    return VOXDAG_OK;
+}
+
+#if defined(VOXDAGI_SAVE_POSIX)
+#define voxdagi_write(fd, p, n) write(fd, p, n)
+#define voxdagi_close(fd) close(fd)
+#define voxdagi_unlink(path) unlink(path)
+#elif defined(VOXDAGI_SAVE_WIN32)
+#define voxdagi_write(fd, p, n) _write(fd, p, (unsigned)(n))
+#define voxdagi_close(fd) _close(fd)
+#define voxdagi_unlink(path) _unlink(path)
+#endif
+
+/* Writes SIZE bytes at DATA to the new file TMP. Returns 1, or 0 with errno
+   set, TMP then removed, or never made (EEXIST: not ours, left alone).
+   MODE: the permission bits to give it, or -1 for the default. */
+static int voxdagi_write_new(const char *tmp, const uint8_t *data, size_t size, long mode) {
+#if defined(VOXDAGI_SAVE_POSIX) || defined(VOXDAGI_SAVE_WIN32)
+    int ok = 1, e, fd;
+#if defined(VOXDAGI_SAVE_POSIX)
+    int flags = O_WRONLY | O_CREAT | O_EXCL; /* O_EXCL: never through a link at TMP */
+#ifdef O_NOFOLLOW
+    flags |= O_NOFOLLOW;
+#endif
+#ifdef O_CLOEXEC
+    flags |= O_CLOEXEC;
+#endif
+    fd = open(tmp, flags, 0666);
+    if (fd >= 0 && mode >= 0) ok = !fchmod(fd, (mode_t)mode);
+#else
+    fd = _open(tmp, _O_WRONLY | _O_CREAT | _O_EXCL | _O_BINARY | _O_NOINHERIT, _S_IREAD | _S_IWRITE);
+    (void)mode;
+#endif
+    if (fd < 0) return 0;
+    while (ok && size) {
+        size_t n = size < ((size_t)1 << 30) ? size : ((size_t)1 << 30);
+        long got = (long)voxdagi_write(fd, data, n);
+        if (got < 0 && errno == EINTR) continue;
+        if (got <= 0) {
+            if (got == 0) errno = EIO;
+            ok = 0;
+            break;
+        }
+        data += got;
+        size -= (size_t)got;
+    }
+    e = errno;
+    if (voxdagi_close(fd) && ok) ok = 0, e = errno;
+    if (!ok) voxdagi_unlink(tmp);
+    errno = e;
+    return ok;
+#else
+    FILE *f = fopen(tmp, "rb");
+    int ok, e;
+    (void)mode;
+    if (f) { /* taken: not ours */
+        fclose(f);
+#ifdef EEXIST
+        errno = EEXIST;
+#endif
+        return 0;
+    }
+    if (!(f = fopen(tmp, "wb"))) return 0;
+    ok = fwrite(data, 1, size, f) == size && !fflush(f);
+    e = errno;
+    if (fclose(f) && ok) ok = 0, e = errno;
+    if (!ok) remove(tmp);
+    errno = e;
+    return ok;
+#endif
+}
+
+/* Writes the image to voxdag_save_temp_path's name beside PATH, created
+   exclusively, and renames it over PATH (see the declaration). */
 VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path, voxdag_error *err) {
     char tmp[4096];
-    size_t n;
-    unsigned k;
-    FILE *f = NULL;
-    voxdag_status st = VOXDAG_OK;
+    long mode = -1;
+    int written;
     if (!dag || !path) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "dag or path is NULL");
-    n = strlen(path);
-    if (n + 16 > sizeof tmp) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "path longer than 4080 bytes");
-    for (k = 0; k < 1000 && !f; k++) {
-        FILE *probe;
-        sprintf(tmp, "%s.tmp%u", path, k);
-        probe = fopen(tmp, "rb");
-        if (probe) { /* taken */
-            fclose(probe);
-            continue;
+    if (voxdag_save_temp_path(path, tmp, sizeof tmp) != VOXDAG_OK)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "path longer than 4064 bytes");
+#if defined(VOXDAGI_SAVE_POSIX) || defined(VOXDAGI_SAVE_WIN32)
+    {
+#if defined(VOXDAGI_SAVE_POSIX)
+        struct stat st;
+        int got = !stat(path, &st), dir = got && S_ISDIR(st.st_mode);
+        if (got && S_ISREG(st.st_mode)) mode = (long)(st.st_mode & 0777);
+#else
+        struct _stat st;
+        int dir = !_stat(path, &st) && (st.st_mode & _S_IFMT) == _S_IFDIR;
+#endif
+        if (dir) {
+            errno = EISDIR;
+            return voxdagi_fail_io(err, "the target is a directory");
         }
-        f = fopen(tmp, "wb");
-        if (!f) return voxdagi_fail_io(err, "cannot create a temporary file beside the target");
     }
-    if (!f) return VOXDAGI_FAIL(err, VOXDAG_ERR_IO, "no free temporary file name beside the target");
-    if (fwrite(dag->image, 1, dag->image_size, f) != dag->image_size || fflush(f))
-        st = voxdagi_fail_io(err, "cannot write the file");
-    if (fclose(f) && st == VOXDAG_OK) st = voxdagi_fail_io(err, "cannot write the file");
-    if (st == VOXDAG_OK && rename(tmp, path)) {
+#endif
+    written = voxdagi_write_new(tmp, (const uint8_t *)dag->image, dag->image_size, mode);
+#ifdef EEXIST
+    /* A taken name is a stale temporary (a save that was killed, in a
+       process of this id): the name is removed (a link itself, never its
+       target) and the file created exclusively once more, so whatever
+       appears there in between makes the save fail, not follow it. */
+    if (!written && errno == EEXIST && !remove(tmp))
+        written = voxdagi_write_new(tmp, (const uint8_t *)dag->image, dag->image_size, mode);
+#endif
+    if (!written) return voxdagi_fail_io(err, "cannot write a temporary file beside the target (PATH.vdag-tmp-PID)");
+    if (rename(tmp, path)) {
         int e = errno;
-        /* where rename does not replace an existing file */
-        if (remove(path) || rename(tmp, path)) {
+#if !defined(VOXDAGI_SAVE_POSIX)
+        /* where rename does not replace a file: remove it first, when it is
+           one (never a directory: that does not open for writing) */
+        FILE *old = fopen(path, "r+b");
+        if (old) fclose(old);
+        if (!old || remove(path) || rename(tmp, path))
+#endif
+        {
+            remove(tmp);
             errno = e;
-            st = voxdagi_fail_io(err, "cannot move the temporary file over the target");
+            return voxdagi_fail_io(err, "cannot move the temporary file over the target");
         }
-    }
-    if (st != VOXDAG_OK) {
-        remove(tmp);
-        return st;
     }
     return voxdagi_ok(err);
 }

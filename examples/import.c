@@ -1065,6 +1065,13 @@ static uint64_t vi_hash_u64(uint64_t x) { /* splitmix64 finaliser */
 
 // -- Files and paths
 
+/* 1 when the caller lets the import read PATH (limits.on_file), else 0
+   with a message. */
+static int vi_may_read(vi_ctx *c, const char *path) {
+    if (!c->limits.on_file || c->limits.on_file(c->limits.on_file_user, path)) return 1;
+    return vi_fail(c, "%s: not read (refused by the caller)", path);
+}
+
 /* Reads F to its end into *DATA (malloc'd) and *SIZE: at most MAX bytes
    (else an error naming WHAT, the limit); KNOWN (or -1) reserves the size. */
 static int vi_read_stream(vi_ctx *c, FILE *f, long known, uint64_t max, const char *what, char **data,
@@ -1373,6 +1380,7 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_texcache *cache, const char *
     memset(e, 0, sizeof *e);
     e->path = path;
     e->image = -1;
+    if (!vi_may_read(c, path)) return 0;
     if ((got = vi_open_side(c, path, &f, &e->id, &bytes, why, sizeof why)) <= 0) {
         if (got < 0 && !c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", why);
         return got < 0;
@@ -1671,6 +1679,10 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span
     vi_text t;
     int ok = 0;
     if (!path) return 0;
+    if (!vi_may_read(o->c, path)) {
+        free(path);
+        return 0;
+    }
     sub.format = path; /* messages name the library */
     if ((ok = vi_read_side(&sub, path, &data, &size, why, why_size)) <= 0) {
         free(path);
@@ -2274,7 +2286,8 @@ int vdag_import_file(const char *path, const vdag_import_limits *limits, vdag_sc
     int ok;
     vi_ctx_init(&c, path, err, err_size, limits); /* messages start with the file name */
     memset(out, 0, sizeof *out);
-    ok = vi_read_file(&c, path, &data, &size) && (c.base_dir = dir = vi_dirname(&c, path)) != NULL &&
+    ok = vi_may_read(&c, path) && vi_read_file(&c, path, &data, &size) &&
+         (c.base_dir = dir = vi_dirname(&c, path)) != NULL &&
          vi_import(&c, dot ? vi_format(dot + 1) : -1, data ? data : vi_empty, size, out);
     free(data);
     free(dir);

@@ -93,6 +93,11 @@ typedef struct vdag_import_limits {
                                  their colours; for callers that need no colours) */
     int quiet;                /* 1: no warnings on stderr (what an import
                                  tolerates, skips or cannot decode) */
+    int (*on_file)(void *user, const char *path); /* NULL, or called with the
+                                 path of each file before it is read (the
+                                 input, .mtl libraries, textures): returning 0
+                                 stops the import with an error */
+    void *on_file_user;
 } vdag_import_limits;
 
 #ifndef VDAG_IMPORT_MAX_INPUT_BYTES

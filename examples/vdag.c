@@ -23,6 +23,7 @@
 
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -124,7 +125,8 @@ static const struct {
      "Builds a .vdag file from IN: .xyz (voxels \"x y z [r g b]\", integers; with decimal\n"
      "coordinates a point cloud), .ply, .obj (+ .mtl, textures PNG/JPEG/TGA/BMP/PNM), .off,\n"
      ".stl, .vox, .spm, .ac. Meshes and point clouds are fitted into the 2^L grid by their\n"
-     "bounding box; voxel lists keep their coordinates. OUT may not be IN.\n"
+     "bounding box; voxel lists keep their coordinates. OUT may not be IN, nor a file the\n"
+     "build reads (.mtl libraries, textures).\n"
      "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
      "                     point clouds; voxel lists: the smallest grid that holds them)\n"
      "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
@@ -774,11 +776,30 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     return rc;
 }
 
+/* The output of a build, to refuse files the import reads (the input, its
+   .mtl libraries, textures) as the output: the same device and inode. */
+typedef struct output_guard {
+    struct stat out; /* valid when exists */
+    int exists;
+    char clash[4096]; /* the file read that is the output, else "" */
+} output_guard;
+
+static int guard_read(void *user, const char *path) {
+    output_guard *g = (output_guard *)user;
+    struct stat st;
+    if (g->exists && !stat(path, &st) && st.st_dev == g->out.st_dev && st.st_ino == g->out.st_ino) {
+        snprintf(g->clash, sizeof g->clash, "%s", path);
+        return 0;
+    }
+    return 1;
+}
+
 static int cmd_build(int argc, char **argv) {
     build_args a;
     color_spill spill;
     vdag_scene sc;
     vdag_import_limits limits;
+    output_guard guard;
     char msg[256];
     voxdag_build_opts o;
     voxdag_builder *b;
@@ -870,7 +891,15 @@ static int cmd_build(int argc, char **argv) {
     limits.skip_textures = a.no_colors && a.no_alpha_test;
     limits.max_texture_pixels = a.max_texture_pixels;
     limits.max_vox_voxels = a.max_vox_voxels;
-    if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) return vdag_fail("%s", msg);
+    guard.exists = !stat(a.out, &guard.out);
+    guard.clash[0] = 0;
+    limits.on_file = guard_read;
+    limits.on_file_user = &guard;
+    if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) {
+        if (guard.clash[0])
+            return vdag_fail("%s: is %s, a file the build reads; refusing to write over it", a.out, guard.clash);
+        return vdag_fail("%s", msg);
+    }
     if (!a.up) a.up = default_up(a.in);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
     turn_up(sc.positions, sc.vertex_count, a.up, 0);
@@ -900,9 +929,46 @@ static int cmd_build(int argc, char **argv) {
     return finish_build(&a, b, rc, &err, t0);
 }
 
+/* The temporary file of the save in progress (voxdag_save_temp_path: the
+   library creates it exclusively under this name), for save_stopped. */
+static char save_temp[4200];
+
+/* A signal that stops a save removes its temporary file, then ends the
+   process as the signal would have (async-signal-safe: unlink, signal,
+   raise). */
+static void save_stopped(int sig) {
+    unlink(save_temp);
+    signal(sig, SIG_DFL);
+    raise(sig);
+}
+
+/* voxdag_save_file, and on SIGINT, SIGTERM, SIGHUP or SIGXFSZ (a file-size
+   limit) while it runs, no temporary file left behind. A signal the tool
+   was started with ignored stays ignored (SIGXFSZ then fails the write with
+   EFBIG, and the library removes the temporary). TMP receives the name. */
+static voxdag_status save_file(const voxdag *dag, const char *path, char *tmp, size_t tmp_size, voxdag_error *err) {
+    static const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGXFSZ};
+    struct sigaction sa, old[sizeof sigs / sizeof sigs[0]];
+    voxdag_status st;
+    size_t i;
+    if (voxdag_save_temp_path(path, save_temp, sizeof save_temp) != VOXDAG_OK)
+        return voxdag_save_file(dag, path, err); /* the path is too long: the library says so */
+    snprintf(tmp, tmp_size, "%s", save_temp);
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = save_stopped;
+    sigemptyset(&sa.sa_mask);
+    for (i = 0; i < sizeof sigs / sizeof sigs[0]; i++) sigaddset(&sa.sa_mask, sigs[i]);
+    for (i = 0; i < sizeof sigs / sizeof sigs[0]; i++)
+        if (!sigaction(sigs[i], NULL, &old[i]) && old[i].sa_handler != SIG_IGN) sigaction(sigs[i], &sa, NULL);
+    st = voxdag_save_file(dag, path, err);
+    for (i = 0; i < sizeof sigs / sizeof sigs[0]; i++) sigaction(sigs[i], &old[i], NULL);
+    return st;
+}
+
 /* Finishes a build whose input is all added (FAILED: adding failed, B is
    freed), compresses colours when asked, and saves. */
 static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_error *err, double t0) {
+    char tmp[4200];
     voxdag *dag = NULL;
     voxdag_build_stats st;
     int rc = failed;
@@ -924,9 +990,11 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
         fprintf(stderr, "vdag: warning: %s gave no voxels (its triangles or points lie outside the grid, "
                         "or are degenerate)\n", a->in);
     errno = 0;
-    rc = voxdag_save_file(dag, a->out, err) != VOXDAG_OK;
+    rc = save_file(dag, a->out, tmp, sizeof tmp, err) != VOXDAG_OK;
     voxdag_free(dag);
-    if (rc && errno) return vdag_fail("%s: %s (%s)", a->out, err->message, strerror(errno));
+    if (rc && err->os_error == EEXIST)
+        return vdag_fail("%s: %s is in the way (taken again while the save removed a stale one)", a->out, tmp);
+    if (rc && err->os_error) return vdag_fail("%s: %s (%s)", a->out, err->message, strerror(err->os_error));
     if (rc) return vdag_fail("%s: %s", a->out, err->message);
     if (!a->quiet) fprintf(stderr, "vdag: wrote %s\n", a->out);
     return 0;

@@ -357,6 +357,39 @@ check "build refuses to write over its input, also by another name" sh -c "
     ! '$VDAG' build '$T/keep.xyz' '$T/keep.xyz' 2>'$T/err' && grep -q 'is the input' '$T/err' &&
     ! '$VDAG' build '$T/keep.xyz' '$T/./keep.xyz' 2>/dev/null && ln -s keep.xyz '$T/alias.xyz' &&
     ! '$VDAG' build '$T/keep.xyz' '$T/alias.xyz' 2>/dev/null && cmp -s '$T/keep.xyz' '$T/in.xyz'"
+printf 'newmtl red\nKd 1 0 0\nmap_Kd own.png\n' >"$T/own.mtl"
+printf 'not an image' >"$T/own.png"
+cp "$T/own.mtl" "$T/own.mtl.orig"
+cp "$T/own.png" "$T/own.png.orig"
+printf 'mtllib own.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl red\nf 1/1 2/2 3/3\n' >"$T/own.obj"
+check "build refuses to write over a file its input reads (the .mtl, a texture), one line, the file unchanged" sh -c "
+    ! '$VDAG' build '$T/own.obj' '$T/own.mtl' --levels 3 --quiet 2>'$T/err' && grep -q 'own.mtl, a file the build reads' '$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && cmp -s '$T/own.mtl' '$T/own.mtl.orig' &&
+    ! '$VDAG' build '$T/own.obj' '$T/own.png' --levels 3 --quiet 2>'$T/err' && grep -q 'own.png, a file the build reads' '$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && cmp -s '$T/own.png' '$T/own.png.orig' &&
+    '$VDAG' build '$T/own.obj' '$T/own.vdag' --levels 3 2>/dev/null"
+# A save stopped by a signal: the old file stays and no temporary is left
+# (a file-size limit raises SIGXFSZ in the write; strace delivers the others
+# as the save renames its finished temporary, which then fails with EINTR).
+"$VDAG" build "$T/in.xyz" "$T/old.vdag" --levels 5 --no-colors --quiet
+check "a file-size limit (SIGXFSZ) stopping a save leaves the old file and no temporary" sh -c "
+    exec 2>/dev/null # the shell's 'File size limit exceeded'
+    cp '$T/a.vdag' '$T/fz.vdag'
+    (ulimit -f 1 && exec '$VDAG' build '$T/in.xyz' '$T/fz.vdag' --levels 5 --no-colors --quiet) 2>/dev/null
+    [ \$? != 0 ] && cmp -s '$T/fz.vdag' '$T/a.vdag' && [ \$(wc -c <'$T/old.vdag') -gt 1024 ] && ! ls '$T' | grep -q '^fz\\.vdag\\.'"
+if command -v strace >/dev/null 2>&1 && strace -o /dev/null true 2>/dev/null; then
+    for sig in TERM INT HUP; do
+        check "SIG$sig stopping a save leaves the old file and no temporary" sh -c "
+            exec 2>/dev/null
+            cp '$T/a.vdag' '$T/sig.vdag'
+            strace -f -o /dev/null -e trace=rename,renameat,renameat2 \
+                -e inject=rename,renameat,renameat2:error=EINTR:signal=$sig \
+                '$VDAG' build '$T/in.xyz' '$T/sig.vdag' --levels 5 --no-colors --quiet 2>/dev/null
+            [ \$? != 0 ] && cmp -s '$T/sig.vdag' '$T/a.vdag' && ! ls '$T' | grep -q '^sig\\.vdag\\.'"
+    done
+else
+    ko "signals during a save: strace missing or not permitted (tests/deps.sh installs strace)"
+fi
 check "render refuses to write over its input" sh -c "! '$VDAG' render '$T/a.vdag' '$T/a.vdag' 2>/dev/null && '$VDAG' validate '$T/a.vdag' 2>/dev/null"
 check "a directory as output or as a .vdag says so" sh -c "
     ! '$VDAG' build '$T/in.xyz' '$T' 2>'$T/err' && grep -q 'is a directory' '$T/err' &&

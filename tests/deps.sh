@@ -8,6 +8,7 @@ command -v oiiotool >/dev/null 2>&1 || need="$need openimageio-tools"
 command -v assimp >/dev/null 2>&1 || need="$need assimp-utils"
 command -v clang >/dev/null 2>&1 || need="$need clang"
 command -v g++ >/dev/null 2>&1 || need="$need g++"
+command -v strace >/dev/null 2>&1 || need="$need strace" # signals during a save (tests/cli.sh)
 matrix=""
 # The portability matrix (tests/check_all.sh): 32-bit x86 and big-endian
 # s390x cross compilers run under qemu-user, MinGW-w64 under Wine. (Debian's

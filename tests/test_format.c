@@ -20,6 +20,7 @@
 #ifdef __unix__
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -1173,6 +1174,29 @@ static int file_equals(const char *path, const void *data, size_t size) {
     return same;
 }
 
+/* 1 if a temporary file of a save of PATH is left: this process's name,
+   or the names of earlier versions (PATH.tmp0, PATH.vdag-tmp). */
+static int save_temp_left(const char *path) {
+    char tmp[4200];
+    const char *names[3];
+    int k, left = 0;
+    voxdag_save_temp_path(path, tmp, sizeof tmp);
+    names[0] = tmp;
+    names[1] = ".tmp0";
+    names[2] = ".vdag-tmp";
+    for (k = 0; k < 3; k++) {
+        char name[4200];
+        FILE *fp;
+        if (k) snprintf(name, sizeof name, "%s%s", path, names[k]);
+        else snprintf(name, sizeof name, "%s", tmp);
+        if ((fp = fopen(name, "rb")) != NULL) {
+            fclose(fp);
+            left = 1;
+        }
+    }
+    return left;
+}
+
 static void test_save_file(void) {
     size_t size = 0, small_size;
     uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size);
@@ -1218,6 +1242,10 @@ static void test_save_file(void) {
                 }
                 CHECK(pid > 0 && waitpid(pid, &status, 0) == pid && WIFEXITED(status) && WEXITSTATUS(status) == 0);
                 CHECK_MSG(file_equals(path, small, small_size), "a failed save changed the existing file");
+                snprintf(tmp, sizeof tmp, "%s.vdag-tmp-%lu", path, (unsigned long)pid); /* the child's */
+                fp = fopen(tmp, "rb");
+                CHECK_MSG(!fp, "a save that failed with EFBIG left its temporary file");
+                if (fp) fclose(fp);
             }
 #else
             (void)small; /* no file size limit to fail a write with */
@@ -1226,24 +1254,146 @@ static void test_save_file(void) {
         }
         free(g);
     }
-    snprintf(tmp, sizeof tmp, "%s.tmp0", path);
-    fp = fopen(tmp, "rb");
-    CHECK_MSG(!fp, "a temporary file was left behind");
-    if (fp) fclose(fp);
-    /* a taken temporary name is skipped, not overwritten */
+    CHECK_MSG(!save_temp_left(path), "a temporary file was left behind");
+    /* a file at the temporary name is a stale temporary (a save that was
+       killed): removed, and the save goes through */
+    CHECK(voxdag_save_temp_path(path, tmp, sizeof tmp) == VOXDAG_OK);
     fp = fopen(tmp, "wb");
     if (fp) {
-        fputs("someone else's", fp);
+        fputs("a stale temporary", fp);
         fclose(fp);
     }
-    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && file_equals(path, f, size));
-    CHECK(file_equals(tmp, "someone else's", 14));
-    remove(tmp);
+    fp = fopen(path, "wb");
+    if (fp) {
+        fputs("the old file", fp);
+        fclose(fp);
+    }
+    CHECK(voxdag_save_file(d, path, &err) == VOXDAG_OK && file_equals(path, f, size));
+    fp = fopen(tmp, "rb");
+    CHECK_MSG(!fp, "a stale temporary was left");
+    if (fp) fclose(fp);
     remove(path);
 done:
     voxdag_free(d);
     free(f);
 }
+
+/* The temporary name: PATH + ".vdag-tmp-" + the process id; too small a
+   buffer or a NULL is an invalid argument. */
+static void test_save_temp_path(void) {
+    char buf[64], want[64];
+#if defined(_WIN32)
+    snprintf(want, sizeof want, "a/b.vdag.vdag-tmp-%lu", (unsigned long)_getpid());
+#elif defined(__unix__) || defined(__APPLE__)
+    snprintf(want, sizeof want, "a/b.vdag.vdag-tmp-%lu", (unsigned long)getpid());
+#else
+    snprintf(want, sizeof want, "a/b.vdag.vdag-tmp");
+#endif
+    CHECK(voxdag_save_temp_path("a/b.vdag", buf, sizeof buf) == VOXDAG_OK && !strcmp(buf, want));
+    CHECK(voxdag_save_temp_path("a/b.vdag", buf, 8 + 32) == VOXDAG_OK && !strcmp(buf, want));
+    CHECK(voxdag_save_temp_path("a/b.vdag", buf, 8 + 31) == VOXDAG_ERR_INVALID_ARGUMENT);
+    CHECK(voxdag_save_temp_path(NULL, buf, sizeof buf) == VOXDAG_ERR_INVALID_ARGUMENT);
+    CHECK(voxdag_save_temp_path("x", NULL, sizeof buf) == VOXDAG_ERR_INVALID_ARGUMENT);
+}
+
+#ifdef __unix__
+/* A save when links are planted at every temporary name it might use (this
+   version's, and the PATH.tmpN and PATH.vdag-tmp of earlier ones), each
+   pointing at a file that does not exist: no link is followed (none of
+   their targets is created), the target stays a regular file, and a link
+   at its own temporary name is removed (the link, not its target). */
+static void test_save_planted_links(void) {
+    size_t size = 0, one_size = 0;
+    uint8_t *f = read_golden(GOLDEN_MIRRORED_BLOB, &size), *g = read_golden(GOLDEN_ONE_VOXEL, &one_size);
+    voxdag *d = NULL;
+    voxdag_error err;
+    char path[256], link[320], target[320];
+    struct stat st;
+    int k, pass;
+    snprintf(path, sizeof path, "build/test_save_links_%lu.vdag", (unsigned long)getpid());
+    CHECK(f && g && voxdag_load_memory(f, size, NULL, &d, NULL) == VOXDAG_OK);
+    if (!d) goto done;
+    for (pass = 0; pass < 2; pass++) {
+        FILE *fp = fopen(path, "wb"); /* the old file */
+        CHECK(fp && fwrite(g, 1, one_size, fp) == one_size);
+        if (fp) fclose(fp);
+        for (k = -2; k < 10; k++) {
+            if (k == -2) voxdag_save_temp_path(path, link, sizeof link);
+            else if (k == -1) snprintf(link, sizeof link, "%s.vdag-tmp", path);
+            else snprintf(link, sizeof link, "%s.tmp%d", path, k);
+            snprintf(target, sizeof target, "%s.victim%d", path, k + 2);
+            remove(target);
+            remove(link);
+            /* the second pass: no link at this version's own name */
+            CHECK(k == -2 && pass == 1 ? 1 : symlink(target + 6, link) == 0); /* relative to build/ */
+        }
+        CHECK(voxdag_save_file(d, path, &err) == VOXDAG_OK);
+        CHECK(file_equals(path, f, size));
+        CHECK_MSG(lstat(path, &st) == 0 && S_ISREG(st.st_mode), "pass %d: the target is not a regular file", pass);
+        for (k = -2; k < 10; k++) {
+            snprintf(target, sizeof target, "%s.victim%d", path, k + 2);
+            CHECK_MSG(lstat(target, &st) != 0, "pass %d: a planted link was followed (%s created)", pass, target);
+            remove(target);
+            if (k == -2) voxdag_save_temp_path(path, link, sizeof link);
+            else if (k == -1) snprintf(link, sizeof link, "%s.vdag-tmp", path);
+            else snprintf(link, sizeof link, "%s.tmp%d", path, k);
+            CHECK_MSG(k == -2 && pass == 1 ? lstat(link, &st) != 0 : lstat(link, &st) == 0 && S_ISLNK(st.st_mode),
+                      "pass %d: %s changed", pass, link);
+            remove(link);
+        }
+    }
+    remove(path);
+done:
+    voxdag_free(d);
+    free(f);
+    free(g);
+}
+
+/* A save onto a directory (here an empty one, which remove() would delete)
+   is refused, and the directory stays; onto a file, the file's permission
+   bits are kept, and a new file gets 0666 less the umask. */
+static void test_save_directory_and_mode(void) {
+    size_t size = 0;
+    uint8_t *f = read_golden(GOLDEN_ONE_VOXEL, &size);
+    voxdag *d = NULL;
+    voxdag_error err;
+    char path[256];
+    struct stat st;
+    mode_t old_mask;
+    FILE *fp;
+    CHECK(f && voxdag_load_memory(f, size, NULL, &d, NULL) == VOXDAG_OK);
+    if (!d) goto done;
+    snprintf(path, sizeof path, "build/test_save_dir_%lu", (unsigned long)getpid());
+    rmdir(path);
+    CHECK(mkdir(path, 0755) == 0);
+    CHECK(voxdag_save_file(d, path, &err) == VOXDAG_ERR_IO && err.os_error == EISDIR);
+    CHECK_MSG(stat(path, &st) == 0 && S_ISDIR(st.st_mode), "a save onto an empty directory removed it");
+    CHECK_MSG(!save_temp_left(path), "a refused save left a temporary file");
+    rmdir(path);
+    snprintf(path, sizeof path, "build/test_save_mode_%lu.vdag", (unsigned long)getpid());
+    remove(path);
+    old_mask = umask(022);
+    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && stat(path, &st) == 0 && (st.st_mode & 0777) == 0644);
+    CHECK(chmod(path, 0600) == 0);
+    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && file_equals(path, f, size));
+    CHECK_MSG(stat(path, &st) == 0 && (st.st_mode & 0777) == 0600, "a 0600 file became %03o",
+              (unsigned)(st.st_mode & 0777));
+    CHECK(chmod(path, 0640) == 0);
+    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && stat(path, &st) == 0 && (st.st_mode & 0777) == 0640);
+    umask(077); /* the umask does not narrow an existing file's bits */
+    CHECK(chmod(path, 0644) == 0);
+    CHECK(voxdag_save_file(d, path, NULL) == VOXDAG_OK && stat(path, &st) == 0 && (st.st_mode & 0777) == 0644);
+    umask(old_mask);
+    fp = fopen(path, "rb");
+    CHECK(fp != NULL);
+    if (fp) fclose(fp);
+    remove(path);
+    CHECK(!save_temp_left(path));
+done:
+    voxdag_free(d);
+    free(f);
+}
+#endif
 
 const test_case test_format_cases[] = {
     {"format/golden_identical", test_golden_identical},
@@ -1257,5 +1407,10 @@ const test_case test_format_cases[] = {
     {"format/hostile_files", test_hostile_files},
     {"format/version3_fields", test_version3_fields},
     {"format/save_file", test_save_file},
+    {"format/save_temp_path", test_save_temp_path},
+#ifdef __unix__
+    {"format/save_planted_links", test_save_planted_links},
+    {"format/save_directory_and_mode", test_save_directory_and_mode},
+#endif
     {NULL, NULL},
 };
