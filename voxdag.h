@@ -4903,44 +4903,50 @@ VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
            (c[2] & 2) << 4;
 }
 
-/* The world octants a ray can still reach in a node from octant W, moving
-   only towards the AHEAD halves (bit b set: it has yet to cross mid plane b). */
-VOXDAGI_INLINE unsigned voxdagi_reach8(unsigned w, unsigned ahead) {
-    unsigned r = 1u << w;
-    if (ahead & 1) r |= (r & 0x55u) << 1 | (r & 0xAAu) >> 1;
-    if (ahead & 2) r |= (r & 0x33u) << 2 | (r & 0xCCu) >> 2;
-    if (ahead & 4) r |= (r & 0x0Fu) << 4 | (r & 0xF0u) >> 4;
-    return r;
-}
+/* The octants of a 2^3 block a ray can still reach from octant W, moving only
+   towards the AHEAD halves (bit b set: it has yet to cross mid plane b):
+   [W][AHEAD], W with each subset of AHEAD's bits flipped. */
+static const uint8_t voxdagi_reach8[8][8] = {
+    {0x01, 0x03, 0x05, 0x0F, 0x11, 0x33, 0x55, 0xFF}, {0x02, 0x03, 0x0A, 0x0F, 0x22, 0x33, 0xAA, 0xFF},
+    {0x04, 0x0C, 0x05, 0x0F, 0x44, 0xCC, 0x55, 0xFF}, {0x08, 0x0C, 0x0A, 0x0F, 0x88, 0xCC, 0xAA, 0xFF},
+    {0x10, 0x30, 0x50, 0xF0, 0x11, 0x33, 0x55, 0xFF}, {0x20, 0x30, 0xA0, 0xF0, 0x22, 0x33, 0xAA, 0xFF},
+    {0x40, 0xC0, 0x50, 0xF0, 0x44, 0xCC, 0x55, 0xFF}, {0x80, 0xC0, 0xA0, 0xF0, 0x88, 0xCC, 0xAA, 0xFF}};
 
-/* The positions of a 4^3 brick whose coordinate A is at least V (0..4). */
-VOXDAGI_INLINE uint64_t voxdagi_brick_at_least(unsigned a, uint32_t v) {
-    uint64_t lo = voxdagi_brick_bit_clear[a], hi = voxdagi_brick_bit_clear[a + 3];
-    return v == 0 ? ~0ull : v == 1 ? ~(lo & hi) : v == 2 ? ~hi : v == 3 ? ~(lo | hi) : 0;
-}
+/* The positions of a 4^3 brick a ray can still reach along axis A from
+   coordinate V: [A][V][0] for a ray that does not move along A (coordinate
+   V), [1] moving up (at least V), [2] moving down (at most V). */
+static const uint64_t voxdagi_brick_reach[3][4][3] = {
+    {{0x0055005500550055ull, 0xFFFFFFFFFFFFFFFFull, 0x0055005500550055ull},
+     {0x00AA00AA00AA00AAull, 0xFFAAFFAAFFAAFFAAull, 0x00FF00FF00FF00FFull},
+     {0x5500550055005500ull, 0xFF00FF00FF00FF00ull, 0x55FF55FF55FF55FFull},
+     {0xAA00AA00AA00AA00ull, 0xAA00AA00AA00AA00ull, 0xFFFFFFFFFFFFFFFFull}},
+    {{0x0000333300003333ull, 0xFFFFFFFFFFFFFFFFull, 0x0000333300003333ull},
+     {0x0000CCCC0000CCCCull, 0xFFFFCCCCFFFFCCCCull, 0x0000FFFF0000FFFFull},
+     {0x3333000033330000ull, 0xFFFF0000FFFF0000ull, 0x3333FFFF3333FFFFull},
+     {0xCCCC0000CCCC0000ull, 0xCCCC0000CCCC0000ull, 0xFFFFFFFFFFFFFFFFull}},
+    {{0x000000000F0F0F0Full, 0xFFFFFFFFFFFFFFFFull, 0x000000000F0F0F0Full},
+     {0x00000000F0F0F0F0ull, 0xFFFFFFFFF0F0F0F0ull, 0x00000000FFFFFFFFull},
+     {0x0F0F0F0F00000000ull, 0xFFFFFFFF00000000ull, 0x0F0F0F0FFFFFFFFFull},
+     {0xF0F0F0F000000000ull, 0xF0F0F0F000000000ull, 0xFFFFFFFFFFFFFFFFull}}};
 
-/* Whether a full cell of the node at level L (a brick's voxels when VOXELS,
-   else its children, 2^3 cells or a 2^3 cell's voxels) lies on the ray's side
-   of every mid plane it has yet to cross from cell C: its full cells are
-   OCC, or those of the brick MASK (world order). */
-VOXDAGI_INLINE int voxdagi_full_ahead(uint32_t l, uint32_t brick_level, int voxels, unsigned occ, uint64_t mask,
-                                      const uint32_t c[3], const int sgn[3]) {
-    unsigned ahead = 0, w, b;
-    if (l == brick_level && voxels) { /* a box of the brick's voxels */
-        uint64_t reach = ~0ull;
-        for (b = 0; b < 3; b++) {
-            if (sgn[b] >= 0) reach &= voxdagi_brick_at_least(b, c[b] & 3);
-            if (sgn[b] <= 0) reach &= ~voxdagi_brick_at_least(b, (c[b] & 3) + 1);
-        }
-        return (mask & reach) != 0;
-    }
-    if (l == brick_level) { /* 2^3 cells of a brick */
-        for (occ = 0, w = 0; w < 8; w++) occ |= (unsigned)((mask >> 8 * w & 0xFF) != 0) << w;
-    } else if (l > brick_level) { /* voxels of a 2^3 cell */
+/* Whether a full cell of brick MASK (world order) lies on the ray's side of
+   every mid plane it has yet to cross from cell C, the cells being the
+   brick's voxels (WHAT 0), its 2^3 cells (1) or the voxels of C's 2^3 cell
+   (2). MOVING: the axes along which the ray moves (bits), DOWN: those along
+   which it moves down; KIND: per axis, 0 still, 1 up, 2 down. */
+static int voxdagi_brick_full_ahead(int what, uint64_t mask, const uint32_t c[3], unsigned moving, unsigned down,
+                                    const unsigned kind[3]) {
+    unsigned w = (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2, occ = 0, k;
+    if (what == 0) /* a box of the brick's voxels */
+        return (mask & voxdagi_brick_reach[0][c[0] & 3][kind[0]] & voxdagi_brick_reach[1][c[1] & 3][kind[1]] &
+                voxdagi_brick_reach[2][c[2] & 3][kind[2]]) != 0;
+    if (what == 1) {
+        for (k = 0; k < 8; k++) occ |= (unsigned)((mask >> 8 * k & 0xFF) != 0) << k;
+    } else {
         occ = (unsigned)(mask >> 8 * ((c[0] >> 1 & 1) | (c[1] >> 1 & 1) << 1 | (c[2] >> 1 & 1) << 2) & 0xFF);
     }
-    for (b = 0; b < 3; b++) ahead |= (unsigned)(sgn[b] > 0 ? !(c[b] & 1) : sgn[b] < 0 && (c[b] & 1)) << b;
-    return (occ & voxdagi_reach8((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2, ahead)) != 0;
+    /* ahead along b: the lower half moving up, the upper half moving down */
+    return (occ & voxdagi_reach8[w][~(w ^ down) & moving & 7]) != 0;
 }
 
 /* Index of the first voxel of cell C at cell level Q: the voxels of all
@@ -4974,6 +4980,7 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
     int sgn[3];
     unsigned ae = 0, ax = 0, a, mi = d->cube.inv[d->root_transform], header = 0, occ = 0;
     int split, probe;
+    unsigned moving = 0, down = 0, kind[3]; /* for voxdagi_brick_full_ahead */
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
 
@@ -4992,12 +4999,14 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
             continue;
         }
         sgn[a] = dir > 0 ? 1 : -1, up[a] = dir > 0, step[a] = dir > 0 ? 1u : ~0u;
+        moving |= 1u << a, down |= (unsigned)(dir < 0) << a;
         ox[a] = o, ix[a] = voxdagi_frecip(dir);
         lo = voxdagi_plane_t(dir > 0 ? box_lo : box_hi, o, ix[a]);
         hi = voxdagi_plane_t(dir > 0 ? box_hi : box_lo, o, ix[a]);
         if (lo >= te) te = lo, ae = a; /* on ties the last axis enters last */
         if (hi < tx) tx = hi, ax = a;  /* and the first axis leaves first */
     }
+    for (a = 0; a < 3; a++) kind[a] = (unsigned)(sgn[a] > 0 ? 1 : sgn[a] < 0 ? 2 : 0);
     if (ray->t_min >= te) te = ray->t_min, ae = 3;
     if (tx < te || (tx == te && ax < ae) || te > t_max) return 0;
     t_stop = tx == HUGE_VAL ? te : t_max < tx ? t_max : tx;
@@ -5052,13 +5061,16 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
             } else if (mask >> 8 * ((c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2) & 0xFF) {
                 break; /* a 2^3 cell: one byte of the brick, any bit */
             }
-            /* Empty space skipped where it is coarsest: when the node was
-               entered through an empty cell and no full cell lies on the
-               ray's side of the mid planes it has yet to cross, the ray
-               leaves from the node's own cell one level up, at the plane and
-               t at which stepping through the empty cells would leave it
-               (those steps change only bits that the move up drops). */
-            if (probe && !voxdagi_full_ahead(l, brick_level, q == nlevels, occ, mask, c, sgn)) {
+            /* A brick (or 2^3 cell) entered through an empty cell with no
+               full cell on the ray's side of the mid planes it has yet to
+               cross is left from its own cell one level up, at the plane and
+               t at which stepping through its empty cells would leave it
+               (those steps change only bits that the move up drops): a miss
+               then costs a step per brick, not up to ten. Nodes, at most
+               four steps each, are not probed: on surfaces the probe would
+               cost more than it saves. */
+            if (probe && l >= brick_level &&
+                !voxdagi_brick_full_ahead(l > brick_level ? 2 : q < nlevels, mask, c, moving, down, kind)) {
                 uint32_t up_by = l == brick_level && q == nlevels ? 2 : 1;
                 if (l == 0) return 0;
                 c[0] >>= up_by, c[1] >>= up_by, c[2] >>= up_by;

@@ -626,6 +626,26 @@ static void test_miss_cost(void) {
     vox_set s;
     voxdag *d;
     uint32_t i, j, k, a, lane;
+    /* The reach tables against brute force: octants W ^ F for every subset
+       F of AHEAD; brick positions by their coordinate along the axis. */
+    for (i = 0; i < 8; i++)
+        for (j = 0; j < 8; j++) {
+            unsigned want = 0, f;
+            for (f = 0; f < 8; f++)
+                if (!(f & ~j)) want |= 1u << (i ^ f);
+            CHECK_MSG(voxdagi_reach8[i][j] == want, "reach8[%u][%u]", i, j);
+        }
+    for (a = 0; a < 3; a++)
+        for (i = 0; i < 4; i++)
+            for (k = 0; k < 3; k++) {
+                uint64_t want = 0;
+                unsigned p;
+                for (p = 0; p < 64; p++) {
+                    uint32_t v = (p >> a & 1) | (p >> (a + 3) & 1) << 1;
+                    if (k == 0 ? v == i : k == 1 ? v >= i : v <= i) want |= 1ull << p;
+                }
+                CHECK_MSG(voxdagi_brick_reach[a][i][k] == want, "brick_reach[%u][%u][%u]", a, i, k);
+            }
     s.levels = 6;
     s.n = 16 * 16 * 16;
     s.xyz = (uint32_t *)malloc(3 * s.n * sizeof *s.xyz);
