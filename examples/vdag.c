@@ -32,6 +32,9 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
+#ifdef _WIN32
+#include <io.h>
+#endif
 
 #include "check_colors.h"
 #include "cli.h"
@@ -56,9 +59,26 @@ unsigned vdag_cpu_count(void) {
 
 int vdag_check_output(const char *in, const char *out) {
     struct stat a, b;
+    char dir[4096];
+    const char *slash = strrchr(out, '/');
+    size_t n = slash ? (size_t)(slash - out) + (slash == out) : 1; /* "/x": "/"; "x": "." */
     if (!stat(out, &b) && S_ISDIR(b.st_mode)) return !vdag_fail("%s: is a directory, not a file to write", out);
     if (in && !stat(in, &a) && !stat(out, &b) && a.st_dev == b.st_dev && a.st_ino == b.st_ino)
         return !vdag_fail("%s: is the input file %s; refusing to write over it", out, in);
+    /* The folder that will hold OUT (and the save's temporary beside it):
+       checked now, not after a build of minutes. */
+    if (n >= sizeof dir) return !vdag_fail("%s: the path is too long", out);
+    memcpy(dir, slash ? out : ".", n);
+    dir[n] = 0;
+    if (stat(dir, &b))
+        return !vdag_fail("%s: cannot write into the folder %s (%s)", out, dir, strerror(errno));
+    if (!S_ISDIR(b.st_mode)) return !vdag_fail("%s: cannot write into the folder %s (not a directory)", out, dir);
+#ifdef _WIN32
+    if (_access(dir, 2)) /* <io.h>: 2 = write */
+#else
+    if (access(dir, W_OK | X_OK))
+#endif
+        return !vdag_fail("%s: cannot write into the folder %s (%s)", out, dir, strerror(errno));
     return 1;
 }
 
@@ -1126,6 +1146,7 @@ static int cmd_gen(int argc, char **argv) {
         return vdag_fail("usage: vdag gen demo OUT.xyz [--levels L]");
     }
     if (strcmp(argv[1], "demo")) return vdag_fail("gen: unknown scene '%s' (known: demo)", argv[1]);
+    if (!vdag_check_output(NULL, argv[2])) return 1;
     out = fopen(argv[2], "w");
     if (!out) return vdag_fail("%s: %s", argv[2], strerror(errno));
     n = 1u << levels;

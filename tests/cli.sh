@@ -398,6 +398,29 @@ check "write and open errors carry the OS reason" sh -c "
     ! '$VDAG' build '$T/in.xyz' '$T/no/such/dir.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
     ! '$VDAG' info '$T/none.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
     ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && grep -q 'No such file or directory' '$T/err'"
+# An output folder that cannot take the file is refused before any work,
+# in one line naming the folder and why (root passes access(2), so the
+# unwritable folder is tried as user nobody there).
+mkdir "$T/ro" && chmod 555 "$T/ro" && : >"$T/afile" && printf '1 1 1\n' >"$T/ro_in.xyz" && chmod 644 "$T/ro_in.xyz"
+check "an output folder missing or not a directory is refused before the build, one line naming it" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T/no/such/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'cannot write into the folder $T/no/such (No such file or directory)' '$T/err' &&
+    ! '$VDAG' build '$T/in.xyz' '$T/afile/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'cannot write into the folder $T/afile (not a directory)' '$T/err' &&
+    ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'folder $T/no (No such file' '$T/err' &&
+    ! '$VDAG' gen demo '$T/no/d.xyz' 2>'$T/err' && grep -q 'folder $T/no (No such file' '$T/err'"
+as=""
+if [ "$(id -u)" = 0 ]; then as="setpriv --reuid=65534 --regid=65534 --clear-groups"; chmod 755 "$T"; fi
+if [ -z "$as" ] || $as true 2>/dev/null; then
+    check "an unwritable output folder is refused before the build, one line naming it" sh -c "
+        ! $as '$VDAG' build '$T/ro_in.xyz' '$T/ro/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+        grep -q 'cannot write into the folder $T/ro (Permission denied)' '$T/err' &&
+        ! $as '$VDAG' render '$T/a.vdag' '$T/ro/x.png' --size 4x4 2>'$T/err' && grep -q 'folder $T/ro (Permission denied)' '$T/err'"
+else
+    ko "an unwritable output folder: running as root and setpriv cannot drop to nobody"
+fi
+chmod 700 "$T"
 check "progress into a pipe: plain lines, no carriage return, a few lines" sh -c "
     '$VDAG' build '$T/demo.xyz' '$T/p.vdag' --color-error 0.02 2>&1 >/dev/null | tee '$T/log' >/dev/null &&
     ! grep -q \"\$(printf '\\r')\" '$T/log' && [ \$(wc -l <'$T/log') -le 30 ]"
