@@ -4,7 +4,7 @@
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
               [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
-              [--max-vox-voxels N] [--force] [--stats] [--quiet]
+              [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -146,7 +146,9 @@ static const struct {
      "coordinates a point cloud), .ply, .obj (+ .mtl, textures PNG/JPEG/TGA/BMP/PNM), .off,\n"
      ".stl, .vox, .spm, .ac. Meshes and point clouds are fitted into the 2^L grid by their\n"
      "bounding box; voxel lists keep their coordinates. OUT may not be IN, nor a file the\n"
-     "build reads (.mtl libraries, textures).\n"
+     "build reads (.mtl libraries, textures); its folder must exist and be writable (checked\n"
+     "before the build). An input that is no model (an image, an archive, a .vdag, an .mtl,\n"
+     "an empty file, a file without triangles or points) is refused, saying what it looks like.\n"
      "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
      "                     point clouds; voxel lists: the smallest grid that holds them)\n"
      "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
@@ -175,6 +177,8 @@ static const struct {
      "  --max-vox-voxels N the most voxels a .vox scene graph may place (a model once per\n"
      "                     shape showing it), >= 1; past it the file is refused (default:\n"
      "                     2147483648, 2^31)\n"
+     "  --allow-empty      build an empty scene from an empty input, or one without triangles\n"
+     "                     and points, with a warning (default: refused)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
      "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
      "  --stats            also count the nodes per level under all three symmetry groups\n"
@@ -282,6 +286,7 @@ typedef struct build_args {
     int tty, line_open;     /* stderr is a terminal; a progress line is open on it */
     int quiet;              /* --quiet: warnings and errors only */
     int force;              /* --force: build even past the machine's memory */
+    int allow_empty;        /* --allow-empty: an input without triangles or points builds */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
     uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
     uint64_t max_texture_pixels; /* --max-texture-pixels; 0: the importer's default */
@@ -814,6 +819,68 @@ static int guard_read(void *user, const char *path) {
     return 1;
 }
 
+/* The extension of PATH compared with EXT (lower case, no dot), in any case. */
+static int has_ext(const char *path, const char *ext) {
+    const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+    if (!dot) return 0;
+    for (dot++; *dot && (*dot | 0x20) == *ext; dot++, ext++) {}
+    return !*dot && !*ext;
+}
+
+/* What the first bytes of an input say it is, when that is not a model the
+   importers read: "" for anything else. HEAD holds the first N bytes of a
+   regular file of SIZE bytes; TEXT is set when they hold no NUL byte. */
+static const char *sniff_kind(const char *path, const uint8_t *head, size_t n, uint64_t size, int *text) {
+    static const uint8_t png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    static const uint8_t vdag[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
+    size_t i;
+    *text = !memchr(head, 0, n);
+    if (!size) return "an empty file";
+    if (n >= 8 && !memcmp(head, png, 8)) return "a PNG image";
+    if (n >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) return "a JPEG image";
+    if (n >= 6 && (!memcmp(head, "GIF87a", 6) || !memcmp(head, "GIF89a", 6))) return "a GIF image";
+    if (n >= 8 && !memcmp(head, vdag, 8)) return "a .vdag file (already built: vdag info reads it)";
+    if (n >= 2 && head[0] == 0x1F && head[1] == 0x8B) return "gzip-compressed data (decompress it first)";
+    if (n >= 4 && !memcmp(head, "PK\3\4", 4)) return "a zip archive (extract it first)";
+    if (n >= 4 && !memcmp(head, "VOX ", 4) && !has_ext(path, "vox")) return "a MagicaVoxel .vox file (name it .vox)";
+    /* Binary STL: an 80-byte header, a triangle count, 50 bytes a triangle. */
+    if (n >= 84 && !has_ext(path, "stl") && !has_ext(path, "vox") && !has_ext(path, "spm") &&
+        size == 84 + 50 * (uint64_t)(head[80] | head[81] << 8 | head[82] << 16 | (uint32_t)head[83] << 24))
+        return "a binary STL mesh (80-byte header and a triangle count that matches its size; name it .stl)";
+    /* A material library: its first keyword (after blank lines, comments
+       and a UTF-8 byte order mark) is newmtl; or so named. */
+    i = n >= 3 && !memcmp(head, "\xEF\xBB\xBF", 3) ? 3 : 0;
+    while (i < n && (head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n' || head[i] == '#')) {
+        if (head[i] == '#')
+            while (i < n && head[i] != '\n') i++;
+        else i++;
+    }
+    if (has_ext(path, "mtl") || (*text && n - i >= 7 && !memcmp(head + i, "newmtl", 6) && (head[i + 6] == ' ' || head[i + 6] == '\t')))
+        return "a material library (.mtl), which holds no geometry: build the .obj that names it in mtllib";
+    return "";
+}
+
+/* Refuses an input that is not a model (an image, an archive, a .vdag, a
+   material library, an empty file unless ALLOW_EMPTY) before importing it,
+   saying what it looks like. Returns 1 to go on, or 0 after printing why.
+   *TEXT receives whether the first bytes are text (no NUL byte). */
+static int check_input(const char *path, int allow_empty, int *text) {
+    uint8_t head[4096];
+    struct stat st;
+    size_t n;
+    const char *kind;
+    FILE *f;
+    *text = 0;
+    if (stat(path, &st) || !S_ISREG(st.st_mode)) return 1; /* the importer says why */
+    if (!(f = fopen(path, "rb"))) return 1;
+    n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    kind = sniff_kind(path, head, n, (uint64_t)st.st_size, text);
+    if (!*kind || (allow_empty && !st.st_size)) return 1;
+    if (!st.st_size) return !vdag_fail("%s: not a model: an empty file (--allow-empty builds an empty scene)", path);
+    return !vdag_fail("%s: not a model: it looks like %s", path, kind);
+}
+
 static int cmd_build(int argc, char **argv) {
     build_args a;
     color_spill spill;
@@ -827,7 +894,7 @@ static int cmd_build(int argc, char **argv) {
     uint32_t *xyz = NULL;
     double bounds[6], t0 = now_seconds();
     size_t i;
-    int k, rc;
+    int k, rc, text;
     memset(&a, 0, sizeof a);
     memset(&spill, 0, sizeof spill);
     a.spill = &spill;
@@ -858,6 +925,8 @@ static int cmd_build(int argc, char **argv) {
                 return vdag_fail("build: --max-vox-voxels takes a voxel count >= 1");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
+        } else if (!strcmp(argv[k], "--allow-empty")) {
+            a.allow_empty = 1;
         } else if (!strcmp(argv[k], "--quiet")) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
@@ -905,6 +974,7 @@ static int cmd_build(int argc, char **argv) {
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
     if (a.verify_colors && !a.compress) return vdag_fail("build: --verify-colors checks compressed colours: add --color-error E");
     if (!vdag_check_output(a.in, a.out)) return 1;
+    if (!check_input(a.in, a.allow_empty, &text)) return 1;
     if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
     memset(&limits, 0, sizeof limits);
     /* Textures give colours and the alpha test: without both, nothing to decode them for. */
@@ -923,6 +993,11 @@ static int cmd_build(int argc, char **argv) {
     if (!a.up) a.up = default_up(a.in);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
     turn_up(sc.positions, sc.vertex_count, a.up, 0);
+    if (!sc.triangle_count && !sc.point_count && !a.allow_empty) {
+        vdag_scene_free(&sc);
+        return vdag_fail("%s: not a model: %s with no triangles and no points (lines are not voxelized; "
+                         "--allow-empty builds an empty scene)", a.in, text ? "a text file" : "a file");
+    }
     if (!sc.triangle_count && !sc.point_count)
         fprintf(stderr, "vdag: warning: %s holds no triangles and no points (lines are not voxelized): "
                         "the result has no voxels\n", a.in);
@@ -1184,7 +1259,7 @@ static int usage(FILE *f) {
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
           "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
-          "                    [--max-vox-voxels N] [--force] [--stats] [--quiet]\n"
+          "                    [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

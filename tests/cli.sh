@@ -9,8 +9,9 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 pass=0
 fail=0
+exec 3>&2 # failures reach stderr also from a check whose stderr is redirected
 ok() { pass=$((pass + 1)); }
-ko() { fail=$((fail + 1)); echo "  FAIL: $*" >&2; }
+ko() { fail=$((fail + 1)); echo "  FAIL: $*" >&3; }
 check() { # check DESCRIPTION COMMAND...: passes when COMMAND succeeds
     d=$1; shift
     if "$@"; then ok; else ko "$d"; fi
@@ -321,18 +322,49 @@ assert frac > 0.1, frac
 assert not any(cover[0]) and not any(cover[-1]) and not any(r[0] or r[-1] for r in cover), 'clipped'
 \""
 
-# -- inputs that give nothing: a warning, or an error that says why
+# -- inputs that give nothing, or are no model: an error that says what the
+# file looks like, before any work; an empty scene only with --allow-empty
 : >"$T/empty.obj"
-check "an empty .obj warns that nothing is voxelized" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
-    grep -q 'warning:.*no triangles and no points' '$T/err'"
+: >"$T/empty.xyz"
+check "an empty .obj or .xyz is refused as an empty file, no output written" sh -c "
+    ! '$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' && grep -q 'empty.obj: not a model: an empty file' '$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' build '$T/empty.xyz' '$T/e.vdag' 2>'$T/err' &&
+    grep -q 'empty.xyz: not a model: an empty file' '$T/err' && [ ! -e '$T/e.vdag' ]"
+check "--allow-empty builds an empty .obj, with a warning" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 --allow-empty 2>'$T/err' &&
+    grep -q 'warning:.*no triangles and no points' '$T/err' && '$VDAG' info '$T/e.vdag' | grep -q '^voxels *0\$'"
 printf 'AC3Db\nMATERIAL "m" rgb 1 1 1\nOBJECT world\nkids 1\nOBJECT poly\nnumvert 2\n0 0 0\n1 1 1\nnumsurf 1\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 0 0\nkids 0\n' >"$T/lines.ac"
-check "an .ac file of lines only warns" sh -c "'$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
-    grep -q 'warning:.*no triangles' '$T/err'"
+printf '# no vertices\no thing\ng group\n' >"$T/novert.obj"
+check "an .ac file of lines only, an .obj without vertices: refused as text with no triangles and no points" sh -c "
+    rm -f '$T/e.vdag'; ! '$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'lines.ac: not a model: a text file with no triangles and no points' '$T/err' &&
+    ! '$VDAG' build '$T/novert.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'novert.obj: not a model: a text file with no triangles and no points' '$T/err' && [ ! -e '$T/e.vdag' ] &&
+    '$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 --allow-empty 2>'$T/err' && grep -q 'warning:.*no triangles' '$T/err'"
+python3 - "$T" <<'EOF2'
+import gzip, struct, sys
+t = sys.argv[1]
+open(t + "/image.obj", "wb").write(b"\x89PNG\r\n\x1a\n" + bytes(32))
+open(t + "/photo.xyz", "wb").write(b"\xff\xd8\xff\xe0" + bytes(32))
+stl = b"solid written by a CAD tool".ljust(80, b" ") + struct.pack("<I", 1) + struct.pack("<12f", 0, 0, 1, 0, 0, 0, 8, 0, 0, 8, 8, 0) + b"\0\0"
+open(t + "/stl.obj", "wb").write(stl)
+open(t + "/lib.obj", "w").write("# exported\n\nnewmtl red\nKd 1 0 0\n")
+open(t + "/packed.xyz", "wb").write(gzip.compress(b"1 2 3\n"))
+open(t + "/packed.obj", "wb").write(b"PK\3\4" + bytes(40))
+EOF2
+rm -f "$T/e.vdag"
+bad=""
+for c in 'image.obj:a PNG image' 'photo.xyz:a JPEG image' 'stl.obj:a binary STL mesh' 'lib.obj:a material library' \
+         'tex.mtl:a material library' 'packed.xyz:gzip-compressed data' 'packed.obj:a zip archive' 'a.vdag:a .vdag file'; do
+    f=${c%%:*}
+    if "$VDAG" build "$T/$f" "$T/e.vdag" --allow-empty 2>"$T/err" || [ "$(wc -l <"$T/err")" != 1 ] ||
+        ! grep -q "$f: not a model: it looks like ${c#*:}" "$T/err"; then bad="$bad $f"; fi
+done
+check "inputs that are no model are refused saying what they look like, one line, no output (wrong:$bad)" sh -c "[ -z '$bad' ] && [ ! -e '$T/e.vdag' ]"
 python3 -c "open('$T/wide.obj', 'wb').write('v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n'.encode('utf-16'))"
 check "a UTF-16 .obj is refused as such" sh -c "! '$VDAG' build '$T/wide.obj' '$T/e.vdag' 2>'$T/err' &&
     grep -q 'UTF-16' '$T/err'"
 printf '\357\273\277AC3Db\nMATERIAL "m" rgb 1 0 0\nOBJECT world\nkids 0\n' >"$T/bom.ac"
-check "an .ac file with a UTF-8 BOM is read" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 2>/dev/null
+check "an .ac file with a UTF-8 BOM is read (no geometry: --allow-empty)" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 --allow-empty 2>/dev/null
 mkdir "$T/adir.obj"
 check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.vdag' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
 
@@ -345,7 +377,7 @@ for c in build info validate lookup rays render export-voxels gen; do
     check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
 done
 check "every build and render option in --help with its default" sh -c "
-    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --force --stats --quiet; do
+    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --allow-empty --force --stats --quiet; do
         '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
     for o in --size --eye --target --fov --shadows --lod --threads; do
         '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
