@@ -157,7 +157,8 @@ static const struct {
      "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
      "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
      "  --color-error E    compress colours with voxcolor, each within E (RGB distance / 255,\n"
-     "                     0 = lossless) (default: colours stored raw, 24 bits each)\n"
+     "                     0 = lossless) (default: colours stored raw, 24 bits each); an E\n"
+     "                     above sqrt(3) = 1.732 warns: every colour is within it\n"
      "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
      "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
      "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
@@ -191,13 +192,14 @@ static const struct {
     {"validate", "usage: vdag validate FILE\nExit status 0 when FILE is a valid .vdag file, else 1 with a one-line reason.\n"},
     {"lookup", "usage: vdag lookup FILE x y z\n"
                "Prints \"0\" when voxel (x, y, z) is empty, else \"1 INDEX R G B\". Coordinates are\n"
-               "grid units: integers 0..2^L-1.\n"},
+               "grid units: integers 0..2^L-1; a voxel outside the grid is an error (exit 1).\n"},
     {"rays", "usage: vdag rays FILE\n"
              "Reads rays from stdin, one a line \"ox oy oz dx dy dz\" (numbers, grid units: the grid\n"
              "spans [0, 2^L)^3), prints a line a ray: \"miss\", or \"hit T X Y Z NX NY NZ INDEX R G B\"\n"
              "(T: distance along the ray in units of |d|; N: the entry face normal).\n"},
     {"render", "usage: vdag render FILE OUT.png [options]\n"
-               "Ray traces a shaded picture, z up. OUT may not be FILE.\n"
+               "Ray traces a shaded picture, z up, into a PNG file: OUT must end in .png (any case),\n"
+               "may not be FILE, and its folder must exist and be writable.\n"
                "  --size WxH        picture size, 1..16384 each (default: 640x480)\n"
                "  --eye x y z       camera position, grid units (default: a three-quarter view from\n"
                "                    +x, -y, above, far enough that the occupied voxels fit)\n"
@@ -523,6 +525,15 @@ typedef struct color_spill {
     const char *dir;
 } color_spill;
 
+/* BYTES of temporary disk as text: bytes under 1 KiB, KiB under 1 MiB (a
+   small spill is not "0.0 MiB"), else MiB. */
+static const char *spill_size(double bytes, char buf[32]) {
+    if (bytes < 1024.0) snprintf(buf, 32, "%.0f bytes", bytes);
+    else if (bytes < 1048576.0) snprintf(buf, 32, "%.1f KiB", bytes / 1024.0);
+    else snprintf(buf, 32, "%.1f MiB", bytes / 1048576.0);
+    return buf;
+}
+
 /* Opens S's file: created and unlinked at once, so that nothing is left
    behind whatever happens. */
 static int spill_open(color_spill *s) {
@@ -650,10 +661,11 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     voxdag *with = NULL;
     voxdag_error err;
     double t0 = now_seconds();
+    char text[32];
     int rc;
-    if (!a->quiet)
-        fprintf(stderr, "vdag: colour spill: %.1f MiB of temporary disk in %s (%llu colours)\n",
-                (double)size / 1048576.0, spill->dir, (unsigned long long)spill->n);
+    if (!a->quiet && spill->n)
+        fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
+                spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
     rewind(spill->f);
     if (!a->compress) {
         uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
@@ -696,6 +708,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
    VOXELS of them (an estimate, reported). */
 static int build_opts(build_args *a, int colors, const double *bounds, double voxels, voxdag_build_opts *o) {
     struct statvfs fs;
+    char text[32];
     double free_mib = -1; /* unknown */
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
@@ -712,12 +725,12 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
         return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
                          strerror(errno));
     if (statvfs(a->spill->dir, &fs) == 0) free_mib = (double)fs.f_bavail * (double)fs.f_frsize / 1048576.0;
-    if (!a->quiet && free_mib >= 0)
-        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; %.0f MiB free there; "
-                        "set TMPDIR to move it)\n", 3.0 * voxels / 1048576.0, a->spill->dir, free_mib);
-    else if (!a->quiet)
-        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
-                3.0 * voxels / 1048576.0, a->spill->dir);
+    if (!a->quiet && voxels > 0 && free_mib >= 0)
+        fprintf(stderr, "vdag: colour spill: about %s of temporary disk in %s (estimate; %.0f MiB free there; "
+                        "set TMPDIR to move it)\n", spill_size(3.0 * voxels, text), a->spill->dir, free_mib);
+    else if (!a->quiet && voxels > 0)
+        fprintf(stderr, "vdag: colour spill: about %s of temporary disk in %s (estimate; set TMPDIR to move it)\n",
+                spill_size(3.0 * voxels, text), a->spill->dir);
     if (free_mib >= 0 && 3.0 * voxels / 1048576.0 > free_mib)
         fprintf(stderr, "vdag: warning: the colour spill may not fit in %s (about %.1f MiB, %.0f MiB free): set TMPDIR "
                         "to a larger disk\n", a->spill->dir, 3.0 * voxels / 1048576.0, free_mib);
@@ -973,6 +986,9 @@ static int cmd_build(int argc, char **argv) {
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
     if (a.verify_colors && !a.compress) return vdag_fail("build: --verify-colors checks compressed colours: add --color-error E");
+    if (a.color_error > sqrt(3.0)) /* the distance from black to white */
+        fprintf(stderr, "vdag: warning: --color-error %g is above sqrt(3) = 1.732, the largest RGB distance / 255: "
+                        "every colour is within it\n", a.color_error);
     if (!vdag_check_output(a.in, a.out)) return 1;
     if (!check_input(a.in, a.allow_empty, &text)) return 1;
     if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
@@ -1097,6 +1113,10 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
 
 // -- vdag info / validate
 
+/* V with a negative zero made positive, so that none is printed as "-0"
+   (a world box of a file built from a turned axis: -z of 0). */
+static double no_minus_zero(double v) { return v == 0 ? 0.0 : v; }
+
 static const char *color_kind_name(voxdag_color_kind k) {
     return k == VOXDAG_COLORS_RGB8 ? "rgb8" : k == VOXDAG_COLORS_VOXCOLOR ? "voxcolor" : "none";
 }
@@ -1110,6 +1130,7 @@ static int cmd_info(int argc, char **argv) {
     if (argc < 2 || argc > 3 || (argc == 3 && !json)) return vdag_fail("usage: vdag info FILE [--json]");
     if (!vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &in);
+    for (l = 0; l < 6; l++) in.bounds[l] = no_minus_zero(in.bounds[l]);
     geo_bits = in.voxels ? 8.0 * (double)(in.node_bytes + in.brick_bytes) / (double)in.voxels : 0.0;
     if (json) {
         printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"symmetry\": \"%s\", \"voxel_box\": [%u, %u, %u, %u, %u, %u], \"nodes_per_level\": [",
@@ -1150,10 +1171,13 @@ static int cmd_info(int argc, char **argv) {
             printf("grid world box  (%g, %g, %g) - (%g, %g, %g), the source's units\n", in.bounds[0], in.bounds[1],
                    in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
             if (in.voxels)
-                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0] + cell * in.voxel_box[0],
-                       in.bounds[1] + cell * in.voxel_box[1], in.bounds[2] + cell * in.voxel_box[2],
-                       in.bounds[0] + cell * in.voxel_box[3], in.bounds[1] + cell * in.voxel_box[4],
-                       in.bounds[2] + cell * in.voxel_box[5]);
+                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n",
+                       no_minus_zero(in.bounds[0] + cell * in.voxel_box[0]),
+                       no_minus_zero(in.bounds[1] + cell * in.voxel_box[1]),
+                       no_minus_zero(in.bounds[2] + cell * in.voxel_box[2]),
+                       no_minus_zero(in.bounds[0] + cell * in.voxel_box[3]),
+                       no_minus_zero(in.bounds[1] + cell * in.voxel_box[4]),
+                       no_minus_zero(in.bounds[2] + cell * in.voxel_box[5]));
         }
     }
     vdag_close(&f);
@@ -1173,6 +1197,7 @@ static int cmd_validate(int argc, char **argv) {
 
 static int cmd_lookup(int argc, char **argv) {
     vdag_file f;
+    voxdag_info in;
     uint32_t c[3];
     uint64_t index;
     int k;
@@ -1180,6 +1205,12 @@ static int cmd_lookup(int argc, char **argv) {
     for (k = 0; k < 3; k++)
         if (!parse_u32(argv[2 + k], &c[k])) return vdag_fail("lookup: bad coordinate '%s'", argv[2 + k]);
     if (!vdag_open(argv[1], &f)) return 1;
+    voxdag_get_info(f.dag, &in);
+    if (c[0] >> in.levels || c[1] >> in.levels || c[2] >> in.levels) {
+        vdag_close(&f);
+        return vdag_fail("lookup: (%u, %u, %u) is outside the grid: %u^3 (levels %u), coordinates 0..%u", c[0], c[1],
+                         c[2], 1u << in.levels, in.levels, (1u << in.levels) - 1);
+    }
     if (voxdag_lookup(f.dag, c[0], c[1], c[2], &index)) {
         uint8_t rgb[3];
         vdag_voxel_color(&f, index, rgb);

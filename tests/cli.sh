@@ -121,9 +121,16 @@ check "--color-effort takes smallest or fast" sh -c "! '$VDAG' build '$T/in.xyz'
 mkdir -p "$T/spill"
 check "the colour spill goes to TMPDIR, is reported up front and at the end, and is removed" sh -c "
     TMPDIR='$T/spill' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 --color-error 0.03 2>'$T/err' &&
-    grep -q 'colour spill: about .* MiB of temporary disk in $T/spill (estimate; [0-9]* MiB free there' '$T/err' &&
-    grep -q 'colour spill: .* MiB of temporary disk in $T/spill ('\$(wc -l <'$T/expected_export')' colours)' '$T/err' &&
+    grep -q 'colour spill: about .* of temporary disk in $T/spill (estimate; [0-9]* MiB free there' '$T/err' &&
+    grep -q 'colour spill: .* of temporary disk in $T/spill ('\$(wc -l <'$T/expected_export')' colours)' '$T/err' &&
     [ -z \"\$(ls -A '$T/spill')\" ]"
+check "a small colour spill is given in KiB (3 bytes a colour), not as 0.0 MiB; a single colour in bytes" sh -c "
+    TMPDIR='$T/spill' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 --color-error 0.03 2>'$T/err' &&
+    n=\$(wc -l <'$T/expected_export') && kib=\$(awk \"BEGIN { printf \\\"%.1f\\\", 3 * \$n / 1024 }\") &&
+    grep -q \"colour spill: about \$kib KiB of temporary disk\" '$T/err' &&
+    grep -q \"colour spill: \$kib KiB of temporary disk in $T/spill (\$n colours)\" '$T/err' && ! grep -q '0\\.0 MiB' '$T/err' &&
+    printf '1 1 1 9 9 9\\n' >'$T/one.xyz' && '$VDAG' build '$T/one.xyz' '$T/one.vdag' 2>'$T/err' &&
+    grep -q 'colour spill: 3 bytes of temporary disk' '$T/err'"
 check "an unusable TMPDIR fails with one line naming it" sh -c "
     ! TMPDIR='$T/none' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 2 ] && grep -q '$T/none' '$T/err'"
@@ -149,6 +156,14 @@ b = bytearray(open('$T/a.vdag', 'rb').read()); b[len(b) // 2] ^= 0x40
 open('$T/flip.vdag', 'wb').write(b)"
 check "flipped byte is invalid, one-line reason" sh -c "! '$VDAG' validate '$T/flip.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
 check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1 2 x 2>/dev/null"
+check "lookup outside the grid fails, one line naming the grid size; its last voxel answers" sh -c "
+    ! '$VDAG' lookup '$T/a.vdag' 32 0 0 >'$T/out' 2>'$T/err' && [ ! -s '$T/out' ] && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'outside the grid: 32^3 (levels 5), coordinates 0..31' '$T/err' &&
+    ! '$VDAG' lookup '$T/a.vdag' 0 0 4294967295 >/dev/null 2>&1 && '$VDAG' lookup '$T/a.vdag' 31 31 31 >/dev/null"
+check "--color-error above sqrt(3) warns that every colour is within it; at sqrt(3) it does not" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/ce.vdag' --levels 5 --color-error 1.8 --quiet 2>'$T/err' &&
+    grep -q 'warning: --color-error 1.8 is above sqrt(3)' '$T/err' &&
+    '$VDAG' build '$T/in.xyz' '$T/ce.vdag' --levels 5 --color-error 1.732 --quiet 2>'$T/err' && [ ! -s '$T/err' ]"
 
 # -- meshes: an axis-aligned square fitted into the grid fills one or two layers
 printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 0 8 0 1 0 0\nf 1 2 3\nf 1 3 4\n' >"$T/square.obj"
@@ -301,6 +316,10 @@ check "info --json gives the occupied voxel box" sh -c "'$VDAG' info '$T/small.v
 import json, sys
 assert json.load(sys.stdin)['voxel_box'] == [150, 90, 20, 154, 94, 26]
 \""
+printf 'v 0 0 0\nv 8 0 0\nv 8 8 0\nf 1 2 3\n' >"$T/yup.obj"
+check "info prints no negative zero (a y-up .obj turns z = 0 into -0)" sh -c "
+    '$VDAG' build '$T/yup.obj' '$T/yup.vdag' --levels 3 --quiet && '$VDAG' info '$T/yup.vdag' >'$T/out' &&
+    '$VDAG' info '$T/yup.vdag' --json >>'$T/out' && grep -q 'world box' '$T/out' && ! grep -q -- '-0\\b' '$T/out'"
 check "info names the grid world box and the occupied box" sh -c "'$VDAG' info '$T/sq.vdag' >'$T/info.txt' &&
     grep -q '^grid world box' '$T/info.txt' && grep -q '^occupied' '$T/info.txt' && ! grep -q '^bounds' '$T/info.txt'"
 check "render: the default camera frames the occupied voxels" sh -c "'$VDAG' render '$T/small.vdag' '$T/small.png' --size 64x48 2>/dev/null &&
@@ -564,6 +583,12 @@ assert b[:8] == b'\\\\x89PNG\\\\r\\\\n\\\\x1a\\\\n' and b[12:16] == b'IHDR', b[:
 assert struct.unpack('>II', b[16:24]) == (37, 23) and b[24:26] == bytes([8, 2])
 assert b[-8:-4] == b'IEND'
 \""
+check "render: an OUT not named .png (any case) is refused, one line, nothing written" sh -c "
+    for o in r.jpg r.jpeg r r.png.bak r.pn; do
+        ! '$VDAG' render '$T/r.vdag' \"$T/\$o\" --size 4x4 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+        grep -q 'written as PNG; name it .png' '$T/err' && [ ! -e \"$T/\$o\" ] || exit 1
+    done
+    '$VDAG' render '$T/r.vdag' '$T/r2.PNG' --size 4x4 --quiet && [ -s '$T/r2.PNG' ]"
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
 
