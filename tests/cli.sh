@@ -391,6 +391,26 @@ check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
 
+# -- README's figures of the demo scene: the scene `make demo` builds (its
+# gen and build commands read from the Makefile) has them
+demo_levels=$(sed -n 's/.*vdag gen demo .* --levels \([0-9]*\).*/\1/p' Makefile)
+demo_error=$(sed -n 's/.*vdag build .*demo\.vdag .*--color-error \([0-9.]*\).*/\1/p' Makefile)
+check "README's demo figures are what make demo builds (levels $demo_levels, --color-error $demo_error)" sh -c "
+    '$VDAG' gen demo '$T/mdemo.xyz' --levels '$demo_levels' && '$VDAG' build '$T/mdemo.xyz' '$T/mdemo.vdag' --color-error '$demo_error' --quiet &&
+    '$VDAG' info '$T/mdemo.vdag' --json >'$T/mdemo.json' && python3 - '$T/mdemo.json' '$demo_levels' '$demo_error' <<'EOF'
+import json, re, sys
+d = json.load(open(sys.argv[1]))
+text = ' '.join(open('README.md').read().split())
+m = re.search(r'a (\d+)\^3 coloured scene, ([\d,]+) voxels, stored in ([\d,]+) bytes of geometry \(([\d.]+) bits per voxel\) '
+              r'and ([\d,]+) bytes of colours \(([\d.]+) bits per colour at an error bound of ([\d.]+)\)', text)
+assert m, 'the demo sentence is not in README.md'
+n = lambda s: int(s.replace(',', ''))
+geo = d['bytes']['nodes'] + d['bytes']['bricks']
+want = (str(1 << int(sys.argv[2])), '{:,}'.format(d['voxels']), '{:,}'.format(geo), '%.3f' % d['bits_per_voxel'],
+        '{:,}'.format(d['bytes']['colors']), '%.2f' % d['color_bits_per_voxel'], sys.argv[3])
+assert m.groups() == want, ('README says', m.groups(), 'make demo gives', want)
+EOF"
+
 # -- help, version, progress, safety
 for c in build info validate lookup rays render export-voxels gen; do
     check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
