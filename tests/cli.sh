@@ -612,6 +612,16 @@ check "render: an OUT not named .png (any case) is refused, one line, nothing wr
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
 
+# -- README states the lifetime of a DAG's allocator (kept by built and
+# loaded DAGs, reused by voxdag_with_colors), where the allocator is described
+check "README: a DAG keeps its allocator and user pointer; voxdag_with_colors reuses it; the state must outlive the DAG" python3 -c "
+text = ' '.join(open('README.md').read().replace(chr(96), '').split())
+part = text[text.index('Allocators live as long as their DAGs'):][:900]
+for words in ['keeps a copy of it, its user pointer included', 'voxdag_with_colors allocates the new DAG with the source DAG',
+              'must outlive every DAG made with it']:
+    assert words in part, words
+"
+
 # -- README's tool section names every command and every option of --help
 check "README lists every command and option of --help" python3 -c "
 import re, subprocess, sys
