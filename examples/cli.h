@@ -25,9 +25,11 @@ void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]);
    Returns 1 when it has one. */
 int vdag_voxel_box(const voxdag *dag, uint32_t box[6]);
 
-/* Checks that OUT may be written: not a directory, and not the file IN
-   (also under another name: same device and inode). Returns 1, or 0 after
-   printing why. IN may be NULL. */
+/* Checks that OUT may be written: not a directory, not the file IN (also
+   under another name: same device and inode), and in a folder that exists,
+   is a directory and is writable (checked before the work, which may take
+   minutes). Returns 1, or 0 after printing why, naming the folder. IN may
+   be NULL. */
 int vdag_check_output(const char *in, const char *out);
 
 /* When ARGV (a command's arguments, ARGV[0] its name) holds --help or -h:

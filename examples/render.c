@@ -319,6 +319,11 @@ int vdag_cmd_render(int argc, char **argv) {
             return vdag_fail("render: unknown option '%s' (%s)", a, usage);
         }
     }
+    {   /* the picture is a PNG: an OUT named otherwise would hold PNG bytes under another name */
+        const char *slash = strrchr(argv[2], '/'), *dot = strrchr(slash ? slash : argv[2], '.');
+        if (!dot || strlen(dot) != 4 || (dot[1] | 0x20) != 'p' || (dot[2] | 0x20) != 'n' || (dot[3] | 0x20) != 'g')
+            return vdag_fail("render: %s: the picture is written as PNG; name it .png", argv[2]);
+    }
     if (!vdag_check_output(argv[1], argv[2]) || !vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &info);
     job.file = &f;

@@ -4,7 +4,7 @@
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
               [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
-              [--max-vox-voxels N] [--force] [--stats] [--quiet]
+              [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -32,6 +32,9 @@
 #include <sys/stat.h>
 #include <sys/statvfs.h>
 #include <unistd.h>
+#ifdef _WIN32
+#include <io.h>
+#endif
 
 #include "check_colors.h"
 #include "cli.h"
@@ -56,9 +59,26 @@ unsigned vdag_cpu_count(void) {
 
 int vdag_check_output(const char *in, const char *out) {
     struct stat a, b;
+    char dir[4096];
+    const char *slash = strrchr(out, '/');
+    size_t n = slash ? (size_t)(slash - out) + (slash == out) : 1; /* "/x": "/"; "x": "." */
     if (!stat(out, &b) && S_ISDIR(b.st_mode)) return !vdag_fail("%s: is a directory, not a file to write", out);
     if (in && !stat(in, &a) && !stat(out, &b) && a.st_dev == b.st_dev && a.st_ino == b.st_ino)
         return !vdag_fail("%s: is the input file %s; refusing to write over it", out, in);
+    /* The folder that will hold OUT (and the save's temporary beside it):
+       checked now, not after a build of minutes. */
+    if (n >= sizeof dir) return !vdag_fail("%s: the path is too long", out);
+    memcpy(dir, slash ? out : ".", n);
+    dir[n] = 0;
+    if (stat(dir, &b))
+        return !vdag_fail("%s: cannot write into the folder %s (%s)", out, dir, strerror(errno));
+    if (!S_ISDIR(b.st_mode)) return !vdag_fail("%s: cannot write into the folder %s (not a directory)", out, dir);
+#ifdef _WIN32
+    if (_access(dir, 2)) /* <io.h>: 2 = write */
+#else
+    if (access(dir, W_OK | X_OK))
+#endif
+        return !vdag_fail("%s: cannot write into the folder %s (%s)", out, dir, strerror(errno));
     return 1;
 }
 
@@ -126,7 +146,9 @@ static const struct {
      "coordinates a point cloud), .ply, .obj (+ .mtl, textures PNG/JPEG/TGA/BMP/PNM), .off,\n"
      ".stl, .vox, .spm, .ac. Meshes and point clouds are fitted into the 2^L grid by their\n"
      "bounding box; voxel lists keep their coordinates. OUT may not be IN, nor a file the\n"
-     "build reads (.mtl libraries, textures).\n"
+     "build reads (.mtl libraries, textures); its folder must exist and be writable (checked\n"
+     "before the build). An input that is no model (an image, an archive, a .vdag, an .mtl,\n"
+     "an empty file, a file without triangles or points) is refused, saying what it looks like.\n"
      "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
      "                     point clouds; voxel lists: the smallest grid that holds them)\n"
      "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
@@ -135,7 +157,8 @@ static const struct {
      "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
      "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
      "  --color-error E    compress colours with voxcolor, each within E (RGB distance / 255,\n"
-     "                     0 = lossless) (default: colours stored raw, 24 bits each)\n"
+     "                     0 = lossless) (default: colours stored raw, 24 bits each); an E\n"
+     "                     above sqrt(3) = 1.732 warns: every colour is within it\n"
      "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
      "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
      "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
@@ -155,6 +178,8 @@ static const struct {
      "  --max-vox-voxels N the most voxels a .vox scene graph may place (a model once per\n"
      "                     shape showing it), >= 1; past it the file is refused (default:\n"
      "                     2147483648, 2^31)\n"
+     "  --allow-empty      build an empty scene from an empty input, or one without triangles\n"
+     "                     and points, with a warning (default: refused)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
      "                     refuse; an estimate is printed before builds of over 10^7 voxels)\n"
      "  --stats            also count the nodes per level under all three symmetry groups\n"
@@ -167,13 +192,14 @@ static const struct {
     {"validate", "usage: vdag validate FILE\nExit status 0 when FILE is a valid .vdag file, else 1 with a one-line reason.\n"},
     {"lookup", "usage: vdag lookup FILE x y z\n"
                "Prints \"0\" when voxel (x, y, z) is empty, else \"1 INDEX R G B\". Coordinates are\n"
-               "grid units: integers 0..2^L-1.\n"},
+               "grid units: integers 0..2^L-1; a voxel outside the grid is an error (exit 1).\n"},
     {"rays", "usage: vdag rays FILE\n"
              "Reads rays from stdin, one a line \"ox oy oz dx dy dz\" (numbers, grid units: the grid\n"
              "spans [0, 2^L)^3), prints a line a ray: \"miss\", or \"hit T X Y Z NX NY NZ INDEX R G B\"\n"
              "(T: distance along the ray in units of |d|; N: the entry face normal).\n"},
     {"render", "usage: vdag render FILE OUT.png [options]\n"
-               "Ray traces a shaded picture, z up. OUT may not be FILE.\n"
+               "Ray traces a shaded picture, z up, into a PNG file: OUT must end in .png (any case),\n"
+               "may not be FILE, and its folder must exist and be writable.\n"
                "  --size WxH        picture size, 1..16384 each (default: 640x480)\n"
                "  --eye x y z       camera position, grid units (default: a three-quarter view from\n"
                "                    +x, -y, above, far enough that the occupied voxels fit)\n"
@@ -262,6 +288,7 @@ typedef struct build_args {
     int tty, line_open;     /* stderr is a terminal; a progress line is open on it */
     int quiet;              /* --quiet: warnings and errors only */
     int force;              /* --force: build even past the machine's memory */
+    int allow_empty;        /* --allow-empty: an input without triangles or points builds */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
     uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
     uint64_t max_texture_pixels; /* --max-texture-pixels; 0: the importer's default */
@@ -498,6 +525,15 @@ typedef struct color_spill {
     const char *dir;
 } color_spill;
 
+/* BYTES of temporary disk as text: bytes under 1 KiB, KiB under 1 MiB (a
+   small spill is not "0.0 MiB"), else MiB. */
+static const char *spill_size(double bytes, char buf[32]) {
+    if (bytes < 1024.0) snprintf(buf, 32, "%.0f bytes", bytes);
+    else if (bytes < 1048576.0) snprintf(buf, 32, "%.1f KiB", bytes / 1024.0);
+    else snprintf(buf, 32, "%.1f MiB", bytes / 1048576.0);
+    return buf;
+}
+
 /* Opens S's file: created and unlinked at once, so that nothing is left
    behind whatever happens. */
 static int spill_open(color_spill *s) {
@@ -625,10 +661,11 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     voxdag *with = NULL;
     voxdag_error err;
     double t0 = now_seconds();
+    char text[32];
     int rc;
-    if (!a->quiet)
-        fprintf(stderr, "vdag: colour spill: %.1f MiB of temporary disk in %s (%llu colours)\n",
-                (double)size / 1048576.0, spill->dir, (unsigned long long)spill->n);
+    if (!a->quiet && spill->n)
+        fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
+                spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
     rewind(spill->f);
     if (!a->compress) {
         uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
@@ -671,6 +708,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
    VOXELS of them (an estimate, reported). */
 static int build_opts(build_args *a, int colors, const double *bounds, double voxels, voxdag_build_opts *o) {
     struct statvfs fs;
+    char text[32];
     double free_mib = -1; /* unknown */
     memset(o, 0, sizeof *o);
     o->levels = a->levels;
@@ -687,12 +725,12 @@ static int build_opts(build_args *a, int colors, const double *bounds, double vo
         return vdag_fail("build: cannot create a temporary file for the colours in %s (set TMPDIR): %s", a->spill->dir,
                          strerror(errno));
     if (statvfs(a->spill->dir, &fs) == 0) free_mib = (double)fs.f_bavail * (double)fs.f_frsize / 1048576.0;
-    if (!a->quiet && free_mib >= 0)
-        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; %.0f MiB free there; "
-                        "set TMPDIR to move it)\n", 3.0 * voxels / 1048576.0, a->spill->dir, free_mib);
-    else if (!a->quiet)
-        fprintf(stderr, "vdag: colour spill: about %.1f MiB of temporary disk in %s (estimate; set TMPDIR to move it)\n",
-                3.0 * voxels / 1048576.0, a->spill->dir);
+    if (!a->quiet && voxels > 0 && free_mib >= 0)
+        fprintf(stderr, "vdag: colour spill: about %s of temporary disk in %s (estimate; %.0f MiB free there; "
+                        "set TMPDIR to move it)\n", spill_size(3.0 * voxels, text), a->spill->dir, free_mib);
+    else if (!a->quiet && voxels > 0)
+        fprintf(stderr, "vdag: colour spill: about %s of temporary disk in %s (estimate; set TMPDIR to move it)\n",
+                spill_size(3.0 * voxels, text), a->spill->dir);
     if (free_mib >= 0 && 3.0 * voxels / 1048576.0 > free_mib)
         fprintf(stderr, "vdag: warning: the colour spill may not fit in %s (about %.1f MiB, %.0f MiB free): set TMPDIR "
                         "to a larger disk\n", a->spill->dir, 3.0 * voxels / 1048576.0, free_mib);
@@ -794,6 +832,68 @@ static int guard_read(void *user, const char *path) {
     return 1;
 }
 
+/* The extension of PATH compared with EXT (lower case, no dot), in any case. */
+static int has_ext(const char *path, const char *ext) {
+    const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
+    if (!dot) return 0;
+    for (dot++; *dot && (*dot | 0x20) == *ext; dot++, ext++) {}
+    return !*dot && !*ext;
+}
+
+/* What the first bytes of an input say it is, when that is not a model the
+   importers read: "" for anything else. HEAD holds the first N bytes of a
+   regular file of SIZE bytes; TEXT is set when they hold no NUL byte. */
+static const char *sniff_kind(const char *path, const uint8_t *head, size_t n, uint64_t size, int *text) {
+    static const uint8_t png[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+    static const uint8_t vdag[8] = {0x89, 'V', 'D', 'A', 'G', '\r', '\n', 0x1A};
+    size_t i;
+    *text = !memchr(head, 0, n);
+    if (!size) return "an empty file";
+    if (n >= 8 && !memcmp(head, png, 8)) return "a PNG image";
+    if (n >= 3 && head[0] == 0xFF && head[1] == 0xD8 && head[2] == 0xFF) return "a JPEG image";
+    if (n >= 6 && (!memcmp(head, "GIF87a", 6) || !memcmp(head, "GIF89a", 6))) return "a GIF image";
+    if (n >= 8 && !memcmp(head, vdag, 8)) return "a .vdag file (already built: vdag info reads it)";
+    if (n >= 2 && head[0] == 0x1F && head[1] == 0x8B) return "gzip-compressed data (decompress it first)";
+    if (n >= 4 && !memcmp(head, "PK\3\4", 4)) return "a zip archive (extract it first)";
+    if (n >= 4 && !memcmp(head, "VOX ", 4) && !has_ext(path, "vox")) return "a MagicaVoxel .vox file (name it .vox)";
+    /* Binary STL: an 80-byte header, a triangle count, 50 bytes a triangle. */
+    if (n >= 84 && !has_ext(path, "stl") && !has_ext(path, "vox") && !has_ext(path, "spm") &&
+        size == 84 + 50 * (uint64_t)(head[80] | head[81] << 8 | head[82] << 16 | (uint32_t)head[83] << 24))
+        return "a binary STL mesh (80-byte header and a triangle count that matches its size; name it .stl)";
+    /* A material library: its first keyword (after blank lines, comments
+       and a UTF-8 byte order mark) is newmtl; or so named. */
+    i = n >= 3 && !memcmp(head, "\xEF\xBB\xBF", 3) ? 3 : 0;
+    while (i < n && (head[i] == ' ' || head[i] == '\t' || head[i] == '\r' || head[i] == '\n' || head[i] == '#')) {
+        if (head[i] == '#')
+            while (i < n && head[i] != '\n') i++;
+        else i++;
+    }
+    if (has_ext(path, "mtl") || (*text && n - i >= 7 && !memcmp(head + i, "newmtl", 6) && (head[i + 6] == ' ' || head[i + 6] == '\t')))
+        return "a material library (.mtl), which holds no geometry: build the .obj that names it in mtllib";
+    return "";
+}
+
+/* Refuses an input that is not a model (an image, an archive, a .vdag, a
+   material library, an empty file unless ALLOW_EMPTY) before importing it,
+   saying what it looks like. Returns 1 to go on, or 0 after printing why.
+   *TEXT receives whether the first bytes are text (no NUL byte). */
+static int check_input(const char *path, int allow_empty, int *text) {
+    uint8_t head[4096];
+    struct stat st;
+    size_t n;
+    const char *kind;
+    FILE *f;
+    *text = 0;
+    if (stat(path, &st) || !S_ISREG(st.st_mode)) return 1; /* the importer says why */
+    if (!(f = fopen(path, "rb"))) return 1;
+    n = fread(head, 1, sizeof head, f);
+    fclose(f);
+    kind = sniff_kind(path, head, n, (uint64_t)st.st_size, text);
+    if (!*kind || (allow_empty && !st.st_size)) return 1;
+    if (!st.st_size) return !vdag_fail("%s: not a model: an empty file (--allow-empty builds an empty scene)", path);
+    return !vdag_fail("%s: not a model: it looks like %s", path, kind);
+}
+
 static int cmd_build(int argc, char **argv) {
     build_args a;
     color_spill spill;
@@ -807,7 +907,7 @@ static int cmd_build(int argc, char **argv) {
     uint32_t *xyz = NULL;
     double bounds[6], t0 = now_seconds();
     size_t i;
-    int k, rc;
+    int k, rc, text;
     memset(&a, 0, sizeof a);
     memset(&spill, 0, sizeof spill);
     a.spill = &spill;
@@ -838,6 +938,8 @@ static int cmd_build(int argc, char **argv) {
                 return vdag_fail("build: --max-vox-voxels takes a voxel count >= 1");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
+        } else if (!strcmp(argv[k], "--allow-empty")) {
+            a.allow_empty = 1;
         } else if (!strcmp(argv[k], "--quiet")) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
@@ -884,7 +986,11 @@ static int cmd_build(int argc, char **argv) {
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
     if (a.verify_colors && !a.compress) return vdag_fail("build: --verify-colors checks compressed colours: add --color-error E");
+    if (a.color_error > sqrt(3.0)) /* the distance from black to white */
+        fprintf(stderr, "vdag: warning: --color-error %g is above sqrt(3) = 1.732, the largest RGB distance / 255: "
+                        "every colour is within it\n", a.color_error);
     if (!vdag_check_output(a.in, a.out)) return 1;
+    if (!check_input(a.in, a.allow_empty, &text)) return 1;
     if (!a.quiet) fprintf(stderr, "vdag: reading %s\n", a.in);
     memset(&limits, 0, sizeof limits);
     /* Textures give colours and the alpha test: without both, nothing to decode them for. */
@@ -903,6 +1009,11 @@ static int cmd_build(int argc, char **argv) {
     if (!a.up) a.up = default_up(a.in);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
     turn_up(sc.positions, sc.vertex_count, a.up, 0);
+    if (!sc.triangle_count && !sc.point_count && !a.allow_empty) {
+        vdag_scene_free(&sc);
+        return vdag_fail("%s: not a model: %s with no triangles and no points (lines are not voxelized; "
+                         "--allow-empty builds an empty scene)", a.in, text ? "a text file" : "a file");
+    }
     if (!sc.triangle_count && !sc.point_count)
         fprintf(stderr, "vdag: warning: %s holds no triangles and no points (lines are not voxelized): "
                         "the result has no voxels\n", a.in);
@@ -1002,6 +1113,10 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
 
 // -- vdag info / validate
 
+/* V with a negative zero made positive, so that none is printed as "-0"
+   (a world box of a file built from a turned axis: -z of 0). */
+static double no_minus_zero(double v) { return v == 0 ? 0.0 : v; }
+
 static const char *color_kind_name(voxdag_color_kind k) {
     return k == VOXDAG_COLORS_RGB8 ? "rgb8" : k == VOXDAG_COLORS_VOXCOLOR ? "voxcolor" : "none";
 }
@@ -1015,6 +1130,7 @@ static int cmd_info(int argc, char **argv) {
     if (argc < 2 || argc > 3 || (argc == 3 && !json)) return vdag_fail("usage: vdag info FILE [--json]");
     if (!vdag_open(argv[1], &f)) return 1;
     voxdag_get_info(f.dag, &in);
+    for (l = 0; l < 6; l++) in.bounds[l] = no_minus_zero(in.bounds[l]);
     geo_bits = in.voxels ? 8.0 * (double)(in.node_bytes + in.brick_bytes) / (double)in.voxels : 0.0;
     if (json) {
         printf("{\"levels\": %u, \"voxels\": %llu, \"symmetric\": %s, \"symmetry\": \"%s\", \"voxel_box\": [%u, %u, %u, %u, %u, %u], \"nodes_per_level\": [",
@@ -1055,10 +1171,13 @@ static int cmd_info(int argc, char **argv) {
             printf("grid world box  (%g, %g, %g) - (%g, %g, %g), the source's units\n", in.bounds[0], in.bounds[1],
                    in.bounds[2], in.bounds[3], in.bounds[4], in.bounds[5]);
             if (in.voxels)
-                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n", in.bounds[0] + cell * in.voxel_box[0],
-                       in.bounds[1] + cell * in.voxel_box[1], in.bounds[2] + cell * in.voxel_box[2],
-                       in.bounds[0] + cell * in.voxel_box[3], in.bounds[1] + cell * in.voxel_box[4],
-                       in.bounds[2] + cell * in.voxel_box[5]);
+                printf("occupied world box  (%g, %g, %g) - (%g, %g, %g)\n",
+                       no_minus_zero(in.bounds[0] + cell * in.voxel_box[0]),
+                       no_minus_zero(in.bounds[1] + cell * in.voxel_box[1]),
+                       no_minus_zero(in.bounds[2] + cell * in.voxel_box[2]),
+                       no_minus_zero(in.bounds[0] + cell * in.voxel_box[3]),
+                       no_minus_zero(in.bounds[1] + cell * in.voxel_box[4]),
+                       no_minus_zero(in.bounds[2] + cell * in.voxel_box[5]));
         }
     }
     vdag_close(&f);
@@ -1078,6 +1197,7 @@ static int cmd_validate(int argc, char **argv) {
 
 static int cmd_lookup(int argc, char **argv) {
     vdag_file f;
+    voxdag_info in;
     uint32_t c[3];
     uint64_t index;
     int k;
@@ -1085,6 +1205,12 @@ static int cmd_lookup(int argc, char **argv) {
     for (k = 0; k < 3; k++)
         if (!parse_u32(argv[2 + k], &c[k])) return vdag_fail("lookup: bad coordinate '%s'", argv[2 + k]);
     if (!vdag_open(argv[1], &f)) return 1;
+    voxdag_get_info(f.dag, &in);
+    if (c[0] >> in.levels || c[1] >> in.levels || c[2] >> in.levels) {
+        vdag_close(&f);
+        return vdag_fail("lookup: (%u, %u, %u) is outside the grid: %u^3 (levels %u), coordinates 0..%u", c[0], c[1],
+                         c[2], 1u << in.levels, in.levels, (1u << in.levels) - 1);
+    }
     if (voxdag_lookup(f.dag, c[0], c[1], c[2], &index)) {
         uint8_t rgb[3];
         vdag_voxel_color(&f, index, rgb);
@@ -1126,6 +1252,7 @@ static int cmd_gen(int argc, char **argv) {
         return vdag_fail("usage: vdag gen demo OUT.xyz [--levels L]");
     }
     if (strcmp(argv[1], "demo")) return vdag_fail("gen: unknown scene '%s' (known: demo)", argv[1]);
+    if (!vdag_check_output(NULL, argv[2])) return 1;
     out = fopen(argv[2], "w");
     if (!out) return vdag_fail("%s: %s", argv[2], strerror(errno));
     n = 1u << levels;
@@ -1163,7 +1290,7 @@ static int usage(FILE *f) {
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
           "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
-          "                    [--max-vox-voxels N] [--force] [--stats] [--quiet]\n"
+          "                    [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

@@ -317,8 +317,12 @@ job "macros: the control (a variable named N under those macros) fails" "error" 
 # -- README: every ```c block, preprocessor lines first, the rest in main(),
 # run where build/demo.vdag is a scene built as `make demo` does (colours in a
 # voxcolor stream, vdag build --color-error): its colour lookup must print.
+# The same text is compiled as C99 and as C++11 (-Wall -Wextra -Werror: a
+# `= {0}` initialiser fails there) and both programs must print the same.
 VDAG_SRC="$(sed -n 's/^VDAG_SRC *:= *//p' Makefile | sed 's|examples/image_stb.c|examples/image_none.c|')" # no texture read
-job "readme: README.md's C code compiled and run on a voxcolor-coloured file" ok \
+cxx1=$(echo $CXXS | cut -d' ' -f1)
+[ -n "$cxx1" ] || { echo "FAIL readme: no g++ or clang++ for the README's code as C++" | tee /dev/stderr; fail=$((fail + 1)); }
+job "readme: README.md's C code compiled as C99 and as C++11 ($cxx1), run on a voxcolor-coloured file" ok \
     "mkdir -p $out/readme/build
      $cc1 -std=c99 -O2 -pthread -I. -o $out/readme/vdag $VDAG_SRC -lm
      $out/readme/vdag gen demo $out/readme/build/demo.xyz --levels 7 >/dev/null
@@ -334,7 +338,10 @@ job "readme: README.md's C code compiled and run on a voxcolor-coloured file" ok
      $cc1 $C99 -Wno-unused -O1 -o $out/readme/readme -I. $out/readme/readme.c $LIBS
      (cd $out/readme && ./readme) >$out/readme/out.txt
      cat $out/readme/out.txt
-     grep -q '^hit voxel .* colour [0-9]* [0-9]* [0-9]*\$' $out/readme/out.txt"
+     grep -q '^hit voxel .* colour [0-9]* [0-9]* [0-9]*\$' $out/readme/out.txt
+     $cxx1 $CXX11 -Wno-unused -O1 -o $out/readme/readme_cxx -I. $out/readme/readme.c $LIBS
+     (cd $out/readme && ./readme_cxx) >$out/readme/out_cxx.txt
+     cmp $out/readme/out.txt $out/readme/out_cxx.txt"
 
 # -- Determinism: vdag built by each C compiler at -O0 and -O2 and in other
 # floating-point models, one scene built with 1 and 3 threads (colour error

@@ -9,8 +9,9 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 pass=0
 fail=0
+exec 3>&2 # failures reach stderr also from a check whose stderr is redirected
 ok() { pass=$((pass + 1)); }
-ko() { fail=$((fail + 1)); echo "  FAIL: $*" >&2; }
+ko() { fail=$((fail + 1)); echo "  FAIL: $*" >&3; }
 check() { # check DESCRIPTION COMMAND...: passes when COMMAND succeeds
     d=$1; shift
     if "$@"; then ok; else ko "$d"; fi
@@ -120,9 +121,16 @@ check "--color-effort takes smallest or fast" sh -c "! '$VDAG' build '$T/in.xyz'
 mkdir -p "$T/spill"
 check "the colour spill goes to TMPDIR, is reported up front and at the end, and is removed" sh -c "
     TMPDIR='$T/spill' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 --color-error 0.03 2>'$T/err' &&
-    grep -q 'colour spill: about .* MiB of temporary disk in $T/spill (estimate; [0-9]* MiB free there' '$T/err' &&
-    grep -q 'colour spill: .* MiB of temporary disk in $T/spill ('\$(wc -l <'$T/expected_export')' colours)' '$T/err' &&
+    grep -q 'colour spill: about .* of temporary disk in $T/spill (estimate; [0-9]* MiB free there' '$T/err' &&
+    grep -q 'colour spill: .* of temporary disk in $T/spill ('\$(wc -l <'$T/expected_export')' colours)' '$T/err' &&
     [ -z \"\$(ls -A '$T/spill')\" ]"
+check "a small colour spill is given in KiB (3 bytes a colour), not as 0.0 MiB; a single colour in bytes" sh -c "
+    TMPDIR='$T/spill' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 --color-error 0.03 2>'$T/err' &&
+    n=\$(wc -l <'$T/expected_export') && kib=\$(awk \"BEGIN { printf \\\"%.1f\\\", 3 * \$n / 1024 }\") &&
+    grep -q \"colour spill: about \$kib KiB of temporary disk\" '$T/err' &&
+    grep -q \"colour spill: \$kib KiB of temporary disk in $T/spill (\$n colours)\" '$T/err' && ! grep -q '0\\.0 MiB' '$T/err' &&
+    printf '1 1 1 9 9 9\\n' >'$T/one.xyz' && '$VDAG' build '$T/one.xyz' '$T/one.vdag' 2>'$T/err' &&
+    grep -q 'colour spill: 3 bytes of temporary disk' '$T/err'"
 check "an unusable TMPDIR fails with one line naming it" sh -c "
     ! TMPDIR='$T/none' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 2 ] && grep -q '$T/none' '$T/err'"
@@ -148,6 +156,14 @@ b = bytearray(open('$T/a.vdag', 'rb').read()); b[len(b) // 2] ^= 0x40
 open('$T/flip.vdag', 'wb').write(b)"
 check "flipped byte is invalid, one-line reason" sh -c "! '$VDAG' validate '$T/flip.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ]"
 check "lookup with a bad coordinate fails" sh -c "! '$VDAG' lookup '$T/a.vdag' 1 2 x 2>/dev/null"
+check "lookup outside the grid fails, one line naming the grid size; its last voxel answers" sh -c "
+    ! '$VDAG' lookup '$T/a.vdag' 32 0 0 >'$T/out' 2>'$T/err' && [ ! -s '$T/out' ] && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'outside the grid: 32^3 (levels 5), coordinates 0..31' '$T/err' &&
+    ! '$VDAG' lookup '$T/a.vdag' 0 0 4294967295 >/dev/null 2>&1 && '$VDAG' lookup '$T/a.vdag' 31 31 31 >/dev/null"
+check "--color-error above sqrt(3) warns that every colour is within it; at sqrt(3) it does not" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/ce.vdag' --levels 5 --color-error 1.8 --quiet 2>'$T/err' &&
+    grep -q 'warning: --color-error 1.8 is above sqrt(3)' '$T/err' &&
+    '$VDAG' build '$T/in.xyz' '$T/ce.vdag' --levels 5 --color-error 1.732 --quiet 2>'$T/err' && [ ! -s '$T/err' ]"
 
 # -- meshes: an axis-aligned square fitted into the grid fills one or two layers
 printf 'v 0 0 0 1 0 0\nv 8 0 0 1 0 0\nv 8 8 0 1 0 0\nv 0 8 0 1 0 0\nf 1 2 3\nf 1 3 4\n' >"$T/square.obj"
@@ -300,6 +316,10 @@ check "info --json gives the occupied voxel box" sh -c "'$VDAG' info '$T/small.v
 import json, sys
 assert json.load(sys.stdin)['voxel_box'] == [150, 90, 20, 154, 94, 26]
 \""
+printf 'v 0 0 0\nv 8 0 0\nv 8 8 0\nf 1 2 3\n' >"$T/yup.obj"
+check "info prints no negative zero (a y-up .obj turns z = 0 into -0)" sh -c "
+    '$VDAG' build '$T/yup.obj' '$T/yup.vdag' --levels 3 --quiet && '$VDAG' info '$T/yup.vdag' >'$T/out' &&
+    '$VDAG' info '$T/yup.vdag' --json >>'$T/out' && grep -q 'world box' '$T/out' && ! grep -q -- '-0\\b' '$T/out'"
 check "info names the grid world box and the occupied box" sh -c "'$VDAG' info '$T/sq.vdag' >'$T/info.txt' &&
     grep -q '^grid world box' '$T/info.txt' && grep -q '^occupied' '$T/info.txt' && ! grep -q '^bounds' '$T/info.txt'"
 check "render: the default camera frames the occupied voxels" sh -c "'$VDAG' render '$T/small.vdag' '$T/small.png' --size 64x48 2>/dev/null &&
@@ -321,18 +341,49 @@ assert frac > 0.1, frac
 assert not any(cover[0]) and not any(cover[-1]) and not any(r[0] or r[-1] for r in cover), 'clipped'
 \""
 
-# -- inputs that give nothing: a warning, or an error that says why
+# -- inputs that give nothing, or are no model: an error that says what the
+# file looks like, before any work; an empty scene only with --allow-empty
 : >"$T/empty.obj"
-check "an empty .obj warns that nothing is voxelized" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
-    grep -q 'warning:.*no triangles and no points' '$T/err'"
+: >"$T/empty.xyz"
+check "an empty .obj or .xyz is refused as an empty file, no output written" sh -c "
+    ! '$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 2>'$T/err' && grep -q 'empty.obj: not a model: an empty file' '$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' build '$T/empty.xyz' '$T/e.vdag' 2>'$T/err' &&
+    grep -q 'empty.xyz: not a model: an empty file' '$T/err' && [ ! -e '$T/e.vdag' ]"
+check "--allow-empty builds an empty .obj, with a warning" sh -c "'$VDAG' build '$T/empty.obj' '$T/e.vdag' --levels 3 --allow-empty 2>'$T/err' &&
+    grep -q 'warning:.*no triangles and no points' '$T/err' && '$VDAG' info '$T/e.vdag' | grep -q '^voxels *0\$'"
 printf 'AC3Db\nMATERIAL "m" rgb 1 1 1\nOBJECT world\nkids 1\nOBJECT poly\nnumvert 2\n0 0 0\n1 1 1\nnumsurf 1\nSURF 0x2\nmat 0\nrefs 2\n0 0 0\n1 0 0\nkids 0\n' >"$T/lines.ac"
-check "an .ac file of lines only warns" sh -c "'$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
-    grep -q 'warning:.*no triangles' '$T/err'"
+printf '# no vertices\no thing\ng group\n' >"$T/novert.obj"
+check "an .ac file of lines only, an .obj without vertices: refused as text with no triangles and no points" sh -c "
+    rm -f '$T/e.vdag'; ! '$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'lines.ac: not a model: a text file with no triangles and no points' '$T/err' &&
+    ! '$VDAG' build '$T/novert.obj' '$T/e.vdag' --levels 3 2>'$T/err' &&
+    grep -q 'novert.obj: not a model: a text file with no triangles and no points' '$T/err' && [ ! -e '$T/e.vdag' ] &&
+    '$VDAG' build '$T/lines.ac' '$T/e.vdag' --levels 3 --allow-empty 2>'$T/err' && grep -q 'warning:.*no triangles' '$T/err'"
+python3 - "$T" <<'EOF2'
+import gzip, struct, sys
+t = sys.argv[1]
+open(t + "/image.obj", "wb").write(b"\x89PNG\r\n\x1a\n" + bytes(32))
+open(t + "/photo.xyz", "wb").write(b"\xff\xd8\xff\xe0" + bytes(32))
+stl = b"solid written by a CAD tool".ljust(80, b" ") + struct.pack("<I", 1) + struct.pack("<12f", 0, 0, 1, 0, 0, 0, 8, 0, 0, 8, 8, 0) + b"\0\0"
+open(t + "/stl.obj", "wb").write(stl)
+open(t + "/lib.obj", "w").write("# exported\n\nnewmtl red\nKd 1 0 0\n")
+open(t + "/packed.xyz", "wb").write(gzip.compress(b"1 2 3\n"))
+open(t + "/packed.obj", "wb").write(b"PK\3\4" + bytes(40))
+EOF2
+rm -f "$T/e.vdag"
+bad=""
+for c in 'image.obj:a PNG image' 'photo.xyz:a JPEG image' 'stl.obj:a binary STL mesh' 'lib.obj:a material library' \
+         'tex.mtl:a material library' 'packed.xyz:gzip-compressed data' 'packed.obj:a zip archive' 'a.vdag:a .vdag file'; do
+    f=${c%%:*}
+    if "$VDAG" build "$T/$f" "$T/e.vdag" --allow-empty 2>"$T/err" || [ "$(wc -l <"$T/err")" != 1 ] ||
+        ! grep -q "$f: not a model: it looks like ${c#*:}" "$T/err"; then bad="$bad $f"; fi
+done
+check "inputs that are no model are refused saying what they look like, one line, no output (wrong:$bad)" sh -c "[ -z '$bad' ] && [ ! -e '$T/e.vdag' ]"
 python3 -c "open('$T/wide.obj', 'wb').write('v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n'.encode('utf-16'))"
 check "a UTF-16 .obj is refused as such" sh -c "! '$VDAG' build '$T/wide.obj' '$T/e.vdag' 2>'$T/err' &&
     grep -q 'UTF-16' '$T/err'"
 printf '\357\273\277AC3Db\nMATERIAL "m" rgb 1 0 0\nOBJECT world\nkids 0\n' >"$T/bom.ac"
-check "an .ac file with a UTF-8 BOM is read" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 2>/dev/null
+check "an .ac file with a UTF-8 BOM is read (no geometry: --allow-empty)" "$VDAG" build "$T/bom.ac" "$T/e.vdag" --levels 3 --allow-empty 2>/dev/null
 mkdir "$T/adir.obj"
 check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.vdag' 2>'$T/err' && grep -q 'is a directory' '$T/err'"
 
@@ -340,12 +391,32 @@ check "a directory as input says so" sh -c "! '$VDAG' build '$T/adir.obj' '$T/e.
 check "gen demo" "$VDAG" gen demo "$T/demo.xyz" --levels 5
 check "build the demo scene" "$VDAG" build "$T/demo.xyz" "$T/demo.vdag" --color-error 0.02 2>/dev/null
 
+# -- README's figures of the demo scene: the scene `make demo` builds (its
+# gen and build commands read from the Makefile) has them
+demo_levels=$(sed -n 's/.*vdag gen demo .* --levels \([0-9]*\).*/\1/p' Makefile)
+demo_error=$(sed -n 's/.*vdag build .*demo\.vdag .*--color-error \([0-9.]*\).*/\1/p' Makefile)
+check "README's demo figures are what make demo builds (levels $demo_levels, --color-error $demo_error)" sh -c "
+    '$VDAG' gen demo '$T/mdemo.xyz' --levels '$demo_levels' && '$VDAG' build '$T/mdemo.xyz' '$T/mdemo.vdag' --color-error '$demo_error' --quiet &&
+    '$VDAG' info '$T/mdemo.vdag' --json >'$T/mdemo.json' && python3 - '$T/mdemo.json' '$demo_levels' '$demo_error' <<'EOF'
+import json, re, sys
+d = json.load(open(sys.argv[1]))
+text = ' '.join(open('README.md').read().split())
+m = re.search(r'a (\d+)\^3 coloured scene, ([\d,]+) voxels, stored in ([\d,]+) bytes of geometry \(([\d.]+) bits per voxel\) '
+              r'and ([\d,]+) bytes of colours \(([\d.]+) bits per colour at an error bound of ([\d.]+)\)', text)
+assert m, 'the demo sentence is not in README.md'
+n = lambda s: int(s.replace(',', ''))
+geo = d['bytes']['nodes'] + d['bytes']['bricks']
+want = (str(1 << int(sys.argv[2])), '{:,}'.format(d['voxels']), '{:,}'.format(geo), '%.3f' % d['bits_per_voxel'],
+        '{:,}'.format(d['bytes']['colors']), '%.2f' % d['color_bits_per_voxel'], sys.argv[3])
+assert m.groups() == want, ('README says', m.groups(), 'make demo gives', want)
+EOF"
+
 # -- help, version, progress, safety
 for c in build info validate lookup rays render export-voxels gen; do
     check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
 done
 check "every build and render option in --help with its default" sh -c "
-    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --force --stats --quiet; do
+    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --allow-empty --force --stats --quiet; do
         '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
     for o in --size --eye --target --fov --shadows --lod --threads; do
         '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
@@ -398,6 +469,29 @@ check "write and open errors carry the OS reason" sh -c "
     ! '$VDAG' build '$T/in.xyz' '$T/no/such/dir.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
     ! '$VDAG' info '$T/none.vdag' 2>'$T/err' && grep -q 'No such file or directory' '$T/err' &&
     ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && grep -q 'No such file or directory' '$T/err'"
+# An output folder that cannot take the file is refused before any work,
+# in one line naming the folder and why (root passes access(2), so the
+# unwritable folder is tried as user nobody there).
+mkdir "$T/ro" && chmod 555 "$T/ro" && : >"$T/afile" && printf '1 1 1\n' >"$T/ro_in.xyz" && chmod 644 "$T/ro_in.xyz"
+check "an output folder missing or not a directory is refused before the build, one line naming it" sh -c "
+    ! '$VDAG' build '$T/in.xyz' '$T/no/such/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'cannot write into the folder $T/no/such (No such file or directory)' '$T/err' &&
+    ! '$VDAG' build '$T/in.xyz' '$T/afile/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'cannot write into the folder $T/afile (not a directory)' '$T/err' &&
+    ! '$VDAG' render '$T/a.vdag' '$T/no/x.png' --size 4x4 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+    grep -q 'folder $T/no (No such file' '$T/err' &&
+    ! '$VDAG' gen demo '$T/no/d.xyz' 2>'$T/err' && grep -q 'folder $T/no (No such file' '$T/err'"
+as=""
+if [ "$(id -u)" = 0 ]; then as="setpriv --reuid=65534 --regid=65534 --clear-groups"; chmod 755 "$T"; fi
+if [ -z "$as" ] || $as true 2>/dev/null; then
+    check "an unwritable output folder is refused before the build, one line naming it" sh -c "
+        ! $as '$VDAG' build '$T/ro_in.xyz' '$T/ro/x.vdag' 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+        grep -q 'cannot write into the folder $T/ro (Permission denied)' '$T/err' &&
+        ! $as '$VDAG' render '$T/a.vdag' '$T/ro/x.png' --size 4x4 2>'$T/err' && grep -q 'folder $T/ro (Permission denied)' '$T/err'"
+else
+    ko "an unwritable output folder: running as root and setpriv cannot drop to nobody"
+fi
+chmod 700 "$T"
 check "progress into a pipe: plain lines, no carriage return, a few lines" sh -c "
     '$VDAG' build '$T/demo.xyz' '$T/p.vdag' --color-error 0.02 2>&1 >/dev/null | tee '$T/log' >/dev/null &&
     ! grep -q \"\$(printf '\\r')\" '$T/log' && [ \$(wc -l <'$T/log') -le 30 ]"
@@ -509,8 +603,24 @@ assert b[:8] == b'\\\\x89PNG\\\\r\\\\n\\\\x1a\\\\n' and b[12:16] == b'IHDR', b[:
 assert struct.unpack('>II', b[16:24]) == (37, 23) and b[24:26] == bytes([8, 2])
 assert b[-8:-4] == b'IEND'
 \""
+check "render: an OUT not named .png (any case) is refused, one line, nothing written" sh -c "
+    for o in r.jpg r.jpeg r r.png.bak r.pn; do
+        ! '$VDAG' render '$T/r.vdag' \"$T/\$o\" --size 4x4 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+        grep -q 'written as PNG; name it .png' '$T/err' && [ ! -e \"$T/\$o\" ] || exit 1
+    done
+    '$VDAG' render '$T/r.vdag' '$T/r2.PNG' --size 4x4 --quiet && [ -s '$T/r2.PNG' ]"
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
+
+# -- README states the lifetime of a DAG's allocator (kept by built and
+# loaded DAGs, reused by voxdag_with_colors), where the allocator is described
+check "README: a DAG keeps its allocator and user pointer; voxdag_with_colors reuses it; the state must outlive the DAG" python3 -c "
+text = ' '.join(open('README.md').read().replace(chr(96), '').split())
+part = text[text.index('Allocators live as long as their DAGs'):][:900]
+for words in ['keeps a copy of it, its user pointer included', 'voxdag_with_colors allocates the new DAG with the source DAG',
+              'must outlive every DAG made with it']:
+    assert words in part, words
+"
 
 # -- README's tool section names every command and every option of --help
 check "README lists every command and option of --help" python3 -c "
