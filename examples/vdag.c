@@ -151,8 +151,9 @@ static const struct {
      "an empty file, a file without triangles or points) is refused, saying what it looks like.\n"
      "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
      "                     point clouds; voxel lists: the smallest grid that holds them)\n"
-     "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
-     "                     z for .stl .xyz .vox .spm .ac)\n"
+     "  --up x|y|z         the input's up axis, turned to +z (default: what the exporter named\n"
+     "                     in the file writes (Blender), else y for .obj .ply .off, z for .stl\n"
+     "                     .xyz .vox .spm .ac; the axis and why are printed)\n"
      "  --symmetry G       share subtrees equal up to: none (identical only), reflect (the 8\n"
      "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
      "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
@@ -319,21 +320,98 @@ static void progress_end(build_args *a) {
 
 /* The tool's axes are z up (x right, y away from a viewer in front):
    renders, the default camera and every built file use them. A file's up
-   axis (--up, or the default of its format) is turned to +z by a rotation:
-   y up: (x, y, z) -> (x, -z, y); x up: (x, y, z) -> (y, z, x). Formats
-   whose usual exporters write y up (.obj, .ply, .off) default to y; .stl
-   (CAD and 3D printing), .xyz and .vox default to z; .spm and .ac are
-   turned to z up by the importer and default to z. */
-static char default_up(const char *path) {
+   axis is turned to +z by a rotation: y up: (x, y, z) -> (x, -z, y); x up:
+   (x, y, z) -> (y, z, x). The axis is --up when given; else an exporter's
+   convention that the file names (up_marks); else the default of its
+   format: formats whose usual exporters write y up (.obj, .ply, .off)
+   default to y; .stl (CAD and 3D printing), .xyz and .vox default to z;
+   .spm and .ac are turned to z up by the importer and default to z. */
+
+/* PATH's extension after the last '.', or "" when it has none. */
+static const char *path_ext(const char *path) {
     const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
-    static const char *const y_up[] = {"obj", "ply", "off"};
-    size_t i;
-    for (i = 0; dot && i < sizeof y_up / sizeof y_up[0]; i++) {
-        const char *a = dot + 1, *b = y_up[i];
-        while (*a && (*a | 0x20) == *b) a++, b++;
-        if (!*a && !*b) return 'y';
+    return dot ? dot + 1 : "";
+}
+
+/* Extension EXT is NAME (lower case), in any case. */
+static int ext_is(const char *ext, const char *name) {
+    while (*ext && (*ext | 0x20) == *name) ext++, name++;
+    return !*ext && !*name;
+}
+
+static char default_up(const char *path) {
+    const char *ext = path_ext(path);
+    return ext_is(ext, "obj") || ext_is(ext, "ply") || ext_is(ext, "off") ? 'y' : 'z';
+}
+
+/* Exporters whose default axes are known, by the comment they write: a
+   line in the file's first 4 KiB (.ply: in its header, before end_header)
+   that begins with MARK gives UP. Only conventions read
+   from the exporters' own sources are listed; a file without one keeps its
+   format's default (3ds Max's OBJ exporter, for one, writes y or z up as its
+   "Flip YZ-axis" option says, which the file does not record). */
+static const struct {
+    const char *ext, *mark;
+    char up;
+} up_marks[] = {
+    {"obj", "# Blender", 'y'},                         /* Blender's OBJ exporters: forward -Z, up Y */
+    {"ply", "comment Created by Blender", 'z'},        /* Blender's PLY add-on (to 3.5): forward Y, up Z */
+    {"ply", "comment Created in Blender version", 'y'}, /* Blender 3.6 and later: forward -Z, up Y */
+};
+
+/* The up axis of the file at PATH when its first 4 KiB name an exporter of
+   up_marks, else 0; WHY (WHY_SIZE bytes, at least 4) receives the line that
+   names it, its first 72 bytes and "..." when longer, with '"' and bytes
+   outside printable ASCII as '?'. */
+static char file_up(const char *path, char *why, size_t why_size) {
+    char buf[4097], *line, *next;
+    const char *ext = path_ext(path);
+    size_t n, i, k;
+    struct stat st;
+    FILE *f;
+    if (stat(path, &st) || !S_ISREG(st.st_mode) || !(f = fopen(path, "rb"))) return 0; /* read once only */
+    n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    line = buf;
+    if (n >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3)) line += 3; /* a UTF-8 byte order mark */
+    for (; line < buf + n; line = next + 1) {
+        next = line + strcspn(line, "\r\n");
+        if (next >= buf + n) break; /* a line cut at 4 KiB, or the end: not read */
+        *next = 0;
+        if (ext_is(ext, "ply") && !strncmp(line, "end_header", 10)) break;
+        for (i = 0; i < sizeof up_marks / sizeof up_marks[0]; i++) {
+            if (!ext_is(ext, up_marks[i].ext) || strncmp(line, up_marks[i].mark, strlen(up_marks[i].mark))) continue;
+            for (k = 0; line[k] && k + 4 < why_size && k < 72; k++)
+                why[k] = line[k] >= 0x20 && line[k] < 0x7f && line[k] != '"' ? line[k] : '?';
+            strcpy(why + k, line[k] ? "..." : "");
+            return up_marks[i].up;
+        }
     }
-    return 'z';
+    return 0;
+}
+
+/* Sets A->up (unless --up gave it) and prints it with the reason. */
+static void choose_up(build_args *a) {
+    char line[80] = "";
+    const char *ext = path_ext(a->in);
+    if (a->up) {
+        if (!a->quiet) fprintf(stderr, "vdag: up axis: %c (--up)\n", a->up);
+        return;
+    }
+    a->up = file_up(a->in, line, sizeof line);
+    if (a->up) {
+        if (!a->quiet) fprintf(stderr, "vdag: up axis: %c (from the file: \"%s\"; --up overrides)\n", a->up, line);
+        return;
+    }
+    a->up = default_up(a->in);
+    if (!a->quiet) {
+        size_t k;
+        for (k = 0; ext[k] && k < 8; k++)
+            line[k] = ext[k] >= 'A' && ext[k] <= 'Z' ? (char)(ext[k] + 32) : ext[k] > 0x20 && ext[k] < 0x7f ? ext[k] : '?';
+        line[k] = 0;
+        fprintf(stderr, "vdag: up axis: %c (default for .%s; --up overrides)\n", a->up, line);
+    }
 }
 
 /* Turns N points (3 doubles each) so that axis UP becomes +z. Voxels
@@ -1006,7 +1084,7 @@ static int cmd_build(int argc, char **argv) {
             return vdag_fail("%s: is %s, a file the build reads; refusing to write over it", a.out, guard.clash);
         return vdag_fail("%s", msg);
     }
-    if (!a.up) a.up = default_up(a.in);
+    choose_up(&a);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
     turn_up(sc.positions, sc.vertex_count, a.up, 0);
     if (!sc.triangle_count && !sc.point_count && !a.allow_empty) {
