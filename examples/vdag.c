@@ -149,8 +149,10 @@ static const struct {
      "build reads (.mtl libraries, textures); its folder must exist and be writable (checked\n"
      "before the build). An input that is no model (an image, an archive, a .vdag, an .mtl,\n"
      "an empty file, a file without triangles or points) is refused, saying what it looks like.\n"
-     "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
-     "                     point clouds; voxel lists: the smallest grid that holds them)\n"
+     "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes; point\n"
+     "                     clouds: the largest L up to 10 whose voxel is at least the median\n"
+     "                     nearest-neighbour spacing, printed; voxel lists: the smallest grid\n"
+     "                     that holds them)\n"
      "  --up x|y|z         the input's up axis, turned to +z (default: what the exporter named\n"
      "                     in the file writes (Blender), else y for .obj .ply .off, z for .stl\n"
      "                     .xyz .vox .spm .ac; the axis and why are printed)\n"
@@ -433,6 +435,129 @@ static void turn_up(double *p, size_t n, char up, int voxels) {
             p[3 * i + 2] = x;
         }
     }
+}
+
+/* The level of a point cloud (float points, no triangles) built without
+   --levels: the largest L up to 10 (the default of meshes) whose voxel,
+   the bounding box's largest extent / 2^L as scene_to_grid fits it, is at
+   least the cloud's spacing (point_spacing), so that two points that far
+   apart fall in the same or in touching voxels (they differ by at most one
+   voxel on each axis); at least 2. */
+#define CLOUD_SAMPLES 2000  /* points whose nearest neighbour is searched */
+#define CLOUD_WORK 65536    /* cells and points one search visits at most */
+#define CLOUD_MAX_LEVELS 10 /* the default level of meshes, never exceeded */
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The median distance from a point to its nearest other point (a duplicate,
+   at distance 0, is none), over every (N / CLOUD_SAMPLES)-th point (all of
+   them up to CLOUD_SAMPLES), each searched against all N points through a
+   uniform grid of about N cells (4 bytes a point and 4 a cell) in rings of
+   cells around it. A search stops after CLOUD_WORK cells and points with
+   the nearest found, so clusters and outliers stay cheap; the answer depends
+   on the points alone. *USED receives the samples that found a neighbour
+   (the median is over them; 0 when none did, and the result is 0);
+   *EXTENT the bounding box's largest extent. Returns -1 when out of
+   memory. */
+static double point_spacing(const double *p, size_t n, size_t *used, double *extent) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, side, *nearest, median = 0;
+    uint32_t dim[3], *start, *order, g;
+    size_t i, k, cells, samples, step;
+    *used = 0;
+    *extent = 0;
+    for (i = 0; i < 3 * n; i++) {
+        if (p[i] < lo[i % 3]) lo[i % 3] = p[i];
+        if (p[i] > hi[i % 3]) hi[i % 3] = p[i];
+    }
+    for (k = 0; k < 3; k++)
+        if (n && hi[k] - lo[k] > *extent) *extent = hi[k] - lo[k];
+    if (n < 2 || n > UINT32_MAX || !(*extent > 0)) return 0;
+    g = (uint32_t)ceil(cbrt((double)n));
+    side = *extent / g;
+    for (cells = 1, k = 0; k < 3; k++) {
+        double d = floor((hi[k] - lo[k]) / side) + 1;
+        dim[k] = d > g ? g : (uint32_t)d;
+        cells *= dim[k];
+    }
+    samples = n < CLOUD_SAMPLES ? n : CLOUD_SAMPLES;
+    start = (uint32_t *)calloc(cells + 1, sizeof *start);
+    order = (uint32_t *)malloc(n * sizeof *order);
+    nearest = (double *)malloc(samples * sizeof *nearest);
+    if (!start || !order || !nearest) {
+        free(start), free(order), free(nearest);
+        return -1;
+    }
+#define CLOUD_CELL(q, k) \
+    ((q)[k] - lo[k] >= dim[k] * side ? dim[k] - 1 : (uint32_t)(((q)[k] - lo[k]) / side))
+#define CLOUD_INDEX(q) (((size_t)CLOUD_CELL(q, 2) * dim[1] + CLOUD_CELL(q, 1)) * dim[0] + CLOUD_CELL(q, 0))
+    for (i = 0; i < n; i++) start[CLOUD_INDEX(p + 3 * i) + 1]++;
+    for (k = 0; k < cells; k++) start[k + 1] += start[k];
+    for (i = 0; i < n; i++) order[start[CLOUD_INDEX(p + 3 * i)]++] = (uint32_t)i;
+    for (k = cells; k > 0; k--) start[k] = start[k - 1]; /* each cell's first point again */
+    start[0] = 0;
+    step = n / samples;
+    for (i = 0; i < samples; i++) {
+        const double *q = p + 3 * (i * step);
+        long c[3], r, x, y, z, reach = 0, work = 0;
+        double best = HUGE_VAL;
+        for (k = 0; k < 3; k++) {
+            c[k] = (long)CLOUD_CELL(q, k);
+            if ((long)dim[k] > reach) reach = dim[k];
+        }
+        /* Ring r: the cells r away (Chebyshev) from q's own. Its points are
+           at least (r - 1) SIDE from q: the search stops before it once the
+           nearest found is that close. */
+        for (r = 0; r <= reach && work < CLOUD_WORK && !(best <= (double)(r - 1) * side * ((double)(r - 1) * side)); r++)
+            for (z = c[2] - r; z <= c[2] + r; z++)
+                for (y = c[1] - r; y <= c[1] + r; y++)
+                    for (x = c[0] - r; x <= c[0] + r;
+                         x += r && z != c[2] - r && z != c[2] + r && y != c[1] - r && y != c[1] + r ? 2 * r : 1) {
+                        size_t cell, j;
+                        work++;
+                        if (x < 0 || y < 0 || z < 0 || x >= (long)dim[0] || y >= (long)dim[1] || z >= (long)dim[2])
+                            continue;
+                        cell = ((size_t)z * dim[1] + (size_t)y) * dim[0] + (size_t)x;
+                        for (j = start[cell]; j < start[cell + 1] && work < CLOUD_WORK; j++, work++) {
+                            const double *o = p + 3 * (size_t)order[j];
+                            double d = (o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) +
+                                       (o[2] - q[2]) * (o[2] - q[2]);
+                            if (d > 0 && d < best) best = d;
+                        }
+                    }
+        if (best < HUGE_VAL) nearest[(*used)++] = sqrt(best);
+    }
+#undef CLOUD_CELL
+#undef CLOUD_INDEX
+    if (*used) {
+        qsort(nearest, *used, sizeof *nearest, cmp_double);
+        median = nearest[*used / 2];
+    }
+    free(start), free(order), free(nearest);
+    return median;
+}
+
+/* Chooses A->levels for a point cloud built without --levels and prints
+   it with the spacing it comes from. Returns 1 when out of memory. */
+static int choose_cloud_levels(const vdag_scene *sc, build_args *a) {
+    size_t used;
+    double extent, spacing = point_spacing(sc->points, sc->point_count, &used, &extent);
+    if (spacing < 0) return vdag_fail("out of memory");
+    a->levels = 2;
+    while (a->levels < CLOUD_MAX_LEVELS && spacing > 0 && extent / (double)(1u << (a->levels + 1)) >= spacing)
+        a->levels++;
+    if (!spacing) a->levels = CLOUD_MAX_LEVELS;
+    if (a->quiet) return 0;
+    if (spacing > 0)
+        fprintf(stderr, "vdag: point cloud: median spacing %.3g (of %zu sampled points), extent %.3g: --levels %u "
+                        "(voxels of %.3g; override with --levels)\n", spacing, used, extent, a->levels,
+                extent / (double)(1u << a->levels));
+    else
+        fprintf(stderr, "vdag: point cloud: no sampled point has a distinct neighbour near it: --levels %u (override with "
+                        "--levels)\n", a->levels);
+    return 0;
 }
 
 /* Points to grid voxels: integer voxels as they are, point clouds and mesh
@@ -1097,6 +1222,10 @@ static int cmd_build(int argc, char **argv) {
                         "the result has no voxels\n", a.in);
     a.input_items = sc.triangle_count ? sc.triangle_count : sc.point_count;
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
+    if (!a.levels && !sc.points_are_voxels && sc.point_count && choose_cloud_levels(&sc, &a)) {
+        vdag_scene_free(&sc);
+        return 1;
+    }
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);
         return 1;

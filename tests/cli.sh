@@ -270,6 +270,74 @@ done
 check "build a float .xyz point cloud" "$VDAG" build "$T/pts.xyz" "$T/pts.vdag" --levels 4 2>/dev/null
 check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/pts_expected'"
 
+# -- a point cloud built without --levels gets the level at which its
+# neighbours touch: the largest L up to 10 whose voxel (extent / 2^L) is at
+# least the median distance from a point to its nearest other point (the
+# upper median; all points are sampled up to 2000, else every (n / 2000)-th),
+# computed here by brute force; printed, and --levels overrides it. The
+# voxels then form no isolated voxel (none without one of its 26 neighbours).
+python3 - "$T" <<'EOF'
+import math, sys
+t = sys.argv[1]
+def level(pts, sample):
+    ext = max(max(p[k] for p in pts) - min(p[k] for p in pts) for k in range(3))
+    near = []
+    for q in sample:
+        d = min((o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) + (o[2] - q[2]) * (o[2] - q[2])
+                for o in pts if o != q)
+        near.append(math.sqrt(d))
+    s = sorted(near)[len(near) // 2]
+    l = 2
+    while l < 10 and ext / 2 ** (l + 1) >= s:
+        l += 1
+    return "%.3g %d %d\n" % (s, len(sample), l)
+# a sphere of radius 3, 1200 points on a Fibonacci spiral (.xyz)
+n, g = 1200, math.pi * (3 - math.sqrt(5))
+lines = []
+for i in range(n):
+    z = 1 - 2 * (i + 0.5) / n
+    r = math.sqrt(1 - z * z)
+    lines.append("%.6f %.6f %.6f" % (3 * r * math.cos(g * i), 3 * r * math.sin(g * i), 3 * z))
+open(t + "/sphere.xyz", "w").write("\n".join(lines) + "\n")
+pts = [tuple(map(float, l.split())) for l in lines]
+open(t + "/sphere.want", "w").write(level(pts, pts))
+# a 100 x 100 plate of points 1/16 apart (.ply, no faces): 10000 points,
+# every 5th sampled; each one's nearest neighbour is 1/16 away
+pts = [(x / 16, y / 16, 0.0) for y in range(100) for x in range(100)]
+open(t + "/plate.ply", "w").write("ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
+                                  "property double z\nend_header\n" % len(pts) + "".join("%r %r %r\n" % p for p in pts))
+sample = pts[::5]
+assert len(sample) == 2000 and all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 / 16 for a, b in zip(pts, pts[1:]) if a[1] == b[1])
+open(t + "/plate.want", "w").write("%.3g %d %d\n" % (1 / 16, 2000, 6))  # 99/16 / 2^6 >= 1/16 > 99/16 / 2^7
+EOF
+isolated() { # isolated FILE.vdag: how many voxels have none of their 26 neighbours
+    "$VDAG" export-voxels "$1" | python3 -c "
+import sys
+v = set(tuple(map(int, l.split()[:3])) for l in sys.stdin)
+print(sum(1 for (x, y, z) in v if not any((x + a, y + b, z + c) in v
+      for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if a or b or c)))"
+}
+for f in sphere.xyz plate.ply; do
+    read -r s m l <"$T/${f%.*}.want"
+    rm -f "$T/pc.vdag"
+    "$VDAG" build "$T/$f" "$T/pc.vdag" 2>"$T/err"
+    check "a point cloud ($f) gets --levels $l from its median spacing $s, printed; no isolated voxel" sh -c "
+        grep -q '^vdag: point cloud: median spacing $s (of $m sampled points), extent .*: --levels $l (voxels of .*; override with --levels)\$' '$T/err' &&
+        '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": $l,' && [ '$(isolated "$T/pc.vdag")' = 0 ]"
+    check "--levels overrides a point cloud's level ($f), with no spacing line" sh -c "
+        '$VDAG' build '$T/$f' '$T/pc.vdag' --levels 9 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+        '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 9,'"
+done
+check "voxel lists and meshes keep their default levels, with no spacing line" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/pc.vdag' 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 5,' &&
+    '$VDAG' build '$T/sq_a.stl' '$T/pc.vdag' 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 10,'"
+check "a point cloud without two distinct points keeps level 10, saying so" sh -c "
+    printf '1.5 2 3\n1.5 2 3\n' >'$T/dup.xyz' && '$VDAG' build '$T/dup.xyz' '$T/pc.vdag' 2>'$T/err' &&
+    grep -q 'point cloud: no sampled point has a distinct neighbour near it: --levels 10' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 10,'"
+
 # -- orientation: z up; a file's up axis (--up, default per format) is turned
 # to +z: y up (x, y, z) -> (x, -z, y), x up (x, y, z) -> (y, z, x); the
 # expected voxels are the rotated points fitted into the grid, computed here
