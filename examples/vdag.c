@@ -149,10 +149,13 @@ static const struct {
      "build reads (.mtl libraries, textures); its folder must exist and be writable (checked\n"
      "before the build). An input that is no model (an image, an archive, a .vdag, an .mtl,\n"
      "an empty file, a file without triangles or points) is refused, saying what it looks like.\n"
-     "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes and\n"
-     "                     point clouds; voxel lists: the smallest grid that holds them)\n"
-     "  --up x|y|z         the input's up axis, turned to +z (default: y for .obj .ply .off,\n"
-     "                     z for .stl .xyz .vox .spm .ac)\n"
+     "  --levels L         grid of 2^L voxels per axis, 2..21 (default: 10 for meshes; point\n"
+     "                     clouds: the largest L up to 10 whose voxel is at least the median\n"
+     "                     nearest-neighbour spacing, printed; voxel lists: the smallest grid\n"
+     "                     that holds them)\n"
+     "  --up x|y|z         the input's up axis, turned to +z (default: what the exporter named\n"
+     "                     in the file writes (Blender), else y for .obj .ply .off, z for .stl\n"
+     "                     .xyz .vox .spm .ac; the axis and why are printed)\n"
      "  --symmetry G       share subtrees equal up to: none (identical only), reflect (the 8\n"
      "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
      "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
@@ -319,21 +322,98 @@ static void progress_end(build_args *a) {
 
 /* The tool's axes are z up (x right, y away from a viewer in front):
    renders, the default camera and every built file use them. A file's up
-   axis (--up, or the default of its format) is turned to +z by a rotation:
-   y up: (x, y, z) -> (x, -z, y); x up: (x, y, z) -> (y, z, x). Formats
-   whose usual exporters write y up (.obj, .ply, .off) default to y; .stl
-   (CAD and 3D printing), .xyz and .vox default to z; .spm and .ac are
-   turned to z up by the importer and default to z. */
-static char default_up(const char *path) {
+   axis is turned to +z by a rotation: y up: (x, y, z) -> (x, -z, y); x up:
+   (x, y, z) -> (y, z, x). The axis is --up when given; else an exporter's
+   convention that the file names (up_marks); else the default of its
+   format: formats whose usual exporters write y up (.obj, .ply, .off)
+   default to y; .stl (CAD and 3D printing), .xyz and .vox default to z;
+   .spm and .ac are turned to z up by the importer and default to z. */
+
+/* PATH's extension after the last '.', or "" when it has none. */
+static const char *path_ext(const char *path) {
     const char *slash = strrchr(path, '/'), *dot = strrchr(slash ? slash : path, '.');
-    static const char *const y_up[] = {"obj", "ply", "off"};
-    size_t i;
-    for (i = 0; dot && i < sizeof y_up / sizeof y_up[0]; i++) {
-        const char *a = dot + 1, *b = y_up[i];
-        while (*a && (*a | 0x20) == *b) a++, b++;
-        if (!*a && !*b) return 'y';
+    return dot ? dot + 1 : "";
+}
+
+/* Extension EXT is NAME (lower case), in any case. */
+static int ext_is(const char *ext, const char *name) {
+    while (*ext && (*ext | 0x20) == *name) ext++, name++;
+    return !*ext && !*name;
+}
+
+static char default_up(const char *path) {
+    const char *ext = path_ext(path);
+    return ext_is(ext, "obj") || ext_is(ext, "ply") || ext_is(ext, "off") ? 'y' : 'z';
+}
+
+/* Exporters whose default axes are known, by the comment they write: a
+   line in the file's first 4 KiB (.ply: in its header, before end_header)
+   that begins with MARK gives UP. Only conventions read
+   from the exporters' own sources are listed; a file without one keeps its
+   format's default (3ds Max's OBJ exporter, for one, writes y or z up as its
+   "Flip YZ-axis" option says, which the file does not record). */
+static const struct {
+    const char *ext, *mark;
+    char up;
+} up_marks[] = {
+    {"obj", "# Blender", 'y'},                         /* Blender's OBJ exporters: forward -Z, up Y */
+    {"ply", "comment Created by Blender", 'z'},        /* Blender's PLY add-on (to 3.5): forward Y, up Z */
+    {"ply", "comment Created in Blender version", 'y'}, /* Blender 3.6 and later: forward -Z, up Y */
+};
+
+/* The up axis of the file at PATH when its first 4 KiB name an exporter of
+   up_marks, else 0; WHY (WHY_SIZE bytes, at least 4) receives the line that
+   names it, its first 72 bytes and "..." when longer, with '"' and bytes
+   outside printable ASCII as '?'. */
+static char file_up(const char *path, char *why, size_t why_size) {
+    char buf[4097], *line, *next;
+    const char *ext = path_ext(path);
+    size_t n, i, k;
+    struct stat st;
+    FILE *f;
+    if (stat(path, &st) || !S_ISREG(st.st_mode) || !(f = fopen(path, "rb"))) return 0; /* read once only */
+    n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    buf[n] = 0;
+    line = buf;
+    if (n >= 3 && !memcmp(buf, "\xef\xbb\xbf", 3)) line += 3; /* a UTF-8 byte order mark */
+    for (; line < buf + n; line = next + 1) {
+        next = line + strcspn(line, "\r\n");
+        if (next >= buf + n) break; /* a line cut at 4 KiB, or the end: not read */
+        *next = 0;
+        if (ext_is(ext, "ply") && !strncmp(line, "end_header", 10)) break;
+        for (i = 0; i < sizeof up_marks / sizeof up_marks[0]; i++) {
+            if (!ext_is(ext, up_marks[i].ext) || strncmp(line, up_marks[i].mark, strlen(up_marks[i].mark))) continue;
+            for (k = 0; line[k] && k + 4 < why_size && k < 72; k++)
+                why[k] = line[k] >= 0x20 && line[k] < 0x7f && line[k] != '"' ? line[k] : '?';
+            strcpy(why + k, line[k] ? "..." : "");
+            return up_marks[i].up;
+        }
     }
-    return 'z';
+    return 0;
+}
+
+/* Sets A->up (unless --up gave it) and prints it with the reason. */
+static void choose_up(build_args *a) {
+    char line[80] = "";
+    const char *ext = path_ext(a->in);
+    if (a->up) {
+        if (!a->quiet) fprintf(stderr, "vdag: up axis: %c (--up)\n", a->up);
+        return;
+    }
+    a->up = file_up(a->in, line, sizeof line);
+    if (a->up) {
+        if (!a->quiet) fprintf(stderr, "vdag: up axis: %c (from the file: \"%s\"; --up overrides)\n", a->up, line);
+        return;
+    }
+    a->up = default_up(a->in);
+    if (!a->quiet) {
+        size_t k;
+        for (k = 0; ext[k] && k < 8; k++)
+            line[k] = ext[k] >= 'A' && ext[k] <= 'Z' ? (char)(ext[k] + 32) : ext[k] > 0x20 && ext[k] < 0x7f ? ext[k] : '?';
+        line[k] = 0;
+        fprintf(stderr, "vdag: up axis: %c (default for .%s; --up overrides)\n", a->up, line);
+    }
 }
 
 /* Turns N points (3 doubles each) so that axis UP becomes +z. Voxels
@@ -355,6 +435,129 @@ static void turn_up(double *p, size_t n, char up, int voxels) {
             p[3 * i + 2] = x;
         }
     }
+}
+
+/* The level of a point cloud (float points, no triangles) built without
+   --levels: the largest L up to 10 (the default of meshes) whose voxel,
+   the bounding box's largest extent / 2^L as scene_to_grid fits it, is at
+   least the cloud's spacing (point_spacing), so that two points that far
+   apart fall in the same or in touching voxels (they differ by at most one
+   voxel on each axis); at least 2. */
+#define CLOUD_SAMPLES 2000  /* points whose nearest neighbour is searched */
+#define CLOUD_WORK 65536    /* cells and points one search visits at most */
+#define CLOUD_MAX_LEVELS 10 /* the default level of meshes, never exceeded */
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return x < y ? -1 : x > y;
+}
+
+/* The median distance from a point to its nearest other point (a duplicate,
+   at distance 0, is none), over every (N / CLOUD_SAMPLES)-th point (all of
+   them up to CLOUD_SAMPLES), each searched against all N points through a
+   uniform grid of about N cells (4 bytes a point and 4 a cell) in rings of
+   cells around it. A search stops after CLOUD_WORK cells and points with
+   the nearest found, so clusters and outliers stay cheap; the answer depends
+   on the points alone. *USED receives the samples that found a neighbour
+   (the median is over them; 0 when none did, and the result is 0);
+   *EXTENT the bounding box's largest extent. Returns -1 when out of
+   memory. */
+static double point_spacing(const double *p, size_t n, size_t *used, double *extent) {
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL}, side, *nearest, median = 0;
+    uint32_t dim[3], *start, *order, g;
+    size_t i, k, cells, samples, step;
+    *used = 0;
+    *extent = 0;
+    for (i = 0; i < 3 * n; i++) {
+        if (p[i] < lo[i % 3]) lo[i % 3] = p[i];
+        if (p[i] > hi[i % 3]) hi[i % 3] = p[i];
+    }
+    for (k = 0; k < 3; k++)
+        if (n && hi[k] - lo[k] > *extent) *extent = hi[k] - lo[k];
+    if (n < 2 || n > UINT32_MAX || !(*extent > 0)) return 0;
+    g = (uint32_t)ceil(cbrt((double)n));
+    side = *extent / g;
+    for (cells = 1, k = 0; k < 3; k++) {
+        double d = floor((hi[k] - lo[k]) / side) + 1;
+        dim[k] = d > g ? g : (uint32_t)d;
+        cells *= dim[k];
+    }
+    samples = n < CLOUD_SAMPLES ? n : CLOUD_SAMPLES;
+    start = (uint32_t *)calloc(cells + 1, sizeof *start);
+    order = (uint32_t *)malloc(n * sizeof *order);
+    nearest = (double *)malloc(samples * sizeof *nearest);
+    if (!start || !order || !nearest) {
+        free(start), free(order), free(nearest);
+        return -1;
+    }
+#define CLOUD_CELL(q, k) \
+    ((q)[k] - lo[k] >= dim[k] * side ? dim[k] - 1 : (uint32_t)(((q)[k] - lo[k]) / side))
+#define CLOUD_INDEX(q) (((size_t)CLOUD_CELL(q, 2) * dim[1] + CLOUD_CELL(q, 1)) * dim[0] + CLOUD_CELL(q, 0))
+    for (i = 0; i < n; i++) start[CLOUD_INDEX(p + 3 * i) + 1]++;
+    for (k = 0; k < cells; k++) start[k + 1] += start[k];
+    for (i = 0; i < n; i++) order[start[CLOUD_INDEX(p + 3 * i)]++] = (uint32_t)i;
+    for (k = cells; k > 0; k--) start[k] = start[k - 1]; /* each cell's first point again */
+    start[0] = 0;
+    step = n / samples;
+    for (i = 0; i < samples; i++) {
+        const double *q = p + 3 * (i * step);
+        long c[3], r, x, y, z, reach = 0, work = 0;
+        double best = HUGE_VAL;
+        for (k = 0; k < 3; k++) {
+            c[k] = (long)CLOUD_CELL(q, k);
+            if ((long)dim[k] > reach) reach = dim[k];
+        }
+        /* Ring r: the cells r away (Chebyshev) from q's own. Its points are
+           at least (r - 1) SIDE from q: the search stops before it once the
+           nearest found is that close. */
+        for (r = 0; r <= reach && work < CLOUD_WORK && !(best <= (double)(r - 1) * side * ((double)(r - 1) * side)); r++)
+            for (z = c[2] - r; z <= c[2] + r; z++)
+                for (y = c[1] - r; y <= c[1] + r; y++)
+                    for (x = c[0] - r; x <= c[0] + r;
+                         x += r && z != c[2] - r && z != c[2] + r && y != c[1] - r && y != c[1] + r ? 2 * r : 1) {
+                        size_t cell, j;
+                        work++;
+                        if (x < 0 || y < 0 || z < 0 || x >= (long)dim[0] || y >= (long)dim[1] || z >= (long)dim[2])
+                            continue;
+                        cell = ((size_t)z * dim[1] + (size_t)y) * dim[0] + (size_t)x;
+                        for (j = start[cell]; j < start[cell + 1] && work < CLOUD_WORK; j++, work++) {
+                            const double *o = p + 3 * (size_t)order[j];
+                            double d = (o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) +
+                                       (o[2] - q[2]) * (o[2] - q[2]);
+                            if (d > 0 && d < best) best = d;
+                        }
+                    }
+        if (best < HUGE_VAL) nearest[(*used)++] = sqrt(best);
+    }
+#undef CLOUD_CELL
+#undef CLOUD_INDEX
+    if (*used) {
+        qsort(nearest, *used, sizeof *nearest, cmp_double);
+        median = nearest[*used / 2];
+    }
+    free(start), free(order), free(nearest);
+    return median;
+}
+
+/* Chooses A->levels for a point cloud built without --levels and prints
+   it with the spacing it comes from. Returns 1 when out of memory. */
+static int choose_cloud_levels(const vdag_scene *sc, build_args *a) {
+    size_t used;
+    double extent, spacing = point_spacing(sc->points, sc->point_count, &used, &extent);
+    if (spacing < 0) return vdag_fail("out of memory");
+    a->levels = 2;
+    while (a->levels < CLOUD_MAX_LEVELS && spacing > 0 && extent / (double)(1u << (a->levels + 1)) >= spacing)
+        a->levels++;
+    if (!spacing) a->levels = CLOUD_MAX_LEVELS;
+    if (a->quiet) return 0;
+    if (spacing > 0)
+        fprintf(stderr, "vdag: point cloud: median spacing %.3g (of %zu sampled points), extent %.3g: --levels %u "
+                        "(voxels of %.3g; override with --levels)\n", spacing, used, extent, a->levels,
+                extent / (double)(1u << a->levels));
+    else
+        fprintf(stderr, "vdag: point cloud: no sampled point has a distinct neighbour near it: --levels %u (override with "
+                        "--levels)\n", a->levels);
+    return 0;
 }
 
 /* Points to grid voxels: integer voxels as they are, point clouds and mesh
@@ -1006,7 +1209,7 @@ static int cmd_build(int argc, char **argv) {
             return vdag_fail("%s: is %s, a file the build reads; refusing to write over it", a.out, guard.clash);
         return vdag_fail("%s", msg);
     }
-    if (!a.up) a.up = default_up(a.in);
+    choose_up(&a);
     turn_up(sc.points, sc.point_count, a.up, sc.points_are_voxels);
     turn_up(sc.positions, sc.vertex_count, a.up, 0);
     if (!sc.triangle_count && !sc.point_count && !a.allow_empty) {
@@ -1019,6 +1222,10 @@ static int cmd_build(int argc, char **argv) {
                         "the result has no voxels\n", a.in);
     a.input_items = sc.triangle_count ? sc.triangle_count : sc.point_count;
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
+    if (!a.levels && !sc.points_are_voxels && sc.point_count && choose_cloud_levels(&sc, &a)) {
+        vdag_scene_free(&sc);
+        return 1;
+    }
     if (scene_to_grid(&sc, &a, &xyz, bounds)) {
         vdag_scene_free(&sc);
         return 1;

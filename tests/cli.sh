@@ -133,7 +133,7 @@ check "a small colour spill is given in KiB (3 bytes a colour), not as 0.0 MiB; 
     grep -q 'colour spill: 3 bytes of temporary disk' '$T/err'"
 check "an unusable TMPDIR fails with one line naming it" sh -c "
     ! TMPDIR='$T/none' '$VDAG' build '$T/in.xyz' '$T/s.vdag' --levels 5 2>'$T/err' &&
-    [ \$(wc -l <'$T/err') = 2 ] && grep -q '$T/none' '$T/err'"
+    [ \$(grep -v -e '^vdag: reading ' -e '^vdag: up axis: ' '$T/err' | wc -l) = 1 ] && grep -q '$T/none' '$T/err'"
 
 # -- symmetry off gives the same voxels; the same input gives the same bytes
 check "build --no-symmetry" "$VDAG" build "$T/in.xyz" "$T/n.vdag" --levels 5 --no-symmetry 2>/dev/null
@@ -270,6 +270,74 @@ done
 check "build a float .xyz point cloud" "$VDAG" build "$T/pts.xyz" "$T/pts.vdag" --levels 4 2>/dev/null
 check "float .xyz points fitted into the grid" sh -c "'$VDAG' export-voxels '$T/pts.vdag' | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - '$T/pts_expected'"
 
+# -- a point cloud built without --levels gets the level at which its
+# neighbours touch: the largest L up to 10 whose voxel (extent / 2^L) is at
+# least the median distance from a point to its nearest other point (the
+# upper median; all points are sampled up to 2000, else every (n / 2000)-th),
+# computed here by brute force; printed, and --levels overrides it. The
+# voxels then form no isolated voxel (none without one of its 26 neighbours).
+python3 - "$T" <<'EOF'
+import math, sys
+t = sys.argv[1]
+def level(pts, sample):
+    ext = max(max(p[k] for p in pts) - min(p[k] for p in pts) for k in range(3))
+    near = []
+    for q in sample:
+        d = min((o[0] - q[0]) * (o[0] - q[0]) + (o[1] - q[1]) * (o[1] - q[1]) + (o[2] - q[2]) * (o[2] - q[2])
+                for o in pts if o != q)
+        near.append(math.sqrt(d))
+    s = sorted(near)[len(near) // 2]
+    l = 2
+    while l < 10 and ext / 2 ** (l + 1) >= s:
+        l += 1
+    return "%.3g %d %d\n" % (s, len(sample), l)
+# a sphere of radius 3, 1200 points on a Fibonacci spiral (.xyz)
+n, g = 1200, math.pi * (3 - math.sqrt(5))
+lines = []
+for i in range(n):
+    z = 1 - 2 * (i + 0.5) / n
+    r = math.sqrt(1 - z * z)
+    lines.append("%.6f %.6f %.6f" % (3 * r * math.cos(g * i), 3 * r * math.sin(g * i), 3 * z))
+open(t + "/sphere.xyz", "w").write("\n".join(lines) + "\n")
+pts = [tuple(map(float, l.split())) for l in lines]
+open(t + "/sphere.want", "w").write(level(pts, pts))
+# a 100 x 100 plate of points 1/16 apart (.ply, no faces): 10000 points,
+# every 5th sampled; each one's nearest neighbour is 1/16 away
+pts = [(x / 16, y / 16, 0.0) for y in range(100) for x in range(100)]
+open(t + "/plate.ply", "w").write("ply\nformat ascii 1.0\nelement vertex %d\nproperty double x\nproperty double y\n"
+                                  "property double z\nend_header\n" % len(pts) + "".join("%r %r %r\n" % p for p in pts))
+sample = pts[::5]
+assert len(sample) == 2000 and all(abs(a[0] - b[0]) + abs(a[1] - b[1]) == 1 / 16 for a, b in zip(pts, pts[1:]) if a[1] == b[1])
+open(t + "/plate.want", "w").write("%.3g %d %d\n" % (1 / 16, 2000, 6))  # 99/16 / 2^6 >= 1/16 > 99/16 / 2^7
+EOF
+isolated() { # isolated FILE.vdag: how many voxels have none of their 26 neighbours
+    "$VDAG" export-voxels "$1" | python3 -c "
+import sys
+v = set(tuple(map(int, l.split()[:3])) for l in sys.stdin)
+print(sum(1 for (x, y, z) in v if not any((x + a, y + b, z + c) in v
+      for a in (-1, 0, 1) for b in (-1, 0, 1) for c in (-1, 0, 1) if a or b or c)))"
+}
+for f in sphere.xyz plate.ply; do
+    read -r s m l <"$T/${f%.*}.want"
+    rm -f "$T/pc.vdag"
+    "$VDAG" build "$T/$f" "$T/pc.vdag" 2>"$T/err"
+    check "a point cloud ($f) gets --levels $l from its median spacing $s, printed; no isolated voxel" sh -c "
+        grep -q '^vdag: point cloud: median spacing $s (of $m sampled points), extent .*: --levels $l (voxels of .*; override with --levels)\$' '$T/err' &&
+        '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": $l,' && [ '$(isolated "$T/pc.vdag")' = 0 ]"
+    check "--levels overrides a point cloud's level ($f), with no spacing line" sh -c "
+        '$VDAG' build '$T/$f' '$T/pc.vdag' --levels 9 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+        '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 9,'"
+done
+check "voxel lists and meshes keep their default levels, with no spacing line" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/pc.vdag' 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 5,' &&
+    '$VDAG' build '$T/sq_a.stl' '$T/pc.vdag' 2>'$T/err' && ! grep -q 'point cloud' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 10,'"
+check "a point cloud without two distinct points keeps level 10, saying so" sh -c "
+    printf '1.5 2 3\n1.5 2 3\n' >'$T/dup.xyz' && '$VDAG' build '$T/dup.xyz' '$T/pc.vdag' 2>'$T/err' &&
+    grep -q 'point cloud: no sampled point has a distinct neighbour near it: --levels 10' '$T/err' &&
+    '$VDAG' info '$T/pc.vdag' --json | grep -q '\"levels\": 10,'"
+
 # -- orientation: z up; a file's up axis (--up, default per format) is turned
 # to +z: y up (x, y, z) -> (x, -z, y), x up (x, y, z) -> (y, z, x); the
 # expected voxels are the rotated points fitted into the grid, computed here
@@ -302,6 +370,60 @@ import sys
 v = sorted(tuple(map(int, l.split()[:3])) for l in sys.stdin)
 assert v == sorted((x, 0, z) for x in range(8) for z in range(8)), v[:5]
 \""
+
+# -- the up axis is printed with its reason: --up; else an exporter the
+# file names, where its default axes are known (Blender's PLY add-on to 3.5
+# writes z up; its OBJ exporters and the PLY exporter of 3.6 on, y up); else
+# the format's default. A plate in the file's x-y plane lies flat (the layer
+# z = 0) when the file is z up, and stands (the layer y = 0) when y up.
+python3 - "$T" <<'EOF'
+import sys
+t = sys.argv[1]
+plate = [(0, 0, 0), (8, 0, 0), (8, 8, 0), (0, 8, 0)]
+def ply(comment):
+    return ("ply\nformat ascii 1.0\n" + comment + "element vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+            "element face 2\nproperty list uchar int vertex_indices\nend_header\n" +
+            "".join("%d %d %d\n" % v for v in plate) + "3 0 1 2\n3 0 2 3\n")
+def obj(comment):
+    return comment + "".join("v %d %d %d\n" % v for v in plate) + "f 1 2 3\nf 1 3 4\n"
+cases = [  # file, text, extra option, axis, the reason printed
+    ("b279.ply", ply("comment Created by Blender 2.79 (sub 0) - www.blender.org, source file: 'p.blend'\n"), "", "z",
+     'from the file: "comment Created by Blender 2.79 (sub 0) - www.blender.org, source file: ...";'
+     ' --up overrides'),
+    ("b402.ply", ply("comment Created in Blender version 4.0.2\n"), "", "y",
+     'from the file: "comment Created in Blender version 4.0.2"; --up overrides'),
+    ("hand.ply", ply("comment made by hand\n"), "", "y", "default for .ply; --up overrides"),
+    ("b36.obj", obj("# Blender 3.6.0\n# www.blender.org\n"), "", "y", 'from the file: "# Blender 3.6.0"; --up overrides'),
+    ("BOM.OBJ", "\ufeff" + obj("# Blender v2.93.0 OBJ File: 'a\x1bb\"c\u00e9'\r\n"), "", "y",
+     'from the file: "# Blender v2.93.0 OBJ File: \'a?b?c??\'"; --up overrides'),
+    ("max.obj", obj("# 3ds Max Wavefront OBJ Exporter v0.97b - (c)2007 guruware\n"), "", "y", "default for .obj; --up overrides"),
+    ("up.ply", ply("comment Created in Blender version 4.0.2\n"), "--up z", "z", "--up"),
+    ("bup.ply", ply("comment Created by Blender 2.79\n"), "--up y", "y", "--up"),
+]
+with open(t + "/upcases", "w") as f:
+    for name, text, opt, up, why in cases:
+        open(t + "/" + name, "w", encoding="utf-8").write(text)
+        open(t + "/" + name + ".want", "w").write("vdag: up axis: %s (%s)\n" % (up, why))
+        f.write("%s %s %s\n" % (name, up, opt))
+flat = sorted((x, y, 0) for x in range(8) for y in range(8))
+stand = sorted((x, 0, z) for x in range(8) for z in range(8))
+open(t + "/plate_z", "w").write("".join(sorted("%d %d %d\n" % v for v in flat)))
+open(t + "/plate_y", "w").write("".join(sorted("%d %d %d\n" % v for v in stand)))
+EOF
+bad=""
+while read -r f up opt; do
+    # shellcheck disable=SC2086
+    if ! "$VDAG" build "$T/$f" "$T/upc.vdag" --levels 3 $opt 2>"$T/err" || ! grep -Fxq -f "$T/$f.want" "$T/err" ||
+        [ "$(grep -c '^vdag: up axis' "$T/err")" != 1 ] ||
+        ! "$VDAG" export-voxels "$T/upc.vdag" | cut -d' ' -f1-3 | LC_ALL=C sort | cmp -s - "$T/plate_$up"; then
+        bad="$bad $f"
+    fi
+done <"$T/upcases"
+check "build prints the up axis and why (--up, the exporter the file names, the format's default), and turns it (wrong:$bad)" [ -z "$bad" ]
+check "the up axis of .stl and .xyz: z by default, printed" sh -c "
+    '$VDAG' build '$T/sq_a.stl' '$T/upc.vdag' --levels 3 2>'$T/err' && grep -Fxq 'vdag: up axis: z (default for .stl; --up overrides)' '$T/err' &&
+    '$VDAG' build '$T/in.xyz' '$T/upc.vdag' --levels 5 2>'$T/err' && grep -Fxq 'vdag: up axis: z (default for .xyz; --up overrides)' '$T/err' &&
+    '$VDAG' build '$T/in.xyz' '$T/upc.vdag' --levels 5 --quiet 2>'$T/err' && [ ! -s '$T/err' ]"
 
 # -- framing: a small model in a large grid fills the default view (more
 # than a tenth of the pixels), and is not clipped (no border pixel covered)
