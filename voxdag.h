@@ -5322,7 +5322,7 @@ static int voxdagi_write_new(const char *tmp, const uint8_t *data, size_t size, 
     FILE *f = fopen(tmp, "rb");
     int ok, e;
     (void)mode;
-    if (f) { /* taken: not ours */
+    if (f) { /* taken (the caller may remove a stale temporary and try again) */
         fclose(f);
 #ifdef EEXIST
         errno = EEXIST;

@@ -275,6 +275,21 @@ static int parse_numbers(int argc, char **argv, int *i, double *out, int count) 
     return 1;
 }
 
+/* Parses "WxH", each 1..16384 in decimal digits (no sign, no wrap-around
+   of long numbers). Returns 1 on success. */
+static int parse_size(const char *s, uint32_t *w, uint32_t *h) {
+    uint32_t v[2] = {0, 0};
+    int k;
+    for (k = 0; k < 2; k++) {
+        if (*s < '0' || *s > '9') return 0;
+        for (; *s >= '0' && *s <= '9'; s++)
+            if ((v[k] = 10 * v[k] + (uint32_t)(*s - '0')) > 16384) return 0;
+        if (!v[k] || *s++ != (k ? '\0' : 'x')) return 0;
+    }
+    *w = v[0], *h = v[1];
+    return 1;
+}
+
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
                                 "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet]";
@@ -292,9 +307,7 @@ int vdag_cmd_render(int argc, char **argv) {
     for (i = 3; i < argc; i++) {
         const char *a = argv[i];
         if (!strcmp(a, "--size") && i + 1 < argc) {
-            char tail;
-            if (sscanf(argv[++i], "%ux%u%c", &job.cam.w, &job.cam.h, &tail) != 2 || !job.cam.w || !job.cam.h ||
-                job.cam.w > 16384 || job.cam.h > 16384)
+            if (!parse_size(argv[++i], &job.cam.w, &job.cam.h))
                 return vdag_fail("render: --size takes WxH, 1..16384 each");
         } else if (!strcmp(a, "--eye")) {
             if (!parse_numbers(argc, argv, &i, eye, 3)) return vdag_fail("render: --eye takes 3 numbers");

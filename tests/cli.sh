@@ -444,6 +444,11 @@ check "info prints no negative zero (a y-up .obj turns z = 0 into -0)" sh -c "
     '$VDAG' info '$T/yup.vdag' --json >>'$T/out' && grep -q 'world box' '$T/out' && ! grep -q -- '-0\\b' '$T/out'"
 check "info names the grid world box and the occupied box" sh -c "'$VDAG' info '$T/sq.vdag' >'$T/info.txt' &&
     grep -q '^grid world box' '$T/info.txt' && grep -q '^occupied' '$T/info.txt' && ! grep -q '^bounds' '$T/info.txt'"
+check "render --size refuses sizes out of range, also past 2^32 (no wrap-around)" sh -c "
+    for s in 0x8 16385x8 4294967297x8 8x4294967304 8x 8x8x +8x8; do
+        ! '$VDAG' render '$T/small.vdag' '$T/size.png' --size \$s 2>/dev/null || exit 1
+    done
+    '$VDAG' render '$T/small.vdag' '$T/size.png' --size 16384x1 2>/dev/null"
 check "render: the default camera frames the occupied voxels" sh -c "'$VDAG' render '$T/small.vdag' '$T/small.png' --size 64x48 2>/dev/null &&
     python3 -c \"
 import struct, zlib
