@@ -1675,7 +1675,25 @@ static voxcolor_status voxcolori_check_opts(const voxcolor_encode_opts *o, voxco
    of the call. On the stack of that call; nothing is allocated. */
 #ifndef VOXCOLOR_NO_THREADS
 #if defined(_WIN32)
+/* Only what threads need, and no min/max macros in the includer's unit;
+   an includer's own choice of these two macros is kept. */
+#ifndef WIN32_LEAN_AND_MEAN
+#define WIN32_LEAN_AND_MEAN
+#define VOXCOLORI_LEAN_AND_MEAN
+#endif
+#ifndef NOMINMAX
+#define NOMINMAX
+#define VOXCOLORI_NOMINMAX
+#endif
 #include <windows.h>
+#ifdef VOXCOLORI_LEAN_AND_MEAN
+#undef WIN32_LEAN_AND_MEAN
+#undef VOXCOLORI_LEAN_AND_MEAN
+#endif
+#ifdef VOXCOLORI_NOMINMAX
+#undef NOMINMAX
+#undef VOXCOLORI_NOMINMAX
+#endif
 typedef CRITICAL_SECTION voxcolori_mutex;
 typedef CONDITION_VARIABLE voxcolori_cond;
 typedef HANDLE voxcolori_thread;

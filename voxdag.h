@@ -650,7 +650,25 @@ int fchmod(int fd, mode_t mode); /* POSIX; strict C99 headers (-std=c99) leave i
 #endif
 #ifndef VOXDAG_NO_THREADS
 #if defined(_WIN32)
+/* Only what threads need, and no min/max macros in the includer's unit;
+   an includer's own choice of these two macros is kept. */
+#ifndef WIN32_LEAN_AND_MEAN
+#define WIN32_LEAN_AND_MEAN
+#define VOXDAGI_LEAN_AND_MEAN
+#endif
+#ifndef NOMINMAX
+#define NOMINMAX
+#define VOXDAGI_NOMINMAX
+#endif
 #include <windows.h> /* Win32 threads (Vista and later): SRW locks, condition variables */
+#ifdef VOXDAGI_LEAN_AND_MEAN
+#undef WIN32_LEAN_AND_MEAN
+#undef VOXDAGI_LEAN_AND_MEAN
+#endif
+#ifdef VOXDAGI_NOMINMAX
+#undef NOMINMAX
+#undef VOXDAGI_NOMINMAX
+#endif
 typedef SRWLOCK voxdagi_lock_t;
 typedef CONDITION_VARIABLE voxdagi_cond_t;
 typedef HANDLE voxdagi_thread_t;
@@ -3670,7 +3688,7 @@ static void voxdagi_child_refs(const voxdag *d, uint32_t l, const uint8_t *rec, 
 }
 
 static uint64_t voxdagi_brick(const voxdag *d, uint64_t index) {
-    return voxdagi_le(d->bricks + 8 * index, 8);
+    return voxdagi_le_fast(d->bricks + 8 * index, 8);
 }
 
 /* Voxels below the node at byte OFFSET of inner level L whose level stores

@@ -37,3 +37,9 @@ int check_header_voxdag(voxdag_status status) {
 #endif
     return (int)opts.levels + (int)status + VOXDAG_VERSION;
 }
+
+/* On Windows the implementation includes <windows.h> lean and without the
+   min/max macros, and leaves neither switch defined behind it. */
+#if defined(_WIN32) && (defined(min) || defined(max) || defined(WIN32_LEAN_AND_MEAN) || defined(NOMINMAX))
+#error "<windows.h> leaked min/max, or its switches stayed defined"
+#endif
