@@ -1,18 +1,20 @@
 /* voxdag.h - symmetry-aware sparse voxel DAGs in one header.      version 0.1.0
 
    Builds a voxel scene into a sparse voxel DAG whose subtrees are shared when
-   they are equal up to a reflection along x, y and/or z (SSVDAG), with a voxel
-   count per node so that every voxel's index into a colour array is found on
-   the way down. The result is a compact byte image (the .vdag file format,
-   see FORMAT.md) that is queried in place.
+   they are equal up to one of the 48 symmetries of the cube (reflections and
+   axis permutations: the SSVDAG's mirrors, extended), with a voxel count per
+   node so that every voxel's index into a colour array is found on the way
+   down. The result is a compact byte image (the .vdag file format, see
+   FORMAT.md) that is queried in place, and ray cast.
 
    QUICK START
        #define VOXDAG_IMPLEMENTATION   // in exactly one C or C++ file
        #include "voxdag.h"
 
-       voxdag_build_opts opts = {0};
+       voxdag_build_opts opts;
+       memset(&opts, 0, sizeof opts);            // defaults (C and C++)
        opts.levels = 8;                          // a 256^3 grid
-       voxdag_builder *b; voxdag *dag; uint64_t index;
+       voxdag_builder *b; voxdag *dag; uint64_t index; uint8_t out_rgb[3];
        voxdag_builder_create(&opts, &b, NULL);
        uint32_t xyz[] = { 1,2,3,  4,5,6 };
        uint8_t  rgb[] = { 255,0,0,  0,255,0 };
@@ -29,7 +31,9 @@
    - Morton code: the octant numbers along the root-to-voxel path, root first.
    - Voxel index = rank of a full voxel's Morton code among all full voxels;
      colours are stored in this order.
-   - Reflection m in 0..7: bit a set mirrors axis a about the node's centre.
+   - Transform t in 0..47 (FORMAT.md, Transforms): perm * 8 + m, an axis
+     permutation, then mirrors m (bit a set mirrors axis a about the node's
+     centre); 0..7 are the reflections, 0 the identity.
 
    CONFIGURATION (define before including the implementation)
      VOXDAG_MALLOC(sz) / VOXDAG_FREE(p)  default allocator (define both or none)
