@@ -10,6 +10,14 @@
    vdag_import_limits.quiet). Coordinates stay in the file's own axes,
    except where a format's rules below say otherwise.
 
+   Polygons (.ply, .off, .obj, .ac) are triangulated in the plane of the
+   axis their Newell normal leans on most: a convex polygon as a fan from
+   its first corner, a concave one by ear clipping (n - 2 triangles either
+   way, corners in the polygon's order). A polygon that is degenerate (no
+   normal) or self-intersecting in that plane, or past a work limit of
+   about 2^28 point tests per file, is fan-triangulated, and the file gets
+   one warning with the number of such polygons.
+
    Formats, and the rules where they leave a choice:
    - .xyz: "x y z" or "x y z r g b" per line; '#' starts a comment. The
      first data line decides the number of values: every line must agree.
@@ -22,14 +30,14 @@
      lines with an unknown keyword are skipped with a warning. Vertex
      x y z, optional red green blue (integers 0..255, ushort 0..65535, or
      floats 0..1) and s t / u v texture coordinates; face vertex_indices
-     (or vertex_index) lists, fan-triangulated. Other elements and
+     (or vertex_index) lists, triangulated. Other elements and
      properties, lists included, are skipped. No faces: a point cloud.
    - .off: [ST][C][N]OFF headers; the counts may follow on the header line.
      COFF colours are 0..1 floats when written with a '.' or an exponent,
      else 0..255 integers (decided per vertex line). Text after a face's
      corners (a face colour) is ignored. No faces: a point cloud.
    - .obj: v (with "v x y z r g b" colours, 0..1), vt, f in every corner
-     form with negative (relative) indices; polygons fan-triangulated, lines
+     form with negative (relative) indices; polygons triangulated, lines
      and points ignored. One material per name given to usemtl, numbered by
      first use, white until a library (mtllib, read from BASE_DIR) gives its
      Kd and map_Kd; Kd values 0..1 map straight to 0..255. A map_Kd texture
@@ -135,7 +143,7 @@ typedef struct vdag_scene {
     uint8_t *point_rgb;  /* 3 per point, or NULL when the file has no colours */
     int points_are_voxels; /* 1: integer grid coordinates, used as they are */
 
-    /* Triangles (polygons are fan-triangulated). */
+    /* Triangles (polygons are triangulated: see the top of this file). */
     size_t vertex_count;
     double *positions;   /* 3 per vertex */
     uint8_t *vertex_rgb; /* 3 per vertex, or NULL */

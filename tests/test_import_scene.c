@@ -1,6 +1,6 @@
 /* Game-scene importer tests (.spm, .ac): files written here from random
    scenes round-trip to the scene the test expects (axes turned to z up,
-   AC3D transforms applied, fans triangulated), textures are found where
+   AC3D transforms applied, polygons triangulated), textures are found where
    the formats put them, and broken files (cut at every length, patched
    bytes, bad counts, indices out of range, NaN) fail with one-line messages. */
 #define _POSIX_C_SOURCE 200809L
@@ -397,9 +397,11 @@ static void test_ac_roundtrip(void) {
                                   s.positions[3 * (nv + k) + 2] == want[2],
                               "object %zu corner %zu", o, k);
                 }
-                for (k = 1; k + 1 < n && nt < s.triangle_count; k++, nt++) {
-                    CHECK(s.indices[3 * nt] == nv && s.indices[3 * nt + 1] == nv + k &&
-                          s.indices[3 * nt + 2] == nv + k + 1);
+                for (k = 1; k + 1 < n && nt < s.triangle_count; k++, nt++) { /* corners of the polygon, in order */
+                    const uint32_t *g = &s.indices[3 * nt];
+                    size_t c0 = g[0] - nv, c1 = g[1] - nv, c2 = g[2] - nv;
+                    CHECK(g[0] >= nv && g[1] >= nv && g[2] >= nv && c0 < n && c1 < n && c2 < n && c0 != c1 &&
+                          c1 != c2 && c0 != c2 && (c1 + n - c0) % n + (c2 + n - c1) % n + (c0 + n - c2) % n == n);
                     CHECK(s.triangle_material[nt] == want_mat);
                 }
                 nv += n;
