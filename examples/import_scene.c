@@ -28,7 +28,8 @@
      numvert vertex lines; numsurf surfaces (SURF flags, mat, refs n, then n
      "index u v" lines). Polygons (type nibble 0) are triangulated as in
      .obj (import.h), each corner its own vertex; lines (types 1, 2) and
-     other types are skipped.
+     other types are skipped. "subdiv N" with N > 0 gets a warning: the
+     object is imported unsubdivided, as its control mesh.
      One scene material per distinct (MATERIAL, texture) pair, in order of
      first use. Textures are read beside the file. Unknown object lines are
      ignored; kids nest at most VI_AC_MAX_DEPTH deep. Placed positions
@@ -337,6 +338,7 @@ typedef struct vs_ac {
     vi_buf pos, uv, tris, tmat, verts, poly;
     vi_texcache cache;
     int32_t last; /* scene material of the last surface, or -1 */
+    uint64_t subdiv, subdiv_line; /* objects with subdiv N > 0, the first one's line */
 } vs_ac;
 
 /* The next line of T (no comment syntax); 0 at the end. */
@@ -490,6 +492,10 @@ static int vs_ac_object(vs_ac *a, const double pm[9], const double pt[3], int de
             }
             if (!vi_len(name) || vi_is(name, "empty_texture_no_mapping") || !a->c->base_dir) continue;
             if (!vi_texture(a->c, a->out, &a->cache, a->c->base_dir, name, &image)) return 0;
+        } else if (vi_is(kw, "subdiv")) {
+            uint32_t n;
+            if (!vs_count(&line, INT32_MAX, &n)) return vs_ac_fail(a, "bad subdiv count");
+            if (n && !a->subdiv++) a->subdiv_line = a->t.line;
         } else if (vi_is(kw, "data")) {
             uint32_t n;
             if (!vs_count(&line, (int64_t)(a->t.end - a->t.p), &n)) return vs_ac_fail(a, "bad data length");
@@ -616,6 +622,10 @@ static int vi_parse_ac(vi_ctx *c, vi_text *text, vdag_scene *out) {
         free(out->triangle_material);
         out->triangle_material = NULL;
     }
+    if (a.subdiv)
+        vi_warn(c, "%llu object%s subdiv > 0 (the first on line %llu): subdivision surfaces are imported "
+                "unsubdivided, as their control mesh", (vi_ull)a.subdiv, a.subdiv == 1 ? " has" : "s have",
+                (vi_ull)a.subdiv_line);
     ok = 1;
 done:
     vi_buf_free(&a.mats);

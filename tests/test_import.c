@@ -594,30 +594,6 @@ static void test_obj_points(void) {
 
 // -- Polygons: concave ones clipped into ears, bad ones fanned with a warning
 
-/* Imports DATA as EXT with warnings on, returning what went to stderr in
-   WARN (truncated to WARN_SIZE); the result goes to S (freed by the caller
-   when the import succeeded). */
-static int import_warnings(const char *ext, const bytes *data, vdag_scene *s, char *err, size_t err_size, char *warn,
-                           size_t warn_size) {
-    FILE *tmp = tmpfile();
-    int saved = dup(2), ok;
-    size_t n = 0;
-    warn[0] = 0;
-    CHECK(tmp != NULL && saved >= 0);
-    if (!tmp || saved < 0) return 0;
-    fflush(stderr);
-    dup2(fileno(tmp), 2);
-    ok = vdag_import_memory(ext, data->p, data->n, NULL, NULL, s, err, err_size);
-    fflush(stderr);
-    dup2(saved, 2);
-    close(saved);
-    rewind(tmp);
-    n = fread(warn, 1, warn_size - 1, tmp);
-    warn[n] = 0;
-    fclose(tmp);
-    return ok;
-}
-
 /* A comb in the plane z = 0.5: a base [1.5, 62.5] x [1.5, 4.5] with 16 teeth
    1 wide and 4 apart up to y = 20.5; 64 corners, counter-clockwise, every
    coordinate a half-integer. Its fan from the first corner covers the gaps

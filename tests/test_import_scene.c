@@ -428,6 +428,36 @@ static void test_ac_sweep(void) {
     free(b.p);
 }
 
+/* "subdiv N" with N > 0 warns, once per file, that the objects are imported
+   as their control meshes; subdiv 0 says nothing, and the mesh is the same. */
+static void test_ac_subdiv_warns(void) {
+    static const char *const subdiv[] = {"", "subdiv 0\n", "subdiv 2\n"};
+    int k;
+    for (k = 0; k < 3; k++) {
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256], warn[512];
+        int obj;
+        putf(&b, "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT world\nkids 2\n");
+        for (obj = 0; obj < 2; obj++)
+            putf(&b, "OBJECT poly\n%snumvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
+                     "0 0 0\n1 0 0\n2 0 0\n3 0 0\nkids 0\n",
+                 subdiv[k]);
+        if (!import_warnings("ac", &b, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            const char *w = strstr(warn, "warning: ac: 2 objects have subdiv > 0 (the first on line 6): subdivision "
+                                         "surfaces are imported unsubdivided, as their control mesh");
+            CHECK(s.triangle_count == 4 && s.vertex_count == 8);
+            if (k < 2) CHECK_MSG(!warn[0], "subdiv %d: warned \"%s\"", k, warn);
+            else CHECK_MSG(w && !strstr(w + 1, "warning"), "warned \"%s\"", warn);
+            vdag_scene_free(&s);
+        }
+        free(b.p);
+    }
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nsubdiv x\nkids 0\n", "line 3: bad subdiv count");
+}
+
 static void test_ac_errors(void) {
     static const char obj[] = "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT poly\nnumvert 3\n0 0 0\n1 0 0\n0 1 0\n";
     char text[512];
@@ -586,6 +616,7 @@ const test_case test_import_scene_cases[] = {
     {"import_scene/ac roundtrip", test_ac_roundtrip},
     {"import_scene/ac sweep", test_ac_sweep},
     {"import_scene/ac errors", test_ac_errors},
+    {"import_scene/ac subdiv warns", test_ac_subdiv_warns},
     {"import_scene/texture files", test_scene_files},
     {NULL, NULL},
 };
