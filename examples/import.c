@@ -2338,7 +2338,15 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             memcpy(model->size, size_xyz, sizeof size_xyz);
             model->count = count;
             model->voxels = vi_take(&body, (size_t)count * 4);
-            for (model->solid = 0, i = 0; i < count; i++) model->solid += model->voxels[4 * i + 3] != 0;
+            for (model->solid = 0, i = 0; i < count; i++) {
+                const uint8_t *v = model->voxels + 4 * i;
+                model->solid += v[3] != 0;
+                if (v[3] && (v[0] >= size_xyz[0] || v[1] >= size_xyz[1] || v[2] >= size_xyz[2])) {
+                    /* checked here too, as a model may not be placed (one frame of several) */
+                    vi_fail(c, "byte %llu: a voxel lies outside its model's size", (vi_ull)at);
+                    goto done;
+                }
+            }
             have_size = 0;
         } else if (!memcmp(id, "RGBA", 4)) { /* 256 entries; shorter ones, as some tools write, are padded */
             palette = body.data;
@@ -2371,6 +2379,11 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     /* Colour index k + 1 is palette entry k. */
     vi_vox_default_palette(pal);
     for (i = 0; palette && i < palette_entries; i++) memcpy(pal[i], palette + 4 * i, 3);
+    if (nodes.count && c->limits.vox_model) {
+        vi_fail(c, "model %llu asked for, but the file has a scene graph, which places its models",
+                (vi_ull)c->limits.vox_model);
+        goto done;
+    }
     if (nodes.count) {
         const vi_vox_node *sorted = (const vi_vox_node *)nodes.data;
         qsort(nodes.data, nodes.count, sizeof(vi_vox_node), vi_i32_order);
@@ -2387,14 +2400,25 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             !vi_vox_reserve(c, solid, &pts, &rgb) ||
             !vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb, &listed, &solid))
             goto done;
-    } else { /* no scene graph: every model at the origin */
+    } else { /* no scene graph: one model (of several, animation frames) at the origin */
         vi_xform id;
         vi_identity(&id);
-        for (i = 0; i < models.count; i++) solid += ((const vi_vox_model *)models.data)[i].solid;
-        if (!vi_vox_reserve(c, solid, &pts, &rgb)) goto done;
-        for (i = 0; i < models.count; i++)
-            if (!vi_vox_place(c, &((const vi_vox_model *)models.data)[i], &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
+        if (models.count > 1 || c->limits.vox_model) {
+            if (c->limits.vox_model >= models.count) {
+                vi_fail(c, "model %llu asked for, but the file holds %llu model%s (numbered from 0)",
+                        (vi_ull)c->limits.vox_model, (vi_ull)models.count, models.count == 1 ? "" : "s");
                 goto done;
+            }
+            vi_warn(c, "%llu models and no scene graph (animation frames?): model %llu imported; "
+                       "--vox-model N (0..%llu) picks another",
+                    (vi_ull)models.count, (vi_ull)c->limits.vox_model, (vi_ull)models.count - 1);
+        }
+        if (models.count) {
+            const vi_vox_model *model = (const vi_vox_model *)models.data + c->limits.vox_model;
+            if (!vi_vox_reserve(c, model->solid, &pts, &rgb) ||
+                !vi_vox_place(c, model, &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
+                goto done;
+        }
     }
 
     /* Shift so that the smallest coordinate on each axis is 0. */

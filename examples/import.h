@@ -57,8 +57,10 @@
      tools write 1020 bytes: entry 255 is never used). With a scene graph (nTRN, nGRP, nSHP from node 0, first
      animation frame), each model's centre sits at its transform's origin:
      voxel v fills the cell holding R (v + 1/2 - size/2) + t, rounded down
-     where that lands on a cell corner; without one, models keep their own
-     coordinates. Axes stay MagicaVoxel's (z up, as in the vdag tool), and
+     where that lands on a cell corner. Without one, a file of one model
+     gives that model in its own coordinates; a file of several (animation
+     frames) gives one, vdag_import_limits.vox_model (the first by default),
+     with a warning that names the count. Axes stay MagicaVoxel's (z up, as in the vdag tool), and
      the result is shifted so each axis starts at 0. A model
      shown by several shapes appears once per shape; hidden nodes and nodes
      on hidden layers are left out, as in MagicaVoxel's exports. */
@@ -97,6 +99,11 @@ typedef struct vdag_import_limits {
     uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
     uint64_t max_texture_pixels; /* 0: VDAG_IMPORT_MAX_TEXTURE_PIXELS (all textures) */
     uint64_t max_vox_voxels;  /* 0: VDAG_IMPORT_MAX_VOX_VOXELS (a .vox scene graph) */
+    uint32_t vox_model;       /* a .vox with several models and no scene graph
+                                 (animation frames): the model imported, from 0
+                                 (0: the first, with a warning naming the count);
+                                 past the last, or nonzero with a scene graph,
+                                 an error */
     int skip_textures;        /* 1: do not decode texture images (materials keep
                                  their colours; for callers that need no colours) */
     int quiet;                /* 1: no warnings on stderr (what an import

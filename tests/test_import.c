@@ -1403,6 +1403,10 @@ static void check_voxels(const vdag_scene *s, voxel *want, size_t n) {
 }
 
 /* Two models, no scene graph: voxels keep their model coordinates. */
+/* Two models and no scene graph (animation frames): the first is imported,
+   with a warning naming the count; vox_model picks the other; a number past
+   the last is an error naming the count; a file with a scene graph refuses
+   any but 0. */
 static void test_vox_models(void) {
     uint64_t seed = 8;
     vox_model m[2];
@@ -1410,8 +1414,9 @@ static void test_vox_models(void) {
     voxel want[80];
     bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
     vdag_scene s;
-    char err[256];
-    size_t i, k, n = 0;
+    vdag_import_limits pick;
+    char err[256], warn[512];
+    size_t i, k, n;
     for (i = 0; i < sizeof palette; i++) palette[i] = (uint8_t)test_rand_below(&seed, 256);
     put_le32(&c, 2);
     vox_chunk(&body, "PACK", &c, 0);
@@ -1423,8 +1428,10 @@ static void test_vox_models(void) {
     put(&c, palette, sizeof palette);
     vox_chunk(&body, "RGBA", &c, 0);
     vox_file(&file, &body, 150);
-    for (i = 0; i < 2; i++)
-        for (k = 0; k < m[i].n; k++) {
+    memset(&pick, 0, sizeof pick);
+    pick.quiet = 1;
+    for (i = 0; i < 2; i++) {
+        for (n = k = 0; k < m[i].n; k++) {
             if (!m[i].v[k][3]) continue;
             want[n].p[0] = m[i].v[k][0];
             want[n].p[1] = m[i].v[k][1];
@@ -1432,13 +1439,53 @@ static void test_vox_models(void) {
             memcpy(want[n].rgb, &palette[4 * (m[i].v[k][3] - 1)], 3); /* index i is entry i - 1 */
             n++;
         }
-    if (!import("vox", &file, &s, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
-    } else {
+        if (i == 0 && !import_warnings("vox", &file, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "%s", err);
+            continue;
+        }
+        pick.vox_model = (uint32_t)i;
+        if (i == 1 && !vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err)) {
+            CHECK_MSG(0, "model 1: %s", err);
+            continue;
+        }
+        if (i == 0)
+            CHECK_MSG(strstr(warn, "warning: vox: 2 models and no scene graph (animation frames?): model 0 imported; "
+                                   "--vox-model N (0..1) picks another") != NULL,
+                      "warned \"%s\"", warn);
         check_voxels(&s, want, n);
         vdag_scene_free(&s);
     }
+    pick.vox_model = 2;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "model 2 asked for, but the file holds 2 models (numbered from 0)") != NULL, "%s", err);
+    CHECK(!s.points && !s.point_count);
     sweep("vox", &file, 1);
+    /* One model: no warning; model 1 of it is an error. */
+    body.n = file.n = 0;
+    vox_models(&body, m, 1);
+    vox_file(&file, &body, 150);
+    if (!import_warnings("vox", &file, &s, err, sizeof err, warn, sizeof warn)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK_MSG(!warn[0], "warned \"%s\"", warn);
+        CHECK(s.point_count == m[0].n);
+        vdag_scene_free(&s);
+    }
+    pick.vox_model = 1;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "the file holds 1 model (numbered from 0)") != NULL, "%s", err);
+    /* A scene graph places the models: picking one is refused. */
+    body.n = file.n = 0;
+    vox_models(&body, m, 2);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    vox_shape(&body, 1, 1);
+    vox_file(&file, &body, 150);
+    pick.vox_model = 0;
+    if (!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err)) CHECK_MSG(0, "%s", err);
+    else vdag_scene_free(&s);
+    pick.vox_model = 1;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "the file has a scene graph") != NULL, "%s", err);
     free(body.p);
     free(file.p);
     free(c.p);
@@ -1844,7 +1891,7 @@ const test_case test_import_cases[] = {
     {"import/obj file with mtl and texture", test_obj_file},
     {"import/file errors", test_file_errors},
     {"import/limits", test_limits},
-    {"import/vox models", test_vox_models},
+    {"import/vox models: one of several frames, picked", test_vox_models},
     {"import/vox default palette", test_vox_default_palette},
     {"import/vox scene graph", test_vox_scene_graph},
     {"import/vox errors", test_vox_errors},
