@@ -33,6 +33,10 @@ void *VDAG_IMPORT_REALLOC(void *ptr, size_t size);
 /* Larger coordinate magnitudes are rejected so that bounding boxes and their
    extents stay finite. */
 #define VI_MAX_COORD 1e30
+/* Point tests allowed for triangulating the concave polygons of one file
+   (ear clipping is quadratic in a polygon's corners): past it, polygons are
+   fan-triangulated with a warning. About a second of work. */
+#define VI_EAR_BUDGET ((uint64_t)1 << 28)
 /* "No index" in 32-bit index fields. */
 #define VI_NONE UINT32_MAX
 
@@ -50,6 +54,9 @@ typedef struct vi_ctx {
     size_t err_size;
     const char *base_dir; /* resolves .mtl and texture paths; NULL: no file access */
     vdag_import_limits limits; /* every field set */
+    uint64_t ear_budget;  /* point tests left for triangulating concave polygons */
+    uint64_t polys_bad;   /* polygons fan-triangulated: degenerate or self-intersecting */
+    uint64_t polys_costly; /* polygons fan-triangulated: past ear_budget */
 } vi_ctx;
 
 /* C for one import: the message target and LIMITS with defaults filled in. */
@@ -59,6 +66,8 @@ static void vi_ctx_init(vi_ctx *c, const char *format, char *err, size_t err_siz
     c->err = err;
     c->err_size = err_size;
     c->base_dir = NULL;
+    c->ear_budget = VI_EAR_BUDGET;
+    c->polys_bad = c->polys_costly = 0;
     memset(&c->limits, 0, sizeof c->limits);
     if (limits) c->limits = *limits;
     if (!c->limits.max_input_bytes) c->limits.max_input_bytes = VDAG_IMPORT_MAX_INPUT_BYTES;
@@ -330,6 +339,187 @@ static int vi_fan(vi_ctx *c, vi_buf *tris, const void *poly, size_t n, size_t el
         memcpy(t + 2 * elem, p + (i + 1) * elem, elem);
     }
     return 1;
+}
+
+// -- Polygons
+
+/* Twice the signed area of 2D triangle ABC: positive when counter-clockwise. */
+static double vi_cross2(const double *a, const double *b, const double *c) {
+    return (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+}
+
+/* 1 if 2D segments AB and CD cross, each one's ends strictly on either side
+   of the other's line. */
+static int vi_crosses(const double *a, const double *b, const double *c, const double *d) {
+    double d1 = vi_cross2(a, b, c), d2 = vi_cross2(a, b, d), d3 = vi_cross2(c, d, a), d4 = vi_cross2(c, d, b);
+    return ((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0));
+}
+
+/* Ear clipping of the counter-clockwise 2D polygon XY (N corners): appends
+   triangles of corners from POLY (ELEM bytes each) to TRIS. Returns 1 on
+   success, 0 if the polygon is not simple or no ear is found (TRIS may hold
+   part of the triangles), -1 past the work budget, -2 on allocation failure.
+   NEXT and PREV hold N entries of scratch. */
+static int vi_ears(vi_ctx *c, vi_buf *tris, const char *poly, size_t n, size_t elem, const double *xy, size_t *next,
+                   size_t *prev) {
+    size_t i, j, left = n, misses = 0;
+    /* Simple: no two edges cross. */
+    if ((uint64_t)n * n / 2 > c->ear_budget) return -1;
+    c->ear_budget -= (uint64_t)n * n / 2;
+    for (i = 0; i < n; i++)
+        for (j = i + 2; j < n; j++)
+            if ((i || j + 1 < n) && vi_crosses(&xy[2 * i], &xy[2 * (i + 1)], &xy[2 * j], &xy[2 * ((j + 1) % n)]))
+                return 0;
+    for (i = 0; i < n; i++) {
+        next[i] = (i + 1) % n;
+        prev[i] = (i + n - 1) % n;
+    }
+    for (i = 0; left >= 3;) {
+        size_t p = prev[i], q = next[i];
+        const double *a = &xy[2 * p], *b = &xy[2 * i], *d = &xy[2 * q];
+        double cr = vi_cross2(a, b, d);
+        int ear = left == 3 || cr > 0 ||
+                  (cr == 0 && (b[0] - a[0]) * (d[0] - b[0]) + (b[1] - a[1]) * (d[1] - b[1]) > 0); /* straight on */
+        if (ear && cr > 0 && left > 3)
+            for (j = next[q]; j != p; j = next[j]) {
+                const double *e = &xy[2 * j];
+                if (!c->ear_budget) return -1;
+                c->ear_budget--;
+                if ((e[0] == a[0] && e[1] == a[1]) || (e[0] == b[0] && e[1] == b[1]) || (e[0] == d[0] && e[1] == d[1]))
+                    continue;
+                if (vi_cross2(a, b, e) >= 0 && vi_cross2(b, d, e) >= 0 && vi_cross2(d, a, e) >= 0) {
+                    ear = 0;
+                    break;
+                }
+            }
+        if (ear) {
+            char *t = (char *)vi_push(c, tris, elem, 3);
+            if (!t) return -2;
+            memcpy(t, poly + p * elem, elem);
+            memcpy(t + elem, poly + i * elem, elem);
+            memcpy(t + 2 * elem, poly + q * elem, elem);
+            if (left == 3) return 1;
+            next[p] = q;
+            prev[q] = p;
+            left--;
+            i = p; /* P may have become an ear */
+            misses = 0;
+        } else {
+            if (++misses > left) return 0;
+            i = q;
+        }
+    }
+    return 1;
+}
+
+/* Appends a triangulation of polygon POLY (N corners of ELEM bytes) to TRIS,
+   three corners per triangle, N - 2 triangles in all. A corner's vertex is
+   its uint32 (ELEM 4) or the high half of its uint64 (ELEM 8), a position in
+   POS (3 per vertex); POS NULL: the fan. Polygons are projected onto the
+   plane of the axis their Newell normal leans on most; convex ones get the
+   fan (from the first corner), others ear clipping. A polygon that is
+   degenerate (no normal) or self-intersecting in that plane, or that would
+   take the file past VI_EAR_BUDGET, gets the fan and is counted for a
+   warning (vi_poly_warn). Returns 0 only on allocation failure. */
+static int vi_poly(vi_ctx *c, vi_buf *tris, const void *poly, size_t n, size_t elem, const double *pos) {
+    const char *p = (const char *)poly;
+    double nrm[3] = {0, 0, 0}, *xy = NULL, turn = 0, s;
+    size_t *link = NULL, i, before = tris->count;
+    int axis, u, w, convex = 1, r;
+    if (n <= 3 || !pos) return vi_fan(c, tris, poly, n, elem);
+#define VI_CORNER(k) (pos + 3 * (size_t)(elem == 4 ? *(const uint32_t *)(const void *)(p + (k) * elem) \
+                                                   : (uint32_t)(*(const uint64_t *)(const void *)(p + (k) * elem) >> 32)))
+    for (i = 0; i < n; i++) { /* Newell's normal */
+        const double *a = VI_CORNER(i), *b = VI_CORNER((i + 1) % n);
+        nrm[0] += (a[1] - b[1]) * (a[2] + b[2]);
+        nrm[1] += (a[2] - b[2]) * (a[0] + b[0]);
+        nrm[2] += (a[0] - b[0]) * (a[1] + b[1]);
+    }
+    axis = fabs(nrm[0]) >= fabs(nrm[1]) && fabs(nrm[0]) >= fabs(nrm[2]) ? 0 : fabs(nrm[1]) >= fabs(nrm[2]) ? 1 : 2;
+    if (!(fabs(nrm[axis]) > 0) || !(fabs(nrm[axis]) < HUGE_VAL)) {
+        c->polys_bad++;
+        return vi_fan(c, tris, poly, n, elem);
+    }
+    u = (axis + 1) % 3;
+    w = (axis + 2) % 3;
+    s = nrm[axis] > 0 ? 1 : -1; /* flips the first coordinate: counter-clockwise */
+    if (n > SIZE_MAX / (2 * sizeof(double) + 2 * sizeof(size_t)) ||
+        !(xy = (double *)VDAG_IMPORT_REALLOC(NULL, n * (2 * sizeof(double) + 2 * sizeof(size_t)))))
+        return vi_fail(c, "out of memory");
+    link = (size_t *)(void *)(xy + 2 * n);
+    for (i = 0; i < n; i++) {
+        const double *a = VI_CORNER(i);
+        xy[2 * i] = s * a[u];
+        xy[2 * i + 1] = a[w];
+    }
+#undef VI_CORNER
+    for (i = 0; i < n && convex; i++) { /* left turns only, once around */
+        const double *a = &xy[2 * ((i + n - 1) % n)], *b = &xy[2 * i], *d = &xy[2 * ((i + 1) % n)];
+        double e0 = b[0] - a[0], e1 = b[1] - a[1], f0 = d[0] - b[0], f1 = d[1] - b[1];
+        double cr = e0 * f1 - e1 * f0;
+        convex = cr >= 0;
+        turn += atan2(cr, e0 * f0 + e1 * f1);
+    }
+    if (convex && fabs(turn - 2 * 3.14159265358979323846) < 1) {
+        free(xy);
+        return vi_fan(c, tris, poly, n, elem);
+    }
+    r = vi_ears(c, tris, p, n, elem, xy, link, link + n);
+    free(xy);
+    if (r == -2) return 0;
+    if (r == 1) return 1;
+    if (r == 0) c->polys_bad++;
+    else c->polys_costly++;
+    tris->count = before;
+    return vi_fan(c, tris, poly, n, elem);
+}
+
+/* Notes in LATE (pairs of size_t) that the polygon of N corners whose fan
+   starts at corner FIRST of TRIS was triangulated before its positions were
+   read; a no-op for triangles. Returns 0 only on allocation failure. */
+static int vi_poly_note(vi_ctx *c, vi_buf *late, size_t first, size_t n) {
+    size_t *l;
+    if (n <= 3) return 1;
+    if (!(l = (size_t *)vi_push(c, late, sizeof *l, 2))) return 0;
+    l[0] = first;
+    l[1] = n;
+    return 1;
+}
+
+/* Triangulates again, by vi_poly with positions POS, the polygons that
+   vi_poly_note listed in LATE: each fan gives back its polygon (the first
+   triangle's corners, then each later triangle's last corner) and is
+   overwritten in place. Every corner must be in range of POS. Returns 0
+   only on allocation failure. */
+static int vi_poly_late(vi_ctx *c, vi_buf *tris, size_t elem, const vi_buf *late, const double *pos) {
+    vi_buf poly = {NULL, 0, 0};
+    size_t i, j;
+    int ok = 1;
+    for (i = 0; ok && i < late->count; i += 2) {
+        const size_t *l = (const size_t *)late->data + i;
+        char *q;
+        poly.count = 0;
+        if (!(q = (char *)vi_push(c, &poly, elem, l[1]))) ok = 0;
+        for (j = 0; ok && j < l[1]; j++)
+            memcpy(q + j * elem, (const char *)tris->data + (l[0] + (j < 3 ? j : 3 * (j - 2) + 2)) * elem, elem);
+        j = tris->count;
+        if (ok && (ok = vi_poly(c, tris, q, l[1], elem, pos)) != 0) {
+            memcpy((char *)tris->data + l[0] * elem, (const char *)tris->data + j * elem, (tris->count - j) * elem);
+            tris->count = j;
+        }
+    }
+    vi_buf_free(&poly);
+    return ok;
+}
+
+/* The warning for the polygons vi_poly fan-triangulated as a fallback. */
+static void vi_poly_warn(vi_ctx *c) {
+    if (c->polys_bad)
+        vi_warn(c, "%llu polygon%s degenerate or self-intersecting; fan-triangulated", (vi_ull)c->polys_bad,
+                c->polys_bad == 1 ? " was" : "s were");
+    if (c->polys_costly)
+        vi_warn(c, "%llu concave polygon%s past the triangulation work limit; fan-triangulated",
+                (vi_ull)c->polys_costly, c->polys_costly == 1 ? "" : "s");
 }
 
 /* A mesh without faces is a point cloud: its vertices become the points. */
@@ -655,7 +845,9 @@ static double vi_ply_colour_scale(int type) {
 static int vi_parse_ply(vi_ctx *c, vi_text *t, vdag_scene *out) {
     vi_ply p;
     vi_buf elems = {NULL, 0, 0}, props = {NULL, 0, 0}, poly = {NULL, 0, 0}, tris = {NULL, 0, 0};
+    vi_buf late = {NULL, 0, 0}; /* faces read before the vertices: size_t first corner in tris, corner count */
     vi_ply_elem *vertex = NULL, *face = NULL;
+    int have_pos = 0;
     vi_ply_prop *prop;
     double colour_scale = 1.0;
     int has[VI_ROLE_COUNT] = {0};
@@ -745,7 +937,9 @@ static int vi_parse_ply(vi_ctx *c, vi_text *t, vdag_scene *out) {
             double vals[VI_ROLE_COUNT];
             if (!vi_ply_item(&p, prop, e, vals, &poly)) goto done;
             if (e == face) {
-                if (!vi_fan(c, &tris, poly.data, poly.count, sizeof(uint32_t))) goto done;
+                if (!have_pos && !vi_poly_note(c, &late, tris.count, poly.count)) goto done;
+                if (!vi_poly(c, &tris, poly.data, poly.count, sizeof(uint32_t), have_pos ? out->positions : NULL))
+                    goto done;
             } else if (e == vertex) {
                 double *pos = &out->positions[3 * k];
                 for (j = 0; j < 3; j++) {
@@ -771,10 +965,13 @@ static int vi_parse_ply(vi_ctx *c, vi_text *t, vdag_scene *out) {
                     }
             }
         }
+        have_pos |= e == vertex;
     }
+    if (!vi_poly_late(c, &tris, sizeof(uint32_t), &late, out->positions)) goto done;
     vi_set_triangles(out, &tris);
     ok = 1;
 done:
+    vi_buf_free(&late);
     vi_buf_free(&elems);
     vi_buf_free(&props);
     vi_buf_free(&poly);
@@ -864,7 +1061,7 @@ static int vi_parse_off(vi_ctx *c, vi_text *t, vdag_scene *out) {
             if (!(q = (uint32_t *)vi_push(c, &poly, sizeof *q, 1))) goto done;
             *q = (uint32_t)k;
         }
-        if (!vi_fan(c, &tris, poly.data, poly.count, sizeof(uint32_t))) goto done;
+        if (!vi_poly(c, &tris, poly.data, poly.count, sizeof(uint32_t), out->positions)) goto done;
     }
     vi_set_triangles(out, &tris);
     ok = 1;
@@ -1446,6 +1643,7 @@ typedef struct vi_obj {
     vi_buf corners;      /* uint64 per triangle corner: v << 32 | vt (VI_NONE: none) */
     vi_buf tri_mat;      /* int32 per triangle */
     vi_buf poly;         /* corners of the face being read */
+    vi_buf late;         /* faces naming vertices not yet read (vi_poly_note) */
     vi_buf names;        /* vi_span per material named by usemtl, first use first */
     vi_map name_map;
     vi_buf mtllibs;      /* vi_span per mtllib line */
@@ -1529,7 +1727,7 @@ static int vi_obj_texcoord(vi_obj *o, vi_span line, uint64_t lineno) {
     return 1;
 }
 
-/* "f v v/vt v//vn v/vt/vn ...": a polygon, fan-triangulated. */
+/* "f v v/vt v//vn v/vt/vn ...": a polygon, triangulated by vi_poly. */
 static int vi_obj_face(vi_obj *o, vi_span line, uint64_t lineno) {
     vi_span tok;
     int32_t *m;
@@ -1554,7 +1752,11 @@ static int vi_obj_face(vi_obj *o, vi_span line, uint64_t lineno) {
         *q = (uint64_t)v << 32 | t;
     }
     if (o->poly.count < 3) return 1; /* a point or a line: nothing to voxelize */
-    if (!vi_fan(o->c, &o->corners, o->poly.data, o->poly.count, sizeof(uint64_t))) return 0;
+    for (i = 0; i < o->poly.count && ((const uint64_t *)o->poly.data)[i] >> 32 < o->pos.count / 3; i++) {}
+    if (i < o->poly.count && !vi_poly_note(o->c, &o->late, o->corners.count, o->poly.count)) return 0;
+    if (!vi_poly(o->c, &o->corners, o->poly.data, o->poly.count, sizeof(uint64_t),
+                 i < o->poly.count ? NULL : (const double *)o->pos.data))
+        return 0;
     if (!(m = (int32_t *)vi_push(o->c, &o->tri_mat, sizeof *m, o->poly.count - 2))) return 0;
     for (i = 0; i + 2 < o->poly.count; i++) m[i] = o->material;
     return 1;
@@ -1612,6 +1814,8 @@ static int vi_obj_mesh(vi_obj *o, vdag_scene *out) {
         if (t != VI_NONE && t >= nvt)
             return vi_fail(c, "a face uses texture coordinate %llu of %llu", (vi_ull)t + 1, (vi_ull)nvt);
     }
+    if (!vi_poly_late(c, &o->corners, sizeof(uint64_t), &o->late, (const double *)o->pos.data)) return 0;
+    corner = (const uint64_t *)o->corners.data;
     if (!n || !o->any_vt) { /* the "v" lines are the vertices */
         out->vertex_count = npos;
         out->positions = (double *)o->pos.data;
@@ -1759,6 +1963,7 @@ static int vi_parse_obj(vi_ctx *c, vi_text *t, vdag_scene *out) {
     vi_buf_free(&o.rgb);
     vi_buf_free(&o.vt);
     vi_buf_free(&o.corners);
+    vi_buf_free(&o.late);
     vi_buf_free(&o.tri_mat);
     vi_buf_free(&o.poly);
     vi_buf_free(&o.names);
@@ -2133,7 +2338,15 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             memcpy(model->size, size_xyz, sizeof size_xyz);
             model->count = count;
             model->voxels = vi_take(&body, (size_t)count * 4);
-            for (model->solid = 0, i = 0; i < count; i++) model->solid += model->voxels[4 * i + 3] != 0;
+            for (model->solid = 0, i = 0; i < count; i++) {
+                const uint8_t *v = model->voxels + 4 * i;
+                model->solid += v[3] != 0;
+                if (v[3] && (v[0] >= size_xyz[0] || v[1] >= size_xyz[1] || v[2] >= size_xyz[2])) {
+                    /* checked here too, as a model may not be placed (one frame of several) */
+                    vi_fail(c, "byte %llu: a voxel lies outside its model's size", (vi_ull)at);
+                    goto done;
+                }
+            }
             have_size = 0;
         } else if (!memcmp(id, "RGBA", 4)) { /* 256 entries; shorter ones, as some tools write, are padded */
             palette = body.data;
@@ -2166,6 +2379,11 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     /* Colour index k + 1 is palette entry k. */
     vi_vox_default_palette(pal);
     for (i = 0; palette && i < palette_entries; i++) memcpy(pal[i], palette + 4 * i, 3);
+    if (nodes.count && c->limits.vox_model) {
+        vi_fail(c, "model %llu asked for, but the file has a scene graph, which places its models",
+                (vi_ull)c->limits.vox_model);
+        goto done;
+    }
     if (nodes.count) {
         const vi_vox_node *sorted = (const vi_vox_node *)nodes.data;
         qsort(nodes.data, nodes.count, sizeof(vi_vox_node), vi_i32_order);
@@ -2182,14 +2400,25 @@ static int vi_parse_vox(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             !vi_vox_reserve(c, solid, &pts, &rgb) ||
             !vi_vox_walk(c, &nodes, &hidden, &models, (const uint8_t(*)[3])pal, &pts, &rgb, &listed, &solid))
             goto done;
-    } else { /* no scene graph: every model at the origin */
+    } else { /* no scene graph: one model (of several, animation frames) at the origin */
         vi_xform id;
         vi_identity(&id);
-        for (i = 0; i < models.count; i++) solid += ((const vi_vox_model *)models.data)[i].solid;
-        if (!vi_vox_reserve(c, solid, &pts, &rgb)) goto done;
-        for (i = 0; i < models.count; i++)
-            if (!vi_vox_place(c, &((const vi_vox_model *)models.data)[i], &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
+        if (models.count > 1 || c->limits.vox_model) {
+            if (c->limits.vox_model >= models.count) {
+                vi_fail(c, "model %llu asked for, but the file holds %llu model%s (numbered from 0)",
+                        (vi_ull)c->limits.vox_model, (vi_ull)models.count, models.count == 1 ? "" : "s");
                 goto done;
+            }
+            vi_warn(c, "%llu models and no scene graph (animation frames?): model %llu imported; "
+                       "--vox-model N (0..%llu) picks another",
+                    (vi_ull)models.count, (vi_ull)c->limits.vox_model, (vi_ull)models.count - 1);
+        }
+        if (models.count) {
+            const vi_vox_model *model = (const vi_vox_model *)models.data + c->limits.vox_model;
+            if (!vi_vox_reserve(c, model->solid, &pts, &rgb) ||
+                !vi_vox_place(c, model, &id, 0, (const uint8_t(*)[3])pal, &pts, &rgb))
+                goto done;
+        }
     }
 
     /* Shift so that the smallest coordinate on each axis is 0. */
@@ -2254,6 +2483,7 @@ static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_
     case VI_STL: ok = vi_parse_stl(c, (const uint8_t *)data, size, out); break;
     default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .stl, .vox, .mtl, .spm or .ac)"); break;
     }
+    if (ok) vi_poly_warn(c);
     if (ok && out->point_count > c->limits.max_points)
         ok = vi_fail(c, "more than max_points (%llu) points", (vi_ull)c->limits.max_points);
     if (ok && out->vertex_count > c->limits.max_vertices)

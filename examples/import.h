@@ -10,6 +10,14 @@
    vdag_import_limits.quiet). Coordinates stay in the file's own axes,
    except where a format's rules below say otherwise.
 
+   Polygons (.ply, .off, .obj, .ac) are triangulated in the plane of the
+   axis their Newell normal leans on most: a convex polygon as a fan from
+   its first corner, a concave one by ear clipping (n - 2 triangles either
+   way, corners in the polygon's order). A polygon that is degenerate (no
+   normal) or self-intersecting in that plane, or past a work limit of
+   about 2^28 point tests per file, is fan-triangulated, and the file gets
+   one warning with the number of such polygons.
+
    Formats, and the rules where they leave a choice:
    - .xyz: "x y z" or "x y z r g b" per line; '#' starts a comment. The
      first data line decides the number of values: every line must agree.
@@ -22,14 +30,14 @@
      lines with an unknown keyword are skipped with a warning. Vertex
      x y z, optional red green blue (integers 0..255, ushort 0..65535, or
      floats 0..1) and s t / u v texture coordinates; face vertex_indices
-     (or vertex_index) lists, fan-triangulated. Other elements and
+     (or vertex_index) lists, triangulated. Other elements and
      properties, lists included, are skipped. No faces: a point cloud.
    - .off: [ST][C][N]OFF headers; the counts may follow on the header line.
      COFF colours are 0..1 floats when written with a '.' or an exponent,
      else 0..255 integers (decided per vertex line). Text after a face's
      corners (a face colour) is ignored. No faces: a point cloud.
    - .obj: v (with "v x y z r g b" colours, 0..1), vt, f in every corner
-     form with negative (relative) indices; polygons fan-triangulated, lines
+     form with negative (relative) indices; polygons triangulated, lines
      and points ignored. One material per name given to usemtl, numbered by
      first use, white until a library (mtllib, read from BASE_DIR) gives its
      Kd and map_Kd; Kd values 0..1 map straight to 0..255. A map_Kd texture
@@ -49,8 +57,10 @@
      tools write 1020 bytes: entry 255 is never used). With a scene graph (nTRN, nGRP, nSHP from node 0, first
      animation frame), each model's centre sits at its transform's origin:
      voxel v fills the cell holding R (v + 1/2 - size/2) + t, rounded down
-     where that lands on a cell corner; without one, models keep their own
-     coordinates. Axes stay MagicaVoxel's (z up, as in the vdag tool), and
+     where that lands on a cell corner. Without one, a file of one model
+     gives that model in its own coordinates; a file of several (animation
+     frames) gives one, vdag_import_limits.vox_model (the first by default),
+     with a warning that names the count. Axes stay MagicaVoxel's (z up, as in the vdag tool), and
      the result is shifted so each axis starts at 0. A model
      shown by several shapes appears once per shape; hidden nodes and nodes
      on hidden layers are left out, as in MagicaVoxel's exports. */
@@ -89,6 +99,11 @@ typedef struct vdag_import_limits {
     uint64_t max_triangles;   /* 0: VDAG_IMPORT_MAX_TRIANGLES */
     uint64_t max_texture_pixels; /* 0: VDAG_IMPORT_MAX_TEXTURE_PIXELS (all textures) */
     uint64_t max_vox_voxels;  /* 0: VDAG_IMPORT_MAX_VOX_VOXELS (a .vox scene graph) */
+    uint32_t vox_model;       /* a .vox with several models and no scene graph
+                                 (animation frames): the model imported, from 0
+                                 (0: the first, with a warning naming the count);
+                                 past the last, or nonzero with a scene graph,
+                                 an error */
     int skip_textures;        /* 1: do not decode texture images (materials keep
                                  their colours; for callers that need no colours) */
     int quiet;                /* 1: no warnings on stderr (what an import
@@ -135,7 +150,7 @@ typedef struct vdag_scene {
     uint8_t *point_rgb;  /* 3 per point, or NULL when the file has no colours */
     int points_are_voxels; /* 1: integer grid coordinates, used as they are */
 
-    /* Triangles (polygons are fan-triangulated). */
+    /* Triangles (polygons are triangulated: see the top of this file). */
     size_t vertex_count;
     double *positions;   /* 3 per vertex */
     uint8_t *vertex_rgb; /* 3 per vertex, or NULL */

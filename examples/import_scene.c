@@ -26,8 +26,10 @@
      "empty_texture_no_mapping" is none), texrep and texoff scale and shift
      its texture coordinates; data blocks are skipped by their byte count;
      numvert vertex lines; numsurf surfaces (SURF flags, mat, refs n, then n
-     "index u v" lines). Polygons (type nibble 0) are fan-triangulated, each
-     corner its own vertex; lines (types 1, 2) and other types are skipped.
+     "index u v" lines). Polygons (type nibble 0) are triangulated as in
+     .obj (import.h), each corner its own vertex; lines (types 1, 2) and
+     other types are skipped. "subdiv N" with N > 0 gets a warning: the
+     object is imported unsubdivided, as its control mesh.
      One scene material per distinct (MATERIAL, texture) pair, in order of
      first use. Textures are read beside the file. Unknown object lines are
      ignored; kids nest at most VI_AC_MAX_DEPTH deep. Placed positions
@@ -333,9 +335,10 @@ typedef struct vs_ac {
     vdag_scene *out;
     vi_buf mats;  /* 3 bytes per MATERIAL line */
     vi_buf pairs; /* per scene material: int32 MATERIAL index (-1 none), int32 image */
-    vi_buf pos, uv, tris, tmat, verts;
+    vi_buf pos, uv, tris, tmat, verts, poly;
     vi_texcache cache;
     int32_t last; /* scene material of the last surface, or -1 */
+    uint64_t subdiv, subdiv_line; /* objects with subdiv N > 0, the first one's line */
 } vs_ac;
 
 /* The next line of T (no comment syntax); 0 at the end. */
@@ -395,7 +398,8 @@ static int vs_ac_fail(vs_ac *a, const char *what) {
 static int vs_ac_surface(vs_ac *a, uint32_t flags, int32_t image, const double rep[4]) {
     vi_span line, kw;
     int32_t mat = a->mats.count ? 0 : -1;
-    uint32_t n, i, base;
+    uint32_t n, i, base, *q;
+    int32_t *tm;
     size_t nv = a->verts.count / 3;
     for (;;) {
         if (!vs_line(&a->t, &line)) return vi_fail(a->c, "surface without refs at the end of the file");
@@ -433,16 +437,13 @@ static int vs_ac_surface(vs_ac *a, uint32_t flags, int32_t image, const double r
         uv[0] = (float)(t[0] * rep[0] + rep[2]);
         uv[1] = (float)(t[1] * rep[1] + rep[3]);
     }
-    for (i = 1; i + 1 < n; i++) {
-        uint32_t *tri = (uint32_t *)vi_push(a->c, &a->tris, sizeof(uint32_t), 3);
-        int32_t *tm = (int32_t *)vi_push(a->c, &a->tmat, sizeof(int32_t), 1);
-        if (!tri || !tm) return 0;
-        tri[0] = base;
-        tri[1] = base + i;
-        tri[2] = base + i + 1;
-        if (!vs_ac_material(a, mat, image, tm)) return 0;
-    }
-    return 1;
+    a->poly.count = 0;
+    if (!(q = (uint32_t *)vi_push(a->c, &a->poly, sizeof(uint32_t), n))) return 0;
+    if (!(tm = (int32_t *)vi_push(a->c, &a->tmat, sizeof(int32_t), n - 2))) return 0;
+    for (i = 0; i < n; i++) q[i] = base + i;
+    for (i = 0; i < n - 2; i++)
+        if (!vs_ac_material(a, mat, image, &tm[i])) return 0;
+    return vi_poly(a->c, &a->tris, q, n, sizeof(uint32_t), (const double *)a->pos.data);
 }
 
 /* M' = PM * ROT, T' = PM * LOC + PT. */
@@ -491,6 +492,10 @@ static int vs_ac_object(vs_ac *a, const double pm[9], const double pt[3], int de
             }
             if (!vi_len(name) || vi_is(name, "empty_texture_no_mapping") || !a->c->base_dir) continue;
             if (!vi_texture(a->c, a->out, &a->cache, a->c->base_dir, name, &image)) return 0;
+        } else if (vi_is(kw, "subdiv")) {
+            uint32_t n;
+            if (!vs_count(&line, INT32_MAX, &n)) return vs_ac_fail(a, "bad subdiv count");
+            if (n && !a->subdiv++) a->subdiv_line = a->t.line;
         } else if (vi_is(kw, "data")) {
             uint32_t n;
             if (!vs_count(&line, (int64_t)(a->t.end - a->t.p), &n)) return vs_ac_fail(a, "bad data length");
@@ -617,6 +622,10 @@ static int vi_parse_ac(vi_ctx *c, vi_text *text, vdag_scene *out) {
         free(out->triangle_material);
         out->triangle_material = NULL;
     }
+    if (a.subdiv)
+        vi_warn(c, "%llu object%s subdiv > 0 (the first on line %llu): subdivision surfaces are imported "
+                "unsubdivided, as their control mesh", (vi_ull)a.subdiv, a.subdiv == 1 ? " has" : "s have",
+                (vi_ull)a.subdiv_line);
     ok = 1;
 done:
     vi_buf_free(&a.mats);
@@ -626,6 +635,7 @@ done:
     vi_buf_free(&a.tris);
     vi_buf_free(&a.tmat);
     vi_buf_free(&a.verts);
+    vi_buf_free(&a.poly);
     vi_tex_free(&a.cache);
     return ok;
 }

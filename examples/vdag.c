@@ -4,7 +4,7 @@
               [--no-symmetry] [--color-error E] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
               [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
-              [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]
+              [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -181,6 +181,9 @@ static const struct {
      "  --max-vox-voxels N the most voxels a .vox scene graph may place (a model once per\n"
      "                     shape showing it), >= 1; past it the file is refused (default:\n"
      "                     2147483648, 2^31)\n"
+     "  --vox-model N      a .vox of several models and no scene graph (animation frames):\n"
+     "                     import model N, from 0; past the last, or with a scene graph, an\n"
+     "                     error (default: 0, with a warning that names the model count)\n"
      "  --allow-empty      build an empty scene from an empty input, or one without triangles\n"
      "                     and points, with a warning (default: refused)\n"
      "  --force            build even when the estimate exceeds the machine's memory (default:\n"
@@ -296,6 +299,7 @@ typedef struct build_args {
     uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
     uint64_t max_texture_pixels; /* --max-texture-pixels; 0: the importer's default */
     uint64_t max_vox_voxels;     /* --max-vox-voxels; 0: the importer's default */
+    uint32_t vox_model;          /* --vox-model; 0: the first */
 } build_args;
 
 /* Progress of a build: on a terminal, one line per stage updated in place
@@ -1139,6 +1143,8 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--max-vox-voxels") && k + 1 < argc) {
             if (!parse_count(argv[++k], &a.max_vox_voxels))
                 return vdag_fail("build: --max-vox-voxels takes a voxel count >= 1");
+        } else if (!strcmp(argv[k], "--vox-model") && k + 1 < argc) {
+            if (!parse_u32(argv[++k], &a.vox_model)) return vdag_fail("build: --vox-model takes a model number >= 0");
         } else if (!strcmp(argv[k], "--force")) {
             a.force = 1;
         } else if (!strcmp(argv[k], "--allow-empty")) {
@@ -1200,6 +1206,7 @@ static int cmd_build(int argc, char **argv) {
     limits.skip_textures = a.no_colors && a.no_alpha_test;
     limits.max_texture_pixels = a.max_texture_pixels;
     limits.max_vox_voxels = a.max_vox_voxels;
+    limits.vox_model = a.vox_model;
     guard.exists = !stat(a.out, &guard.out);
     guard.clash[0] = 0;
     limits.on_file = guard_read;
@@ -1497,7 +1504,8 @@ static int usage(FILE *f) {
           "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
           "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
-          "                    [--max-vox-voxels N] [--allow-empty] [--force] [--stats] [--quiet]\n"
+          "                    [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats]\n"
+          "                    [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"

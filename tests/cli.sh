@@ -229,6 +229,28 @@ check "--max-vox-voxels 511 is refused, one line naming it" sh -c "! '$VDAG' bui
 check "--max-texture-pixels and --max-vox-voxels take counts >= 1" sh -c "! '$VDAG' build '$T/lim.vox' '$T/l0.vdag' --max-vox-voxels 0 2>/dev/null &&
     ! '$VDAG' build '$T/lim.obj' '$T/l0.vdag' --max-texture-pixels -1 2>/dev/null &&
     ! '$VDAG' build '$T/lim.obj' '$T/l0.vdag' --max-texture-pixels 18446744073709551616 2>/dev/null && [ ! -e '$T/l0.vdag' ]"
+# -- a .vox of several models and no scene graph (animation frames): model 0
+# with a warning naming the count; --vox-model N picks another; past the last,
+# or any but 0 with a scene graph, one line of error
+python3 - "$T" <<'EOF'
+import struct, sys
+t = sys.argv[1]
+def chunk(i, body): return i + struct.pack("<II", len(body), 0) + body
+body = b""
+for frame in range(3):  # frame k: k + 1 voxels in a row
+    body += chunk(b"SIZE", struct.pack("<III", 4, 1, 1))
+    body += chunk(b"XYZI", struct.pack("<I", frame + 1) + bytes(b for x in range(frame + 1) for b in (x, 0, 0, 9)))
+open(t + "/frames.vox", "wb").write(b"VOX " + struct.pack("<I", 150) + b"MAIN" + struct.pack("<II", 0, len(body)) + body)
+EOF
+check "a .vox of 3 frames builds frame 0, warning with the count and --vox-model" sh -c "'$VDAG' build '$T/frames.vox' '$T/fr0.vdag' --quiet 2>'$T/err' &&
+    grep -q 'warning:.*3 models and no scene graph.*model 0 imported.*--vox-model' '$T/err' && '$VDAG' info '$T/fr0.vdag' | grep -q '^voxels *1\$'"
+check "--vox-model 2 builds frame 2" sh -c "'$VDAG' build '$T/frames.vox' '$T/fr2.vdag' --vox-model 2 --quiet 2>/dev/null &&
+    '$VDAG' info '$T/fr2.vdag' | grep -q '^voxels *3\$'"
+check "--vox-model 3 of 3 is refused, one line naming the count" sh -c "! '$VDAG' build '$T/frames.vox' '$T/fr3.vdag' --vox-model 3 --quiet 2>'$T/err' &&
+    [ \$(wc -l <'$T/err') = 1 ] && grep -q 'model 3 asked for, but the file holds 3 models' '$T/err' && [ ! -e '$T/fr3.vdag' ]"
+check "--vox-model 1 with a scene graph is refused; a bad number too" sh -c "! '$VDAG' build '$T/lim.vox' '$T/fr4.vdag' --vox-model 1 --quiet 2>'$T/err' &&
+    grep -q 'scene graph' '$T/err' && ! '$VDAG' build '$T/frames.vox' '$T/fr4.vdag' --vox-model -1 2>/dev/null && [ ! -e '$T/fr4.vdag' ]"
+check "vdag build --help names --vox-model" sh -c "'$VDAG' build --help | grep -q -- '--vox-model N'"
 mkfifo "$T/fifo.mtl" && printf 'mtllib fifo.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nusemtl a\nf 1 2 3\n' >"$T/fifo.obj"
 check "a FIFO as material library is refused at once, naming it" sh -c "! timeout 20 '$VDAG' build '$T/fifo.obj' '$T/fifo.vdag' --quiet 2>'$T/err' &&
     grep -q 'fifo.mtl: not a regular file' '$T/err'"

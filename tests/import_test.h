@@ -4,6 +4,8 @@
 #define VDAG_IMPORT_TEST_H
 
 #include <stdarg.h>
+#include <stdio.h>
+#include <unistd.h> /* dup, dup2: the includer defines _POSIX_C_SOURCE */
 #include "test.h"
 #include "examples/import.h"
 
@@ -53,6 +55,30 @@ static inline int import(const char *ext, const bytes *data, vdag_scene *s, char
         CHECK_MSG(err[0] && !strchr(err, '\n'), "bad message \"%s\"", err);
         CHECK(!s->points && !s->positions && !s->indices && !s->point_count && !s->triangle_count);
     }
+    return ok;
+}
+
+/* Imports DATA as EXT with warnings on, returning what went to stderr in
+   WARN (truncated to WARN_SIZE); the result goes to S (freed by the caller
+   when the import succeeded). */
+static inline int import_warnings(const char *ext, const bytes *data, vdag_scene *s, char *err, size_t err_size, char *warn,
+                           size_t warn_size) {
+    FILE *tmp = tmpfile();
+    int saved = dup(2), ok;
+    size_t n = 0;
+    warn[0] = 0;
+    CHECK(tmp != NULL && saved >= 0);
+    if (!tmp || saved < 0) return 0;
+    fflush(stderr);
+    dup2(fileno(tmp), 2);
+    ok = vdag_import_memory(ext, data->p, data->n, NULL, NULL, s, err, err_size);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(tmp);
+    n = fread(warn, 1, warn_size - 1, tmp);
+    warn[n] = 0;
+    fclose(tmp);
     return ok;
 }
 

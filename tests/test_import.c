@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "import_test.h"
+#include "voxdag.h"
 
 // -- A random mesh (the expected scene of mesh round trips)
 
@@ -44,7 +45,8 @@ static void random_mesh(mesh *m, uint64_t *seed, size_t nv, size_t npoly, int in
     }
 }
 
-/* Triangle T of the fan triangulation of M's polygons, as vertex numbers. */
+/* Triangle T of the fan triangulation of M's polygons, as vertex numbers
+   (the triangles the STL writers write). */
 static size_t fan(const mesh *m, uint32_t tris[][3]) {
     size_t i, j, n = 0;
     for (i = 0; i < m->npoly; i++)
@@ -57,30 +59,46 @@ static size_t fan(const mesh *m, uint32_t tris[][3]) {
     return n;
 }
 
-/* Checks that S holds M's triangles with positions (and colours and texture
-   coordinates when asked), comparing corner by corner. */
+/* 1 if scene vertex GOT of S has the position (and colour, texture
+   coordinates when asked) of M's vertex WANT. */
+static int same_vertex(const vdag_scene *s, size_t got, const mesh *m, uint32_t want, int rgb, int uv) {
+    size_t a;
+    for (a = 0; a < 3; a++)
+        if (s->positions[3 * got + a] != m->pos[want][a] || (rgb && s->vertex_rgb[3 * got + a] != m->rgb[want][a]))
+            return 0;
+    return !uv || (s->uv[2 * got] == m->uv[want][0] && s->uv[2 * got + 1] == m->uv[want][1]);
+}
+
+/* Checks that S holds a triangulation of each of M's polygons in turn:
+   poly_size - 2 triangles whose corners are corners of the polygon (by
+   position, and colours and texture coordinates when asked), distinct and
+   in the polygon's cyclic order (the importers fan convex polygons and clip
+   ears off concave ones; these random polygons are either). */
 static void check_mesh(const vdag_scene *s, const mesh *m, int rgb, int uv) {
-    uint32_t tris[32 * 4][3];
-    size_t n = fan(m, tris), t, k, a;
+    size_t n = 0, t = 0, i, k;
+    for (i = 0; i < m->npoly; i++) n += m->poly_size[i] - 2;
     CHECK(s->point_count == 0);
     CHECK((s->vertex_rgb != NULL) == rgb);
     CHECK((s->uv != NULL) == uv);
     CHECK_MSG(s->triangle_count == n, "%zu triangles, expected %zu", s->triangle_count, n);
     if (s->triangle_count != n) return;
-    for (t = 0; t < n; t++)
-        for (k = 0; k < 3; k++) {
-            uint32_t got = s->indices[3 * t + k], want = tris[t][k];
-            CHECK(got < s->vertex_count);
-            if (got >= s->vertex_count) return;
-            for (a = 0; a < 3; a++) {
-                CHECK(s->positions[3 * got + a] == m->pos[want][a]);
-                if (rgb) CHECK(s->vertex_rgb[3 * got + a] == m->rgb[want][a]);
-            }
-            if (uv) CHECK(s->uv[2 * got] == m->uv[want][0] && s->uv[2 * got + 1] == m->uv[want][1]);
+    for (i = 0; i < m->npoly; i++) {
+        size_t np = m->poly_size[i], j0, j1, j2, tt;
+        for (tt = 0; tt + 2 < np; tt++, t++) {
+            const uint32_t *g = &s->indices[3 * t];
+            int found = 0;
+            for (k = 0; k < 3; k++) CHECK(g[k] < s->vertex_count);
+            if (g[0] >= s->vertex_count || g[1] >= s->vertex_count || g[2] >= s->vertex_count) return;
+            for (j0 = 0; j0 < np && !found; j0++)
+                for (j1 = 1; j1 < np && !found; j1++)
+                    for (j2 = j1 + 1; j2 < np && !found; j2++)
+                        found = same_vertex(s, g[0], m, m->poly[i][j0], rgb, uv) &&
+                                same_vertex(s, g[1], m, m->poly[i][(j0 + j1) % np], rgb, uv) &&
+                                same_vertex(s, g[2], m, m->poly[i][(j0 + j2) % np], rgb, uv);
+            CHECK_MSG(found, "polygon %zu triangle %zu: not three corners in order", i, tt);
         }
+    }
 }
-
-// -- .xyz
 
 static void test_xyz_roundtrip(void) {
     uint64_t seed = 1;
@@ -569,6 +587,205 @@ static void test_obj_points(void) {
     } else {
         CHECK(s.point_count == 2 && s.points_are_voxels == 0 && s.points[3] == 4 && s.point_rgb);
         CHECK(s.point_rgb && s.point_rgb[0] == 255 && s.point_rgb[3] == 0 && s.point_rgb[4] == 255 && s.point_rgb[5] == 128);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+}
+
+// -- Polygons: concave ones clipped into ears, bad ones fanned with a warning
+
+/* A comb in the plane z = 0.5: a base [1.5, 62.5] x [1.5, 4.5] with 16 teeth
+   1 wide and 4 apart up to y = 20.5; 64 corners, counter-clockwise, every
+   coordinate a half-integer. Its fan from the first corner covers the gaps
+   between the teeth, where two columns of voxels must stay empty. */
+#define COMB_TEETH 16
+#define COMB_N (4 * COMB_TEETH)
+static void comb(double xy[COMB_N][2]) {
+    size_t n = 0;
+    int i;
+    xy[n][0] = 1.5, xy[n++][1] = 1.5;
+    xy[n][0] = 1.5 + 4 * (COMB_TEETH - 1) + 1, xy[n++][1] = 1.5;
+    for (i = COMB_TEETH - 1; i >= 0; i--) {
+        xy[n][0] = 1.5 + 4 * i + 1, xy[n++][1] = 20.5;
+        xy[n][0] = 1.5 + 4 * i, xy[n++][1] = 20.5;
+        if (i) {
+            xy[n][0] = 1.5 + 4 * i, xy[n++][1] = 4.5;
+            xy[n][0] = 1.5 + 4 * i - 3, xy[n++][1] = 4.5;
+        }
+    }
+}
+
+/* Even-odd test of point (X, Y) against polygon XY of N corners. */
+static int inside_polygon(const double (*xy)[2], size_t n, double x, double y) {
+    size_t i, j;
+    int in = 0;
+    for (i = 0, j = n - 1; i < n; j = i++)
+        if ((xy[i][1] > y) != (xy[j][1] > y) &&
+            x < xy[j][0] + (y - xy[j][1]) * (xy[i][0] - xy[j][0]) / (xy[i][1] - xy[j][1]))
+            in = !in;
+    return in;
+}
+
+/* Voxelizes scene S (levels 6) and compares it with the comb, brute force:
+   its edges lie on half-integers, so voxel (x, y, 0) touches the comb
+   exactly when one of its four quarters' centres is inside; no other voxel
+   is full. */
+static void check_comb_voxels(const vdag_scene *s, const double (*xy)[2], const char *what) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    voxdag_mesh vm;
+    voxdag_info info;
+    uint32_t x, y;
+    uint64_t want = 0, wrong = 0;
+    memset(&o, 0, sizeof o);
+    o.levels = 6;
+    memset(&vm, 0, sizeof vm);
+    vm.positions = s->positions;
+    vm.vertex_count = s->vertex_count;
+    vm.indices = s->indices;
+    vm.triangle_count = s->triangle_count;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &vm, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    if (!d) return;
+    for (y = 0; y < 64; y++)
+        for (x = 0; x < 64; x++) {
+            int full = 0, q;
+            for (q = 0; q < 4; q++) full |= inside_polygon(xy, COMB_N, x + 0.25 + 0.5 * (q & 1), y + 0.25 + 0.5 * (q >> 1));
+            want += (uint64_t)full;
+            wrong += (uint64_t)(full != voxdag_lookup(d, x, y, 0, NULL));
+        }
+    voxdag_get_info(d, &info);
+    CHECK(want == 62 * 4 + 16 * 2 * 16); /* base 62 x 4, teeth 2 x 16 */
+    CHECK_MSG(wrong == 0 && info.voxels == want, "%s: %llu voxels of the z = 0 layer wrong; %llu voxels, %llu expected",
+              what, (unsigned long long)wrong, (unsigned long long)info.voxels, (unsigned long long)want);
+    voxdag_free(d);
+}
+
+/* The comb written as one polygon in each text format that has polygons
+   (.ply with its faces before and after its vertices) voxelizes as the comb:
+   no voxel in the gaps between teeth, every voxel of the teeth. */
+static void test_concave_polygons(void) {
+    double xy[COMB_N][2];
+    int fmt;
+    comb(xy);
+    for (fmt = 0; fmt < 5; fmt++) {
+        static const char *const ext[] = {"obj", "off", "ply", "ply", "ac"};
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256], warn[512];
+        size_t i;
+        if (fmt == 0) {
+            for (i = 0; i < COMB_N; i++) putf(&b, "v %g %g 0.5\n", xy[i][0], xy[i][1]);
+            putf(&b, "f");
+            for (i = 0; i < COMB_N; i++) putf(&b, " %zu", i + 1);
+            putf(&b, "\n");
+        } else if (fmt == 1) {
+            putf(&b, "OFF\n%d 1 0\n", COMB_N);
+            for (i = 0; i < COMB_N; i++) putf(&b, "%g %g 0.5\n", xy[i][0], xy[i][1]);
+            putf(&b, "%d", COMB_N);
+            for (i = 0; i < COMB_N; i++) putf(&b, " %zu", i);
+            putf(&b, "\n");
+        } else if (fmt == 2 || fmt == 3) { /* 3: the face element first */
+            const char *vh = "element vertex 64\nproperty float x\nproperty float y\nproperty float z\n";
+            const char *fh = "element face 1\nproperty list uchar int vertex_indices\n";
+            putf(&b, "ply\nformat ascii 1.0\n%s%send_header\n", fmt == 2 ? vh : fh, fmt == 2 ? fh : vh);
+            if (fmt == 2)
+                for (i = 0; i < COMB_N; i++) putf(&b, "%g %g 0.5\n", xy[i][0], xy[i][1]);
+            putf(&b, "%d", COMB_N);
+            for (i = 0; i < COMB_N; i++) putf(&b, " %zu", i);
+            putf(&b, "\n");
+            if (fmt == 3)
+                for (i = 0; i < COMB_N; i++) putf(&b, "%g %g 0.5\n", xy[i][0], xy[i][1]);
+        } else { /* AC3D: y up, so file (x, 0.5, -y) is (x, y, 0.5) */
+            putf(&b, "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT world\nkids 1\nOBJECT poly\nnumvert %d\n", COMB_N);
+            for (i = 0; i < COMB_N; i++) putf(&b, "%g 0.5 %g\n", xy[i][0], -xy[i][1]);
+            putf(&b, "numsurf 1\nSURF 0x10\nmat 0\nrefs %d\n", COMB_N);
+            for (i = 0; i < COMB_N; i++) putf(&b, "%zu 0 0\n", i);
+            putf(&b, "kids 0\n");
+        }
+        if (!import_warnings(ext[fmt], &b, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "%s: %s", ext[fmt], err);
+        } else {
+            CHECK_MSG(s.triangle_count == COMB_N - 2, "%s: %zu triangles", ext[fmt], s.triangle_count);
+            CHECK_MSG(!warn[0], "%s: warned \"%s\"", ext[fmt], warn);
+            check_comb_voxels(&s, (const double(*)[2])xy, ext[fmt]);
+            vdag_scene_free(&s);
+        }
+        sweep(ext[fmt], &b, 0);
+        free(b.p);
+    }
+}
+
+/* Convex polygons keep the fan from their first corner, also with a
+   straight corner (a square with a midpoint). */
+static void test_convex_polygons_fanned(void) {
+    static const char obj[] = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4 5\nf 5 4 3 2 1\n";
+    static const uint32_t want[] = {0, 1, 2, 0, 2, 3, 0, 3, 4, 4, 3, 2, 4, 2, 1, 4, 1, 0};
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256], warn[512];
+    put(&b, obj, strlen(obj));
+    if (!import_warnings("obj", &b, &s, err, sizeof err, warn, sizeof warn)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK(s.triangle_count == 6 && !memcmp(s.indices, want, sizeof want));
+        CHECK_MSG(!warn[0], "warned \"%s\"", warn);
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+}
+
+/* Self-intersecting polygons (a pentagram, a bow tie) and a degenerate one
+   (all corners on a line) are fan-triangulated, with one warning per file
+   that counts them; a concave polygon in the same file is still clipped. */
+static void test_bad_polygons_warn(void) {
+    static const char obj[] = "v 0 10 0\nv 6 -8 0\nv -9.5 3 0\nv 9.5 3 0\nv -6 -8 0\n" /* pentagram, in star order */
+                              "v 0 0 1\nv 1 1 1\nv 1 0 1\nv 0 1 1\n"                   /* bow tie */
+                              "v 0 0 2\nv 1 0 2\nv 2 0 2\nv 3 0 2\n"                   /* on a line */
+                              "v 0 0 3\nv 4 0 3\nv 4 4 3\nv 2 1 3\nv 0 4 3\n"          /* concave: a notch */
+                              "f 1 2 3 4 5\nf 6 7 8 9\nf 10 11 12 13\nf 14 15 16 17 18\n";
+    static const char off[] = "OFF\n5 1 0\n0 10 0\n6 -8 0\n-9.5 3 0\n9.5 3 0\n-6 -8 0\n5 0 1 2 3 4\n";
+    static const uint32_t star_fan[] = {0, 1, 2, 0, 2, 3, 0, 3, 4};
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    char err[256], warn[512];
+    put(&b, obj, strlen(obj));
+    if (!import_warnings("obj", &b, &s, err, sizeof err, warn, sizeof warn)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        const char *w = strstr(warn, "warning: obj: 3 polygons were degenerate or self-intersecting; fan-triangulated");
+        CHECK_MSG(w && !strstr(w + 1, "warning"), "warned \"%s\"", warn);
+        CHECK(s.triangle_count == 3 + 2 + 2 + 3);
+        if (s.triangle_count == 10) {
+            CHECK(!memcmp(s.indices, star_fan, sizeof star_fan));
+            CHECK(s.indices[15] == 9 && s.indices[16] == 10 && s.indices[17] == 11); /* the line: its fan */
+            /* The notch corner (2, 1) is no fan centre: the first corner's
+               fan would cross the notch. Triangles cover area 16 - 6 = 10. */
+            {
+                double area = 0;
+                size_t t;
+                for (t = 7; t < 10; t++) {
+                    const double *p0 = &s.positions[3 * s.indices[3 * t]], *p1 = &s.positions[3 * s.indices[3 * t + 1]],
+                                 *p2 = &s.positions[3 * s.indices[3 * t + 2]];
+                    double a = (p1[0] - p0[0]) * (p2[1] - p0[1]) - (p1[1] - p0[1]) * (p2[0] - p0[0]);
+                    CHECK(a > 0);
+                    area += fabs(a) / 2;
+                }
+                CHECK_MSG(area == 10, "notched polygon: area %g", area);
+            }
+        }
+        vdag_scene_free(&s);
+    }
+    b.n = 0;
+    put(&b, off, strlen(off));
+    if (!import_warnings("off", &b, &s, err, sizeof err, warn, sizeof warn)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK_MSG(strstr(warn, "warning: off: 1 polygon was degenerate or self-intersecting; fan-triangulated") != NULL,
+                  "warned \"%s\"", warn);
+        CHECK(s.triangle_count == 3 && !memcmp(s.indices, star_fan, sizeof star_fan));
         vdag_scene_free(&s);
     }
     free(b.p);
@@ -1186,6 +1403,10 @@ static void check_voxels(const vdag_scene *s, voxel *want, size_t n) {
 }
 
 /* Two models, no scene graph: voxels keep their model coordinates. */
+/* Two models and no scene graph (animation frames): the first is imported,
+   with a warning naming the count; vox_model picks the other; a number past
+   the last is an error naming the count; a file with a scene graph refuses
+   any but 0. */
 static void test_vox_models(void) {
     uint64_t seed = 8;
     vox_model m[2];
@@ -1193,8 +1414,9 @@ static void test_vox_models(void) {
     voxel want[80];
     bytes body = {NULL, 0, 0}, file = {NULL, 0, 0}, c = {NULL, 0, 0};
     vdag_scene s;
-    char err[256];
-    size_t i, k, n = 0;
+    vdag_import_limits pick;
+    char err[256], warn[512];
+    size_t i, k, n;
     for (i = 0; i < sizeof palette; i++) palette[i] = (uint8_t)test_rand_below(&seed, 256);
     put_le32(&c, 2);
     vox_chunk(&body, "PACK", &c, 0);
@@ -1206,8 +1428,10 @@ static void test_vox_models(void) {
     put(&c, palette, sizeof palette);
     vox_chunk(&body, "RGBA", &c, 0);
     vox_file(&file, &body, 150);
-    for (i = 0; i < 2; i++)
-        for (k = 0; k < m[i].n; k++) {
+    memset(&pick, 0, sizeof pick);
+    pick.quiet = 1;
+    for (i = 0; i < 2; i++) {
+        for (n = k = 0; k < m[i].n; k++) {
             if (!m[i].v[k][3]) continue;
             want[n].p[0] = m[i].v[k][0];
             want[n].p[1] = m[i].v[k][1];
@@ -1215,13 +1439,53 @@ static void test_vox_models(void) {
             memcpy(want[n].rgb, &palette[4 * (m[i].v[k][3] - 1)], 3); /* index i is entry i - 1 */
             n++;
         }
-    if (!import("vox", &file, &s, err, sizeof err)) {
-        CHECK_MSG(0, "%s", err);
-    } else {
+        if (i == 0 && !import_warnings("vox", &file, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "%s", err);
+            continue;
+        }
+        pick.vox_model = (uint32_t)i;
+        if (i == 1 && !vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err)) {
+            CHECK_MSG(0, "model 1: %s", err);
+            continue;
+        }
+        if (i == 0)
+            CHECK_MSG(strstr(warn, "warning: vox: 2 models and no scene graph (animation frames?): model 0 imported; "
+                                   "--vox-model N (0..1) picks another") != NULL,
+                      "warned \"%s\"", warn);
         check_voxels(&s, want, n);
         vdag_scene_free(&s);
     }
+    pick.vox_model = 2;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "model 2 asked for, but the file holds 2 models (numbered from 0)") != NULL, "%s", err);
+    CHECK(!s.points && !s.point_count);
     sweep("vox", &file, 1);
+    /* One model: no warning; model 1 of it is an error. */
+    body.n = file.n = 0;
+    vox_models(&body, m, 1);
+    vox_file(&file, &body, 150);
+    if (!import_warnings("vox", &file, &s, err, sizeof err, warn, sizeof warn)) {
+        CHECK_MSG(0, "%s", err);
+    } else {
+        CHECK_MSG(!warn[0], "warned \"%s\"", warn);
+        CHECK(s.point_count == m[0].n);
+        vdag_scene_free(&s);
+    }
+    pick.vox_model = 1;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "the file holds 1 model (numbered from 0)") != NULL, "%s", err);
+    /* A scene graph places the models: picking one is refused. */
+    body.n = file.n = 0;
+    vox_models(&body, m, 2);
+    vox_transform(&body, 0, 1, NULL, NULL);
+    vox_shape(&body, 1, 1);
+    vox_file(&file, &body, 150);
+    pick.vox_model = 0;
+    if (!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err)) CHECK_MSG(0, "%s", err);
+    else vdag_scene_free(&s);
+    pick.vox_model = 1;
+    CHECK(!vdag_import_memory("vox", file.p, file.n, NULL, &pick, &s, err, sizeof err));
+    CHECK_MSG(strstr(err, "the file has a scene graph") != NULL, "%s", err);
     free(body.p);
     free(file.p);
     free(c.p);
@@ -1621,10 +1885,13 @@ const test_case test_import_cases[] = {
     {"import/obj roundtrip", test_obj_roundtrip},
     {"import/obj points", test_obj_points},
     {"import/obj errors", test_obj_errors},
+    {"import/polygons: concave ones as they are", test_concave_polygons},
+    {"import/polygons: convex ones fanned", test_convex_polygons_fanned},
+    {"import/polygons: bad ones fanned with a warning", test_bad_polygons_warn},
     {"import/obj file with mtl and texture", test_obj_file},
     {"import/file errors", test_file_errors},
     {"import/limits", test_limits},
-    {"import/vox models", test_vox_models},
+    {"import/vox models: one of several frames, picked", test_vox_models},
     {"import/vox default palette", test_vox_default_palette},
     {"import/vox scene graph", test_vox_scene_graph},
     {"import/vox errors", test_vox_errors},

@@ -1,6 +1,6 @@
 /* Game-scene importer tests (.spm, .ac): files written here from random
    scenes round-trip to the scene the test expects (axes turned to z up,
-   AC3D transforms applied, fans triangulated), textures are found where
+   AC3D transforms applied, polygons triangulated), textures are found where
    the formats put them, and broken files (cut at every length, patched
    bytes, bad counts, indices out of range, NaN) fail with one-line messages. */
 #define _POSIX_C_SOURCE 200809L
@@ -397,9 +397,11 @@ static void test_ac_roundtrip(void) {
                                   s.positions[3 * (nv + k) + 2] == want[2],
                               "object %zu corner %zu", o, k);
                 }
-                for (k = 1; k + 1 < n && nt < s.triangle_count; k++, nt++) {
-                    CHECK(s.indices[3 * nt] == nv && s.indices[3 * nt + 1] == nv + k &&
-                          s.indices[3 * nt + 2] == nv + k + 1);
+                for (k = 1; k + 1 < n && nt < s.triangle_count; k++, nt++) { /* corners of the polygon, in order */
+                    const uint32_t *g = &s.indices[3 * nt];
+                    size_t c0 = g[0] - nv, c1 = g[1] - nv, c2 = g[2] - nv;
+                    CHECK(g[0] >= nv && g[1] >= nv && g[2] >= nv && c0 < n && c1 < n && c2 < n && c0 != c1 &&
+                          c1 != c2 && c0 != c2 && (c1 + n - c0) % n + (c2 + n - c1) % n + (c0 + n - c2) % n == n);
                     CHECK(s.triangle_material[nt] == want_mat);
                 }
                 nv += n;
@@ -424,6 +426,36 @@ static void test_ac_sweep(void) {
     write_ac(&b, &t);
     sweep("ac", &b, 0);
     free(b.p);
+}
+
+/* "subdiv N" with N > 0 warns, once per file, that the objects are imported
+   as their control meshes; subdiv 0 says nothing, and the mesh is the same. */
+static void test_ac_subdiv_warns(void) {
+    static const char *const subdiv[] = {"", "subdiv 0\n", "subdiv 2\n"};
+    int k;
+    for (k = 0; k < 3; k++) {
+        bytes b = {NULL, 0, 0};
+        vdag_scene s;
+        char err[256], warn[512];
+        int obj;
+        putf(&b, "AC3Db\nMATERIAL \"m\" rgb 1 1 1\nOBJECT world\nkids 2\n");
+        for (obj = 0; obj < 2; obj++)
+            putf(&b, "OBJECT poly\n%snumvert 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\nnumsurf 1\nSURF 0x10\nmat 0\nrefs 4\n"
+                     "0 0 0\n1 0 0\n2 0 0\n3 0 0\nkids 0\n",
+                 subdiv[k]);
+        if (!import_warnings("ac", &b, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            const char *w = strstr(warn, "warning: ac: 2 objects have subdiv > 0 (the first on line 6): subdivision "
+                                         "surfaces are imported unsubdivided, as their control mesh");
+            CHECK(s.triangle_count == 4 && s.vertex_count == 8);
+            if (k < 2) CHECK_MSG(!warn[0], "subdiv %d: warned \"%s\"", k, warn);
+            else CHECK_MSG(w && !strstr(w + 1, "warning"), "warned \"%s\"", warn);
+            vdag_scene_free(&s);
+        }
+        free(b.p);
+    }
+    expect_error_text("ac", "AC3Db\nOBJECT poly\nsubdiv x\nkids 0\n", "line 3: bad subdiv count");
 }
 
 static void test_ac_errors(void) {
@@ -584,6 +616,7 @@ const test_case test_import_scene_cases[] = {
     {"import_scene/ac roundtrip", test_ac_roundtrip},
     {"import_scene/ac sweep", test_ac_sweep},
     {"import_scene/ac errors", test_ac_errors},
+    {"import_scene/ac subdiv warns", test_ac_subdiv_warns},
     {"import_scene/texture files", test_scene_files},
     {NULL, NULL},
 };
