@@ -3741,36 +3741,52 @@ static voxdag_status voxdagi_open_colors(voxdag *d, voxdag_error *err) {
 
 // -- Loading: header, sections and full structural validation (FORMAT.md)
 
-/* Bitmap helpers for validation: which byte offsets start a record, which
-   records some parent points to, and which of them as a private child. */
-static int voxdagi_bit(const uint8_t *bits, uint64_t i) { return bits[i >> 3] >> (i & 7) & 1; }
-static void voxdagi_set_bit(uint8_t *bits, uint64_t i) { bits[i >> 3] = (uint8_t)(bits[i >> 3] | 1u << (i & 7)); }
+/* What validation keeps of a checked level to check the level above it:
+   START, one bit per byte offset, set where a record starts; RANK, the
+   records that start before each 64-bit word of START (a record's rank, its
+   index in the level, is one lookup and one popcount away); COUNT, the voxels
+   below each record, by rank, so that a parent adds its children's counts
+   without decoding them (32-bit when the level's cells hold fewer than 2^32
+   voxels: every count kept is a checked sum, so at most the cell's volume);
+   REFS, two bits per record by rank: bit 2r referenced, bit 2r+1 referenced
+   as a private child. On the brick level a brick's index is its rank, COUNT
+   holds popcounts and there is no START. One allocation per level. */
+typedef struct voxdagi_vlevel {
+    void *block;
+    size_t block_size;
+    uint64_t *start, *refs, *count64;
+    uint32_t *count32, *rank;
+    uint64_t records;
+} voxdagi_vlevel;
 
-typedef struct voxdagi_bitmaps {
-    uint8_t *map[3]; /* start, ref, private */
-    size_t bytes;
-} voxdagi_bitmaps;
-
-enum { VOXDAGI_START, VOXDAGI_REF, VOXDAGI_PRIVATE };
-
-static int voxdagi_bitmaps_alloc(voxdagi_mem *m, voxdagi_bitmaps *b, uint64_t bits) {
-    unsigned k;
-    int ok = 1;
-    b->bytes = (size_t)((bits + 7) / 8);
-    for (k = 0; k < 3; k++) {
-        b->map[k] = (uint8_t *)voxdagi_alloc(m, b->bytes);
-        if (b->map[k]) memset(b->map[k], 0, b->bytes);
-        else ok = 0;
-    }
-    return ok;
+/* Allocates V for a level of UNITS bytes (or bricks, BRICKS 1) and RECORDS
+   records, START and REFS zeroed. Returns 0 when out of memory. */
+static int voxdagi_vlevel_alloc(voxdagi_mem *m, voxdagi_vlevel *v, uint64_t units, uint64_t records, int bricks,
+                                int wide) {
+    uint64_t sw = bricks ? 0 : (units + 63) / 64, rw = (records + 31) / 32, cn = records;
+    uint64_t bytes = 8 * (sw + rw) + (wide ? 8 : 4) * cn + 4 * sw; /* units <= the image size */
+    memset(v, 0, sizeof *v);
+    if ((uint64_t)(size_t)bytes != bytes) return 0;
+    v->block = voxdagi_alloc(m, (size_t)bytes);
+    if (!v->block) return 0;
+    v->block_size = (size_t)bytes;
+    v->records = records;
+    v->start = (uint64_t *)v->block;
+    v->refs = v->start + sw;
+    memset(v->block, 0, (size_t)(8 * (sw + rw)));
+    if (wide) v->count64 = v->refs + rw, v->rank = (uint32_t *)(v->count64 + cn);
+    else v->count32 = (uint32_t *)(v->refs + rw), v->rank = v->count32 + cn;
+    return 1;
 }
 
-static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
-    unsigned k;
-    for (k = 0; k < 3; k++) {
-        voxdagi_free(m, b->map[k], b->bytes);
-        b->map[k] = NULL;
-    }
+static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
+    voxdagi_free(m, v->block, v->block_size);
+    memset(v, 0, sizeof *v);
+}
+
+/* The rank of the record starting at byte OFFSET (its START bit set). */
+VOXDAGI_INLINE uint64_t voxdagi_vlevel_rank(const voxdagi_vlevel *v, uint64_t offset) {
+    return v->rank[offset >> 6] + (uint64_t)voxdagi_popcount64(v->start[offset >> 6] & ((1ull << (offset & 63)) - 1));
 }
 
 /* Every record of every inner level, bottom-up: sizes, zero padding, pointer
@@ -3782,7 +3798,7 @@ static void voxdagi_bitmaps_free(voxdagi_mem *m, voxdagi_bitmaps *b) {
 static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, voxdag_error *err) {
     uint32_t brick_level = d->levels - 2, l;
     uint64_t base = brick_level ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
-    voxdagi_bitmaps child, cur;
+    voxdagi_vlevel child, cur;
     voxdag_status st = VOXDAG_OK;
     const char *msg = NULL;
     uint64_t where = UINT64_MAX, node = UINT64_MAX;
@@ -3802,15 +3818,14 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "root brick does not match the voxel count");
         return VOXDAG_OK;
     }
-    if (!voxdagi_bitmaps_alloc(m, &child, d->brick_count)) {
-        voxdagi_bitmaps_free(m, &child); /* one of the two may have been allocated */
+    if (!voxdagi_vlevel_alloc(m, &child, d->brick_count, d->brick_count, 1, 0))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
-    }
-    for (i = 0; i < d->brick_count; i++) voxdagi_set_bit(child.map[VOXDAGI_START], i); /* every brick starts a record */
+    for (i = 0; i < d->brick_count; i++) child.count32[i] = (uint32_t)voxdagi_popcount64(voxdagi_brick(d, i));
     for (l = brick_level; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
         uint64_t at = 0, records = 0, child_units = l + 1 == brick_level ? d->brick_count : d->level[l + 1].size;
-        if (!voxdagi_bitmaps_alloc(m, &cur, lv->size)) {
+        int bricks = l + 1 == brick_level;
+        if (!voxdagi_vlevel_alloc(m, &cur, lv->size, lv->nodes, 0, d->levels - l > 10)) {
             st = VOXDAG_ERR_OUT_OF_MEMORY;
             msg = "cannot allocate validation bitmaps";
             break;
@@ -3822,7 +3837,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             where = base + (uint64_t)(rec - d->level[0].data);
             node = records;
             if (lv->size - at < 2) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
-            header = (unsigned)voxdagi_le(rec, 2);
+            header = voxdagi_le16(rec);
             if (!header) { st = VOXDAG_ERR_CORRUPT; msg = "node without children"; break; }
             bits = voxdagi_record_bits(lv, header);
             bytes = (bits + 7) / 8;
@@ -3832,8 +3847,8 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             }
             next_private = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits * voxdagi_has_private(header));
             for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
-                unsigned t = header >> (2 * s) & 3, private_child = t == 3 && lv->private_children;
-                uint64_t v, target, c;
+                unsigned t = header >> (2 * s) & 3, private_child = t == 3 && lv->private_children, used;
+                uint64_t v, target, c, r;
                 if (!t) continue;
                 if (private_child) {
                     target = next_private;
@@ -3844,18 +3859,17 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
                     }
                     target = v >> lv->code_bits[t];
                 }
-                if (target >= child_units || !voxdagi_bit(child.map[VOXDAGI_START], target)) {
+                if (target >= child_units || (!bricks && !(child.start[target >> 6] >> (target & 63) & 1))) {
                     st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
                 }
-                if (voxdagi_bit(child.map[private_child ? VOXDAGI_REF : VOXDAGI_PRIVATE], target)) {
+                r = bricks ? target : voxdagi_vlevel_rank(&child, target);
+                used = (unsigned)(child.refs[r >> 5] >> (2 * (r & 31))) & 3;
+                if (private_child ? used : used & 2) {
                     st = VOXDAG_ERR_CORRUPT; msg = "private child referenced twice"; break;
                 }
-                if (private_child) {
-                    voxdagi_set_bit(child.map[VOXDAGI_PRIVATE], target);
-                    next_private = target + voxdagi_node_units(d, l + 1, target);
-                }
-                voxdagi_set_bit(child.map[VOXDAGI_REF], target);
-                c = voxdagi_node_count(d, l + 1, target);
+                child.refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
+                if (private_child) next_private = target + voxdagi_node_units(d, l + 1, target);
+                c = child.count64 ? child.count64[r] : child.count32[r];
                 if (sum + c < sum) { st = VOXDAG_ERR_CORRUPT; msg = "voxel count overflows"; break; }
                 sum += c;
             }
@@ -3863,26 +3877,41 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             if (lv->count_bits && voxdagi_get_bits_wide(rec, 16, lv->count_bits) != sum) {
                 st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
             }
-            voxdagi_set_bit(cur.map[VOXDAGI_START], at);
+            cur.start[at >> 6] |= 1ull << (at & 63);
+            if (records < cur.records) { /* more records than the level table says: refused below */
+                if (cur.count64) cur.count64[records] = sum;
+                else cur.count32[records] = (uint32_t)sum;
+            }
             at += bytes;
             records++;
         }
         if (st == VOXDAG_OK && records != lv->nodes) {
             st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records"; where = UINT64_MAX; node = UINT64_MAX;
         }
-        for (i = 0; st == VOXDAG_OK && i < child.bytes; i++)
-            if (child.map[VOXDAGI_START][i] & ~child.map[VOXDAGI_REF][i]) {
+        for (i = 0; st == VOXDAG_OK && i < child.records; i += 32) { /* bit 2r: record r referenced */
+            uint64_t want = child.records - i >= 32 ? 0x5555555555555555ull
+                                                    : 0x5555555555555555ull >> (64 - 2 * (child.records - i));
+            if ((child.refs[i >> 5] & want) != want) {
                 st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; where = UINT64_MAX; node = UINT64_MAX;
             }
-        voxdagi_bitmaps_free(m, &child);
+        }
+        voxdagi_vlevel_free(m, &child);
         child = cur;
         memset(&cur, 0, sizeof cur);
+        if (st == VOXDAG_OK) {
+            uint64_t w, n = 0;
+            for (w = 0; w < (lv->size + 63) / 64; w++) {
+                child.rank[w] = (uint32_t)n; /* n <= the level's record count, a u32 */
+                n += (uint64_t)voxdagi_popcount64(child.start[w]);
+            }
+        }
     }
-    if (st == VOXDAG_OK && (d->level[0].nodes != 1 || voxdagi_node_count(d, 0, 0) != d->voxels)) {
+    if (st == VOXDAG_OK &&
+        (d->level[0].nodes != 1 || (child.count64 ? child.count64[0] : child.count32[0]) != d->voxels)) {
         st = VOXDAG_ERR_CORRUPT; msg = "root does not hold the header's voxel count"; where = base; node = 0;
     }
-    voxdagi_bitmaps_free(m, &child);
-    voxdagi_bitmaps_free(m, &cur);
+    voxdagi_vlevel_free(m, &child);
+    voxdagi_vlevel_free(m, &cur);
     return st == VOXDAG_OK ? VOXDAG_OK : voxdagi_fail(err, st, msg, where, node);
 }
 
