@@ -3741,30 +3741,36 @@ static voxdag_status voxdagi_open_colors(voxdag *d, voxdag_error *err) {
 
 // -- Loading: header, sections and full structural validation (FORMAT.md)
 
-/* What validation keeps of a checked level to check the level above it:
-   START, one bit per byte offset, set where a record starts; RANK, the
-   records that start before each 64-bit word of START (a record's rank, its
-   index in the level, is one lookup and one popcount away); COUNT, the voxels
-   below each record, by rank, so that a parent adds its children's counts
-   without decoding them (32-bit when the level's cells hold fewer than 2^32
-   voxels: every count kept is a checked sum, so at most the cell's volume);
-   REFS, two bits per record by rank: bit 2r referenced, bit 2r+1 referenced
-   as a private child. On the brick level a brick's index is its rank, COUNT
-   holds popcounts and there is no START. One allocation per level. */
+/* What validation keeps of a checked level to check the level above it.
+   START: per 32 byte offsets, the number of records that start before them
+   (bits 32-63) and one bit per offset where a record starts (bits 0-31), so
+   that a pointer's check and its record's rank (its index in the level) take
+   one load and one popcount. Per record, by rank: its voxel count, so that a
+   parent adds its children's counts without decoding them, and whether it is
+   referenced, and as a private child. Every count kept is a checked sum, at
+   most the volume of its cell: below 2^27 when the cells are at most 2^9 on
+   a side, and there each record is one 32-bit word, REC32 (the count, bit
+   30 referenced, bit 31 private), else COUNT64 and 2 bits in REFS (bit 2r
+   referenced, bit 2r+1 private). On the brick level a brick's index is its
+   rank, the count its popcount, and there is no START. One allocation. */
 typedef struct voxdagi_vlevel {
     void *block;
     size_t block_size;
-    uint64_t *start, *refs, *count64;
-    uint32_t *count32, *rank;
+    uint64_t *start, *count64, *refs;
+    uint32_t *rec32;
     uint64_t records;
 } voxdagi_vlevel;
 
-/* Allocates V for a level of UNITS bytes (or bricks, BRICKS 1) and RECORDS
-   records, START and REFS zeroed. Returns 0 when out of memory. */
+#define VOXDAGI_REC_REF (1u << 30)
+#define VOXDAGI_REC_PRIVATE (1u << 31)
+
+/* Allocates V for a level of UNITS bytes (none for the bricks, BRICKS 1) and
+   RECORDS records, 32-bit unless WIDE; START and REFS zeroed. Returns 0 when
+   out of memory. */
 static int voxdagi_vlevel_alloc(voxdagi_mem *m, voxdagi_vlevel *v, uint64_t units, uint64_t records, int bricks,
                                 int wide) {
-    uint64_t sw = bricks ? 0 : (units + 63) / 64, rw = (records + 31) / 32, cn = records;
-    uint64_t bytes = 8 * (sw + rw) + (wide ? 8 : 4) * cn + 4 * sw; /* units <= the image size */
+    uint64_t sw = bricks ? 0 : (units + 31) / 32, rw = wide ? (records + 31) / 32 : 0;
+    uint64_t bytes = 8 * (sw + rw) + (wide ? 8 : 4) * records; /* units <= the image size */
     memset(v, 0, sizeof *v);
     if ((uint64_t)(size_t)bytes != bytes) return 0;
     v->block = voxdagi_alloc(m, (size_t)bytes);
@@ -3772,21 +3778,15 @@ static int voxdagi_vlevel_alloc(voxdagi_mem *m, voxdagi_vlevel *v, uint64_t unit
     v->block_size = (size_t)bytes;
     v->records = records;
     v->start = (uint64_t *)v->block;
-    v->refs = v->start + sw;
     memset(v->block, 0, (size_t)(8 * (sw + rw)));
-    if (wide) v->count64 = v->refs + rw, v->rank = (uint32_t *)(v->count64 + cn);
-    else v->count32 = (uint32_t *)(v->refs + rw), v->rank = v->count32 + cn;
+    if (wide) v->refs = v->start + sw, v->count64 = v->refs + rw;
+    else v->rec32 = (uint32_t *)(v->start + sw);
     return 1;
 }
 
 static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
     voxdagi_free(m, v->block, v->block_size);
     memset(v, 0, sizeof *v);
-}
-
-/* The rank of the record starting at byte OFFSET (its START bit set). */
-VOXDAGI_INLINE uint64_t voxdagi_vlevel_rank(const voxdagi_vlevel *v, uint64_t offset) {
-    return v->rank[offset >> 6] + (uint64_t)voxdagi_popcount64(v->start[offset >> 6] & ((1ull << (offset & 63)) - 1));
 }
 
 /* Every record of every inner level, bottom-up: sizes, zero padding, pointer
@@ -3820,19 +3820,19 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
     }
     if (!voxdagi_vlevel_alloc(m, &child, d->brick_count, d->brick_count, 1, 0))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
-    for (i = 0; i < d->brick_count; i++) child.count32[i] = (uint32_t)voxdagi_popcount64(voxdagi_brick(d, i));
+    for (i = 0; i < d->brick_count; i++) child.rec32[i] = (uint32_t)voxdagi_popcount64(voxdagi_brick(d, i));
     for (l = brick_level; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
         uint64_t at = 0, records = 0, child_units = l + 1 == brick_level ? d->brick_count : d->level[l + 1].size;
         int bricks = l + 1 == brick_level;
-        if (!voxdagi_vlevel_alloc(m, &cur, lv->size, lv->nodes, 0, d->levels - l > 10)) {
+        if (!voxdagi_vlevel_alloc(m, &cur, lv->size, lv->nodes, 0, d->levels - l > 9)) {
             st = VOXDAG_ERR_OUT_OF_MEMORY;
             msg = "cannot allocate validation bitmaps";
             break;
         }
         while (at < lv->size) {
             const uint8_t *rec = lv->data + at;
-            unsigned header, s;
+            unsigned header, h, s, bit;
             uint64_t sum = 0, bits, bytes, next_private;
             where = base + (uint64_t)(rec - d->level[0].data);
             node = records;
@@ -3846,30 +3846,50 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
                 st = VOXDAG_ERR_CORRUPT; msg = "record padding bits not zero"; break;
             }
             next_private = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits * voxdagi_has_private(header));
-            for (s = 0; s < 8 && st == VOXDAG_OK; s++) {
-                unsigned t = header >> (2 * s) & 3, private_child = t == 3 && lv->private_children, used;
+            bit = voxdagi_child_bit(lv, header, 0); /* then each pointer's width, in octant order */
+            for (h = header; h; h &= ~(3u << (2 * s))) { /* the present octants */
+                unsigned t, private_child, used;
                 uint64_t v, target, c, r;
-                if (!t) continue;
+                uint32_t e = 0;
+                s = voxdagi_lowest_bit(h) >> 1;
+                t = h >> (2 * s) & 3;
+                private_child = t == 3 && lv->private_children;
                 if (private_child) {
                     target = next_private;
                 } else {
-                    v = voxdagi_get_bits(rec, voxdagi_child_bit(lv, header, s), lv->width[t]);
+                    v = voxdagi_get_bits(rec, bit, lv->width[t]);
+                    bit += lv->width[t];
                     if ((v & lv->code_mask[t]) >= lv->table_len) {
                         st = VOXDAG_ERR_CORRUPT; msg = "transform code outside the level's table"; break;
                     }
                     target = v >> lv->code_bits[t];
                 }
-                if (target >= child_units || (!bricks && !(child.start[target >> 6] >> (target & 63) & 1))) {
+                if (target >= child_units) {
                     st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
                 }
-                r = bricks ? target : voxdagi_vlevel_rank(&child, target);
-                used = (unsigned)(child.refs[r >> 5] >> (2 * (r & 31))) & 3;
-                if (private_child ? used : used & 2) {
+                if (bricks) {
+                    r = target;
+                } else {
+                    uint64_t w = child.start[target >> 5];
+                    uint32_t below = (uint32_t)w & ((1u << (target & 31)) - 1);
+                    if (!(w >> (target & 31) & 1)) {
+                        st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
+                    }
+                    r = (w >> 32) + (uint64_t)voxdagi_popcount64(below);
+                }
+                if (child.rec32) e = child.rec32[r], used = e >> 30;
+                else used = (unsigned)(child.refs[r >> 5] >> (2 * (r & 31))) & 3;
+                if (private_child ? used : used & 2) { /* a private child's own bits are both set */
                     st = VOXDAG_ERR_CORRUPT; msg = "private child referenced twice"; break;
                 }
-                child.refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
+                if (child.rec32) {
+                    child.rec32[r] = e | VOXDAGI_REC_REF | (private_child ? VOXDAGI_REC_PRIVATE : 0);
+                    c = e & (VOXDAGI_REC_REF - 1);
+                } else {
+                    child.refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
+                    c = child.count64[r];
+                }
                 if (private_child) next_private = target + voxdagi_node_units(d, l + 1, target);
-                c = child.count64 ? child.count64[r] : child.count32[r];
                 if (sum + c < sum) { st = VOXDAG_ERR_CORRUPT; msg = "voxel count overflows"; break; }
                 sum += c;
             }
@@ -3877,10 +3897,10 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             if (lv->count_bits && voxdagi_get_bits_wide(rec, 16, lv->count_bits) != sum) {
                 st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
             }
-            cur.start[at >> 6] |= 1ull << (at & 63);
+            cur.start[at >> 5] |= 1ull << (at & 31);
             if (records < cur.records) { /* more records than the level table says: refused below */
-                if (cur.count64) cur.count64[records] = sum;
-                else cur.count32[records] = (uint32_t)sum;
+                if (cur.rec32) cur.rec32[records] = (uint32_t)sum;
+                else cur.count64[records] = sum;
             }
             at += bytes;
             records++;
@@ -3888,26 +3908,24 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         if (st == VOXDAG_OK && records != lv->nodes) {
             st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records"; where = UINT64_MAX; node = UINT64_MAX;
         }
-        for (i = 0; st == VOXDAG_OK && i < child.records; i += 32) { /* bit 2r: record r referenced */
-            uint64_t want = child.records - i >= 32 ? 0x5555555555555555ull
-                                                    : 0x5555555555555555ull >> (64 - 2 * (child.records - i));
-            if ((child.refs[i >> 5] & want) != want) {
+        for (i = 0; st == VOXDAG_OK && i < child.records; i++)
+            if (child.rec32 ? !(child.rec32[i] & VOXDAGI_REC_REF) : !(child.refs[i >> 5] >> (2 * (i & 31)) & 1)) {
                 st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; where = UINT64_MAX; node = UINT64_MAX;
             }
-        }
         voxdagi_vlevel_free(m, &child);
         child = cur;
         memset(&cur, 0, sizeof cur);
         if (st == VOXDAG_OK) {
             uint64_t w, n = 0;
-            for (w = 0; w < (lv->size + 63) / 64; w++) {
-                child.rank[w] = (uint32_t)n; /* n <= the level's record count, a u32 */
-                n += (uint64_t)voxdagi_popcount64(child.start[w]);
+            for (w = 0; w < (lv->size + 31) / 32; w++) {
+                uint64_t starts = child.start[w];
+                child.start[w] = n << 32 | starts; /* n <= the level's record count, a u32 */
+                n += (uint64_t)voxdagi_popcount64(starts);
             }
         }
     }
     if (st == VOXDAG_OK &&
-        (d->level[0].nodes != 1 || (child.count64 ? child.count64[0] : child.count32[0]) != d->voxels)) {
+        (d->level[0].nodes != 1 || (child.rec32 ? child.rec32[0] : child.count64[0]) != d->voxels)) {
         st = VOXDAG_ERR_CORRUPT; msg = "root does not hold the header's voxel count"; where = base; node = 0;
     }
     voxdagi_vlevel_free(m, &child);
