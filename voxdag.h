@@ -3789,6 +3789,100 @@ static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
     memset(v, 0, sizeof *v);
 }
 
+/* Checks the records of inner level L against CHILD, what validation kept
+   of level L + 1, and fills CUR for level L (START without ranks). BRICKS:
+   level L + 1 is the bricks; WIDE: CHILD keeps 64-bit counts (both constant
+   at each call, so that each case compiles to its own loop). Returns NULL, or
+   what is wrong with the record at byte *AT, the *RECORD-th of the level;
+   then CHILD's reference bits are partly set. After the last record, *AT is
+   the level's size and *RECORD the number of records. */
+VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
+                                                    const voxdagi_vlevel *cur, uint64_t *at_out,
+                                                    uint64_t *record_out, const int bricks, const int wide) {
+    const voxdagi_level *lv = &d->level[l];
+    const uint8_t *data = lv->data;
+    const unsigned table_len = lv->table_len, count_bits = lv->count_bits;
+    const unsigned private_tag = lv->private_children ? 3 : 4; /* the tag of a private child (4: none) */
+    const uint64_t size = lv->size, child_units = bricks ? d->brick_count : d->level[l + 1].size;
+    const uint64_t *const start = child->start;
+    uint64_t *const cur_start = cur->start, *const refs = child->refs;
+    uint32_t *const rec32 = child->rec32;
+    uint64_t at = 0, records = 0;
+    while (at < size) {
+        const uint8_t *rec = data + at;
+        unsigned header, h, s, bit;
+        uint64_t sum = 0, bits, bytes, next_private;
+        *at_out = at, *record_out = records;
+        if (size - at < 2) return "record runs past its level";
+        header = voxdagi_le16(rec);
+        if (!header) return "node without children";
+        bits = voxdagi_record_bits(lv, header);
+        bytes = (bits + 7) / 8;
+        if (size - at < bytes) return "record runs past its level";
+        if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) return "record padding bits not zero";
+        next_private = voxdagi_get_bits(rec, 16 + count_bits, lv->base_bits * voxdagi_has_private(header));
+        bit = voxdagi_child_bit(lv, header, 0); /* then each pointer's width, in octant order */
+        for (h = header; h; h &= ~(3u << (2 * s))) { /* the present octants */
+            unsigned t, private_child, used;
+            uint64_t v, target, c, r;
+            s = voxdagi_lowest_bit(h) >> 1;
+            t = h >> (2 * s) & 3;
+            private_child = t == private_tag;
+            if (private_child) {
+                target = next_private;
+            } else {
+                v = voxdagi_get_bits(rec, bit, lv->width[t]);
+                bit += lv->width[t];
+                if ((v & lv->code_mask[t]) >= table_len) return "transform code outside the level's table";
+                target = v >> lv->code_bits[t];
+            }
+            if (target >= child_units) return "child pointer does not land on a node";
+            if (bricks) {
+                r = target;
+            } else {
+                uint64_t w = start[target >> 5];
+                if (!(w >> (target & 31) & 1)) return "child pointer does not land on a node";
+                r = (w >> 32) + (uint64_t)voxdagi_popcount64((uint32_t)w & ((1u << (target & 31)) - 1));
+            }
+            if (!wide) {
+                uint32_t e = rec32[r];
+                used = e >> 30;
+                if (private_child ? used : used & 2) /* a private child's own bits are both set */
+                    return "private child referenced twice";
+                rec32[r] = e | VOXDAGI_REC_REF | (private_child ? VOXDAGI_REC_PRIVATE : 0);
+                sum += e & (VOXDAGI_REC_REF - 1); /* 8 counts below 2^27: no overflow */
+            } else {
+                used = (unsigned)(refs[r >> 5] >> (2 * (r & 31))) & 3;
+                if (private_child ? used : used & 2) return "private child referenced twice";
+                refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
+                c = child->count64[r];
+                if (sum + c < sum) return "voxel count overflows";
+                sum += c;
+            }
+            if (private_child) next_private = target + voxdagi_node_units(d, l + 1, target);
+        }
+        if (count_bits && voxdagi_get_bits_wide(rec, 16, count_bits) != sum)
+            return "node count differs from its children's sum";
+        cur_start[at >> 5] |= 1ull << (at & 31);
+        if (records < cur->records) { /* more records than the level table says: refused by the caller */
+            if (cur->rec32) cur->rec32[records] = (uint32_t)sum;
+            else cur->count64[records] = sum;
+        }
+        at += bytes;
+        records++;
+    }
+    *at_out = at, *record_out = records;
+    return NULL;
+}
+
+/* voxdagi_validate_records for level L, one loop per case. */
+static const char *voxdagi_validate_level(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
+                                          const voxdagi_vlevel *cur, uint64_t *at, uint64_t *record) {
+    if (l + 3 == d->levels) return voxdagi_validate_records(d, l, child, cur, at, record, 1, 0);
+    if (child->rec32) return voxdagi_validate_records(d, l, child, cur, at, record, 0, 0);
+    return voxdagi_validate_records(d, l, child, cur, at, record, 0, 1);
+}
+
 /* Every record of every inner level, bottom-up: sizes, zero padding, pointer
    codes (inside the level's transform table), targets (a record start of
    the next level, or a brick; private children: from the base, one node
@@ -3823,94 +3917,21 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
     for (i = 0; i < d->brick_count; i++) child.rec32[i] = (uint32_t)voxdagi_popcount64(voxdagi_brick(d, i));
     for (l = brick_level; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
-        uint64_t at = 0, records = 0, child_units = l + 1 == brick_level ? d->brick_count : d->level[l + 1].size;
-        int bricks = l + 1 == brick_level;
+        uint64_t at, records;
         if (!voxdagi_vlevel_alloc(m, &cur, lv->size, lv->nodes, 0, d->levels - l > 9)) {
             st = VOXDAG_ERR_OUT_OF_MEMORY;
             msg = "cannot allocate validation bitmaps";
             break;
         }
-        while (at < lv->size) {
-            const uint8_t *rec = lv->data + at;
-            unsigned header, h, s, bit;
-            uint64_t sum = 0, bits, bytes, next_private;
-            where = base + (uint64_t)(rec - d->level[0].data);
-            node = records;
-            if (lv->size - at < 2) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
-            header = voxdagi_le16(rec);
-            if (!header) { st = VOXDAG_ERR_CORRUPT; msg = "node without children"; break; }
-            bits = voxdagi_record_bits(lv, header);
-            bytes = (bits + 7) / 8;
-            if (lv->size - at < bytes) { st = VOXDAG_ERR_CORRUPT; msg = "record runs past its level"; break; }
-            if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) {
-                st = VOXDAG_ERR_CORRUPT; msg = "record padding bits not zero"; break;
-            }
-            next_private = voxdagi_get_bits(rec, 16 + lv->count_bits, lv->base_bits * voxdagi_has_private(header));
-            bit = voxdagi_child_bit(lv, header, 0); /* then each pointer's width, in octant order */
-            for (h = header; h; h &= ~(3u << (2 * s))) { /* the present octants */
-                unsigned t, private_child, used;
-                uint64_t v, target, c, r;
-                uint32_t e = 0;
-                s = voxdagi_lowest_bit(h) >> 1;
-                t = h >> (2 * s) & 3;
-                private_child = t == 3 && lv->private_children;
-                if (private_child) {
-                    target = next_private;
-                } else {
-                    v = voxdagi_get_bits(rec, bit, lv->width[t]);
-                    bit += lv->width[t];
-                    if ((v & lv->code_mask[t]) >= lv->table_len) {
-                        st = VOXDAG_ERR_CORRUPT; msg = "transform code outside the level's table"; break;
-                    }
-                    target = v >> lv->code_bits[t];
-                }
-                if (target >= child_units) {
-                    st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
-                }
-                if (bricks) {
-                    r = target;
-                } else {
-                    uint64_t w = child.start[target >> 5];
-                    uint32_t below = (uint32_t)w & ((1u << (target & 31)) - 1);
-                    if (!(w >> (target & 31) & 1)) {
-                        st = VOXDAG_ERR_CORRUPT; msg = "child pointer does not land on a node"; break;
-                    }
-                    r = (w >> 32) + (uint64_t)voxdagi_popcount64(below);
-                }
-                if (child.rec32) e = child.rec32[r], used = e >> 30;
-                else used = (unsigned)(child.refs[r >> 5] >> (2 * (r & 31))) & 3;
-                if (private_child ? used : used & 2) { /* a private child's own bits are both set */
-                    st = VOXDAG_ERR_CORRUPT; msg = "private child referenced twice"; break;
-                }
-                if (child.rec32) {
-                    child.rec32[r] = e | VOXDAGI_REC_REF | (private_child ? VOXDAGI_REC_PRIVATE : 0);
-                    c = e & (VOXDAGI_REC_REF - 1);
-                } else {
-                    child.refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
-                    c = child.count64[r];
-                }
-                if (private_child) next_private = target + voxdagi_node_units(d, l + 1, target);
-                if (sum + c < sum) { st = VOXDAG_ERR_CORRUPT; msg = "voxel count overflows"; break; }
-                sum += c;
-            }
-            if (st != VOXDAG_OK) break;
-            if (lv->count_bits && voxdagi_get_bits_wide(rec, 16, lv->count_bits) != sum) {
-                st = VOXDAG_ERR_CORRUPT; msg = "node count differs from its children's sum"; break;
-            }
-            cur.start[at >> 5] |= 1ull << (at & 31);
-            if (records < cur.records) { /* more records than the level table says: refused below */
-                if (cur.rec32) cur.rec32[records] = (uint32_t)sum;
-                else cur.count64[records] = sum;
-            }
-            at += bytes;
-            records++;
-        }
-        if (st == VOXDAG_OK && records != lv->nodes) {
-            st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records"; where = UINT64_MAX; node = UINT64_MAX;
+        msg = voxdagi_validate_level(d, l, &child, &cur, &at, &records);
+        if (msg) {
+            st = VOXDAG_ERR_CORRUPT, where = base + (uint64_t)(lv->data - d->level[0].data) + at, node = records;
+        } else if (records != lv->nodes) {
+            st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records";
         }
         for (i = 0; st == VOXDAG_OK && i < child.records; i++)
             if (child.rec32 ? !(child.rec32[i] & VOXDAGI_REC_REF) : !(child.refs[i >> 5] >> (2 * (i & 31)) & 1)) {
-                st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; where = UINT64_MAX; node = UINT64_MAX;
+                st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node";
             }
         voxdagi_vlevel_free(m, &child);
         child = cur;
