@@ -992,30 +992,87 @@ static uint64_t voxdagi_mix64(uint64_t z) { /* a strong 64-bit finalizer */
 }
 #endif
 
-/* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing by 8: eight
-   bytes per step through eight 256-entry tables, T[k][b] being the CRC
-   register after byte b followed by k zero bytes. The tables (8 KiB) are
-   built per call in about 2,000 steps (the CRC is linear, so T[0] is XORs of
-   its 8 power-of-two entries); calls are few (a header, a table, a few
-   sections per file) and sections large. The data is read byte by byte, so
-   the result does not depend on alignment or byte order. */
-static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
-    uint32_t t[8][256], crc = 0xFFFFFFFFu;
+/* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing by 16:
+   sixteen bytes per step through sixteen 256-entry tables, T[k][b] being the
+   CRC register after byte b followed by k zero bytes. The tables (16 KiB)
+   are built per call in about 4,000 steps (the CRC is linear, so T[0] is XORs
+   of its 8 power-of-two entries), only for inputs of 4 KiB or more (sections);
+   the header and the section table go byte by byte through T[0]. The data is
+   read byte by byte, so the result does not depend on alignment or byte
+   order. */
+typedef struct voxdagi_crc_tables {
+    uint32_t t[16][256];
+} voxdagi_crc_tables;
+
+static void voxdagi_crc_tables_init(voxdagi_crc_tables *c, int all) {
     uint32_t i, k;
-    t[0][0] = 0;
+    c->t[0][0] = 0;
     for (i = 1; i < 256; i <<= 1) {
-        uint32_t c = i;
-        for (k = 0; k < 8; k++) c = (c >> 1) ^ (0x82F63B78u & (0u - (c & 1)));
-        for (k = 0; k < i; k++) t[0][i + k] = c ^ t[0][k];
+        uint32_t x = i;
+        for (k = 0; k < 8; k++) x = (x >> 1) ^ (0x82F63B78u & (0u - (x & 1)));
+        for (k = 0; k < i; k++) c->t[0][i + k] = x ^ c->t[0][k];
     }
-    for (k = 1; k < 8; k++)
-        for (i = 0; i < 256; i++) t[k][i] = (t[k - 1][i] >> 8) ^ t[0][t[k - 1][i] & 0xFF];
-    for (; n >= 8; n -= 8, p += 8) {
-        uint32_t lo = crc ^ ((uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24);
-        crc = t[7][lo & 0xFF] ^ t[6][lo >> 8 & 0xFF] ^ t[5][lo >> 16 & 0xFF] ^ t[4][lo >> 24] ^ t[3][p[4]] ^
-              t[2][p[5]] ^ t[1][p[6]] ^ t[0][p[7]];
+    for (k = 1; all && k < 16; k++)
+        for (i = 0; i < 256; i++) c->t[k][i] = (c->t[k - 1][i] >> 8) ^ c->t[0][c->t[k - 1][i] & 0xFF];
+}
+
+static uint32_t voxdagi_le32_bytes(const uint8_t *p) {
+    return (uint32_t)p[0] | (uint32_t)p[1] << 8 | (uint32_t)p[2] << 16 | (uint32_t)p[3] << 24;
+}
+
+/* The CRC register after the 16 bytes at P, from register CRC; the four
+   lookups of each 4 bytes are XORed apart, so that a step's loads overlap. */
+VOXDAGI_INLINE uint32_t voxdagi_crc_step(const voxdagi_crc_tables *c, uint32_t crc, const uint8_t *p) {
+    const uint32_t(*t)[256] = c->t;
+    uint32_t a = crc ^ voxdagi_le32_bytes(p), b = voxdagi_le32_bytes(p + 4), d = voxdagi_le32_bytes(p + 8),
+             e = voxdagi_le32_bytes(p + 12);
+    uint32_t x0 = t[15][a & 0xFF] ^ t[14][a >> 8 & 0xFF] ^ t[13][a >> 16 & 0xFF] ^ t[12][a >> 24];
+    uint32_t x1 = t[11][b & 0xFF] ^ t[10][b >> 8 & 0xFF] ^ t[9][b >> 16 & 0xFF] ^ t[8][b >> 24];
+    uint32_t x2 = t[7][d & 0xFF] ^ t[6][d >> 8 & 0xFF] ^ t[5][d >> 16 & 0xFF] ^ t[4][d >> 24];
+    uint32_t x3 = t[3][e & 0xFF] ^ t[2][e >> 8 & 0xFF] ^ t[1][e >> 16 & 0xFF] ^ t[0][e >> 24];
+    return (x0 ^ x1) ^ (x2 ^ x3);
+}
+
+/* A * B modulo the CRC polynomial, both reflected (bit 31 is x^0). */
+static uint32_t voxdagi_crc_mulmod(uint32_t a, uint32_t b) {
+    uint32_t m, p = 0;
+    for (m = 1u << 31; m; m >>= 1) { /* B times x^k for bit k of A */
+        if (a & m) p ^= b;
+        b = b & 1 ? (b >> 1) ^ 0x82F63B78u : b >> 1;
     }
-    while (n--) crc = t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+    return p;
+}
+
+/* The CRC-32C of A followed by B from CRC1 (A's), CRC2 (B's) and B's length:
+   A's register moved past N zero bytes is A's times x^(8N) (zlib's
+   crc32_combine). */
+static uint32_t voxdagi_crc_combine(uint32_t crc1, uint32_t crc2, uint64_t n) {
+    uint32_t x = 1u << 31, sq = 1u << 23; /* x^0 and x^8 */
+    for (; n; n >>= 1, sq = voxdagi_crc_mulmod(sq, sq))
+        if (n & 1) x = voxdagi_crc_mulmod(sq, x);
+    return voxdagi_crc_mulmod(x, crc1) ^ crc2;
+}
+
+/* From 64 KiB on, three thirds at once, combined after: each step waits for
+   the previous one's lookups, and three independent chains fill that wait. */
+static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
+    voxdagi_crc_tables c;
+    uint32_t crc = 0xFFFFFFFFu;
+    int sliced = n >= 4096;
+    voxdagi_crc_tables_init(&c, sliced);
+    if (n >= 65536) {
+        uint64_t part = n / 48 * 16, i; /* a third, in whole steps */
+        uint32_t c1 = 0xFFFFFFFFu, c2 = 0xFFFFFFFFu;
+        for (i = 0; i < part; i += 16) {
+            crc = voxdagi_crc_step(&c, crc, p + i);
+            c1 = voxdagi_crc_step(&c, c1, p + part + i);
+            c2 = voxdagi_crc_step(&c, c2, p + 2 * part + i);
+        }
+        crc = ~voxdagi_crc_combine(voxdagi_crc_combine(~crc, ~c1, part), ~c2, part);
+        p += 3 * part, n -= 3 * part;
+    }
+    for (; sliced && n >= 16; n -= 16, p += 16) crc = voxdagi_crc_step(&c, crc, p);
+    while (n--) crc = c.t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
     return ~crc;
 }
 
