@@ -3641,13 +3641,14 @@ VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, u
 /* occupancy[MI][p]: the world octants w holding a child, for stored presence
    P seen through world-to-stored transform MI (w is full when MI(w) is). */
 static void voxdagi_occupancy_init(voxdag *d) {
-    unsigned tf, p, w;
-    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++)
-        for (p = 0; p < 256; p++) {
-            unsigned o = 0;
-            for (w = 0; w < 8; w++) o |= (p >> d->cube.act[tf][w] & 1) << w;
-            d->occupancy[tf][p] = (uint8_t)o;
-        }
+    unsigned tf, i, k;
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
+        uint8_t *occ = d->occupancy[tf], world[8]; /* world[i]: the world octant of stored octant i, as a bit */
+        for (i = 0; i < 8; i++) world[d->cube.act[tf][i]] = (uint8_t)(1u << i);
+        occ[0] = 0;
+        for (i = 0; i < 8; i++) /* the presences below 2^(i+1) from those below 2^i */
+            for (k = 0; k < 1u << i; k++) occ[(1u << i) + k] = (uint8_t)(occ[k] | world[i]);
+    }
 }
 
 /* Whether a record with HEADER has private children (then its base field
