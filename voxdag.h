@@ -4040,6 +4040,21 @@ typedef struct voxdagi_ref_set {
 } voxdagi_ref_set;
 
 /* Adds KEY to S (growing it when half full). Returns 0 when out of memory. */
+static int voxdagi_ref_set_add(voxdagi_mem *m, voxdagi_ref_set *s, uint64_t key);
+
+/* Makes empty set S hold N keys without growing. Returns 0 when out of
+   memory. */
+static int voxdagi_ref_set_reserve(voxdagi_mem *m, voxdagi_ref_set *s, size_t n) {
+    size_t cap = 64;
+    while (cap < 2 * n && cap < ((size_t)-1 >> 4)) cap *= 2;
+    if (s->n || cap <= s->cap) return 1;
+    voxdagi_free(m, s->slot, s->cap * sizeof *s->slot);
+    s->slot = (uint64_t *)voxdagi_alloc(m, cap * sizeof *s->slot);
+    s->cap = s->slot ? cap : 0;
+    if (s->slot) memset(s->slot, 0, cap * sizeof *s->slot);
+    return s->slot != NULL;
+}
+
 static int voxdagi_ref_set_add(voxdagi_mem *m, voxdagi_ref_set *s, uint64_t key) {
     size_t i;
     if (2 * (s->n + 1) > s->cap) {
@@ -4074,28 +4089,37 @@ static void voxdagi_ref_set_free(voxdagi_mem *m, voxdagi_ref_set *s) {
 static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned high, uint32_t *out) {
     uint32_t brick_level = d->levels - 2, l, at = high ? 1u << d->levels : 0, best = high ? 0 : 4;
     voxdagi_ref_set cur, next;
+    uint8_t wanted[2][VOXDAGI_TRANSFORMS]; /* [half][MI]: the stored octants of the world half */
     size_t i;
-    unsigned w;
+    unsigned w, mi;
     memset(&cur, 0, sizeof cur);
     memset(&next, 0, sizeof next);
+    memset(wanted, 0, sizeof wanted);
+    for (mi = 0; mi < VOXDAGI_TRANSFORMS; mi++)
+        for (w = 0; w < 8; w++) wanted[w >> a & 1][mi] = (uint8_t)(wanted[w >> a & 1][mi] | 1u << d->cube.act[mi][w]);
     if (!voxdagi_ref_set_add(m, &cur, d->cube.inv[d->root_transform])) return 0;
     for (l = 0; l < brick_level; l++) {
         unsigned side; /* the half of each cell on the wanted side, then the other */
         for (side = 0; side < 2 && !next.n; side++) {
             unsigned half = high ^ side;
+            if (!voxdagi_ref_set_reserve(m, &next, 4 * cur.n)) { /* 4 children each at most */
+                voxdagi_ref_set_free(m, &cur);
+                return 0;
+            }
             for (i = 0; i < cur.cap; i++) {
-                uint64_t key = cur.slot[i] - 1, off = key >> 6;
-                unsigned mi = (unsigned)(key & 63), header;
+                uint64_t key = cur.slot[i] - 1, off = key >> 6, ref[8];
+                unsigned header, set, v;
                 const uint8_t *rec;
                 if (!cur.slot[i]) continue;
+                mi = (unsigned)(key & 63);
                 rec = d->level[l].data + off;
                 header = voxdagi_le16(rec);
-                for (w = 0; w < 8; w++) {
-                    unsigned v = d->cube.act[mi][w];
-                    uint64_t ref;
-                    if ((w >> a & 1) != half || !(header >> (2 * v) & 3)) continue;
-                    ref = voxdagi_child_ref(d, l, rec, header, v, 1);
-                    if (!voxdagi_ref_set_add(m, &next, (ref >> 6) << 6 | d->cube.comp[ref & 63][mi])) {
+                set = voxdagi_presence(header) & wanted[half][mi];
+                if (!set) continue;
+                voxdagi_child_refs(d, l, rec, header, set, ref);
+                for (; set; set &= set - 1) {
+                    v = voxdagi_lowest_bit(set);
+                    if (!voxdagi_ref_set_add(m, &next, (ref[v] >> 6) << 6 | d->cube.comp[ref[v] & 63][mi])) {
                         voxdagi_ref_set_free(m, &cur);
                         voxdagi_ref_set_free(m, &next);
                         return 0;
