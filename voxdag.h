@@ -3987,10 +3987,18 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
         } else if (records != lv->nodes) {
             st = VOXDAG_ERR_CORRUPT; msg = "level node count differs from its records";
         }
-        for (i = 0; st == VOXDAG_OK && i < child.records; i++)
-            if (child.rec32 ? !(child.rec32[i] & VOXDAGI_REC_REF) : !(child.refs[i >> 5] >> (2 * (i & 31)) & 1)) {
-                st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node";
+        if (st == VOXDAG_OK) { /* every child referenced: the AND of their reference bits */
+            uint64_t all = ~0ull, want;
+            if (child.rec32) {
+                for (i = 0; i < child.records; i++) all &= child.rec32[i];
+                want = VOXDAGI_REC_REF;
+            } else {
+                for (i = 0; i < child.records; i += 32) /* the bits past the last record count as set */
+                    all &= child.refs[i >> 5] | (child.records - i >= 32 ? 0 : ~0ull << 2 * (child.records - i));
+                want = 0x5555555555555555ull;
             }
+            if ((all & want) != want) { st = VOXDAG_ERR_CORRUPT; msg = "unreferenced node"; }
+        }
         voxdagi_vlevel_free(m, &child);
         child = cur;
         memset(&cur, 0, sizeof cur);
