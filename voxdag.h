@@ -3683,13 +3683,6 @@ VOXDAGI_INLINE uint64_t voxdagi_record_bytes(const voxdagi_level *lv, uint64_t o
     return (voxdagi_record_bits(lv, voxdagi_le16(lv->data + offset)) + 7) >> 3;
 }
 
-/* Units from the node at OFFSET of level L to the next one: its record's
-   bytes, or 1 on the brick level. */
-static uint64_t voxdagi_node_units(const voxdag *d, uint32_t l, uint64_t offset) {
-    if (l == d->levels - 2) return 1;
-    return voxdagi_record_bytes(&d->level[l], offset);
-}
-
 /* The offset of the private child of stored octant S of record REC of
    inner level L: the base, then one node further per lower private child
    (bricks: one each). */
@@ -3847,6 +3840,13 @@ static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
     memset(v, 0, sizeof *v);
 }
 
+/* Returns WHY from voxdagi_validate_records, for the record at AT. */
+#define VOXDAGI_BAD(why) \
+    do { \
+        *at_out = at, *record_out = records; \
+        return why; \
+    } while (0)
+
 /* Checks the records of inner level L against CHILD, what validation kept
    of level L + 1, and fills CUR for level L (START without ranks). BRICKS:
    level L + 1 is the bricks; WIDE: CHILD keeps 64-bit counts (both constant
@@ -3857,7 +3857,9 @@ static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
 VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
                                                     const voxdagi_vlevel *cur, uint64_t *at_out,
                                                     uint64_t *record_out, const int bricks, const int wide) {
-    const voxdagi_level *lv = &d->level[l];
+    const voxdagi_level level = d->level[l], *lv = &level; /* a copy, which the stores below cannot change */
+    const uint64_t wmask[4] = {0, (1ull << level.width[1]) - 1, (1ull << level.width[2]) - 1,
+                               (1ull << level.width[3]) - 1}; /* each class's pointer bits */
     const uint8_t *data = lv->data;
     const unsigned table_len = lv->table_len, count_bits = lv->count_bits;
     const unsigned private_tag = lv->private_children ? 3 : 4; /* the tag of a private child (4: none) */
@@ -3868,59 +3870,58 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
     uint64_t at = 0, records = 0;
     while (at < size) {
         const uint8_t *rec = data + at;
-        unsigned header, h, s, bit;
+        unsigned header, h, bit;
         uint64_t sum = 0, bits, bytes, next_private;
-        *at_out = at, *record_out = records;
-        if (size - at < 2) return "record runs past its level";
+        if (size - at < 2) VOXDAGI_BAD("record runs past its level");
         header = voxdagi_le16(rec);
-        if (!header) return "node without children";
+        if (!header) VOXDAGI_BAD("node without children");
         bits = voxdagi_record_bits(lv, header);
         bytes = (bits + 7) / 8;
-        if (size - at < bytes) return "record runs past its level";
-        if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) return "record padding bits not zero";
+        if (size - at < bytes) VOXDAGI_BAD("record runs past its level");
+        if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) VOXDAGI_BAD("record padding bits not zero");
         next_private = voxdagi_get_bits(rec, 16 + count_bits, lv->base_bits * voxdagi_has_private(header));
         bit = voxdagi_child_bit(lv, header, 0); /* then each pointer's width, in octant order */
-        for (h = header; h; h &= ~(3u << (2 * s))) { /* the present octants */
+        for (h = header; h; h >>= 2) { /* the present octants' tags, lowest first */
             unsigned t, private_child, used;
             uint64_t v, target, c, r;
-            s = voxdagi_lowest_bit(h) >> 1;
-            t = h >> (2 * s) & 3;
+            h >>= voxdagi_lowest_bit(h) & ~1u; /* past the absent octants */
+            t = h & 3;
             private_child = t == private_tag;
             if (private_child) {
                 target = next_private;
             } else {
-                v = voxdagi_get_bits(rec, bit, lv->width[t]);
+                v = voxdagi_le_fast(rec + (bit >> 3), 8) >> (bit & 7) & wmask[t]; /* voxdagi_get_bits */
                 bit += lv->width[t];
-                if ((v & lv->code_mask[t]) >= table_len) return "transform code outside the level's table";
+                if ((v & lv->code_mask[t]) >= table_len) VOXDAGI_BAD("transform code outside the level's table");
                 target = v >> lv->code_bits[t];
             }
-            if (target >= child_units) return "child pointer does not land on a node";
+            if (target >= child_units) VOXDAGI_BAD("child pointer does not land on a node");
             if (bricks) {
                 r = target;
             } else {
                 uint64_t w = start[target >> 5];
-                if (!(w >> (target & 31) & 1)) return "child pointer does not land on a node";
+                if (!(w >> (target & 31) & 1)) VOXDAGI_BAD("child pointer does not land on a node");
                 r = (w >> 32) + (uint64_t)voxdagi_popcount64((uint32_t)w & ((1u << (target & 31)) - 1));
             }
             if (!wide) {
                 uint32_t e = rec32[r];
                 used = e >> 30;
                 if (private_child ? used : used & 2) /* a private child's own bits are both set */
-                    return "private child referenced twice";
+                    VOXDAGI_BAD("private child referenced twice");
                 rec32[r] = e | VOXDAGI_REC_REF | (private_child ? VOXDAGI_REC_PRIVATE : 0);
                 sum += e & (VOXDAGI_REC_REF - 1); /* 8 counts below 2^27: no overflow */
             } else {
                 used = (unsigned)(refs[r >> 5] >> (2 * (r & 31))) & 3;
-                if (private_child ? used : used & 2) return "private child referenced twice";
+                if (private_child ? used : used & 2) VOXDAGI_BAD("private child referenced twice");
                 refs[r >> 5] |= (uint64_t)(private_child ? 3 : 1) << (2 * (r & 31));
                 c = child->count64[r];
-                if (sum + c < sum) return "voxel count overflows";
+                if (sum + c < sum) VOXDAGI_BAD("voxel count overflows");
                 sum += c;
             }
-            if (private_child) next_private = target + voxdagi_node_units(d, l + 1, target);
+            if (private_child) next_private = target + (bricks ? 1 : voxdagi_record_bytes(&d->level[l + 1], target));
         }
         if (count_bits && voxdagi_get_bits_wide(rec, 16, count_bits) != sum)
-            return "node count differs from its children's sum";
+            VOXDAGI_BAD("node count differs from its children's sum");
         cur_start[at >> 5] |= 1ull << (at & 31);
         if (records < cur->records) { /* more records than the level table says: refused by the caller */
             if (cur->rec32) cur->rec32[records] = (uint32_t)sum;
@@ -3932,6 +3933,7 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
     *at_out = at, *record_out = records;
     return NULL;
 }
+#undef VOXDAGI_BAD
 
 /* voxdagi_validate_records for level L, one loop per case. */
 static const char *voxdagi_validate_level(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
