@@ -3840,6 +3840,18 @@ static void voxdagi_vlevel_free(voxdagi_mem *m, voxdagi_vlevel *v) {
     memset(v, 0, sizeof *v);
 }
 
+/* The set bits of X; branch-free with 32-bit constants (cheaper than
+   voxdagi_popcount64 where the popcount instruction is not enabled). */
+static unsigned voxdagi_popcount32(uint32_t x) {
+#if (defined(__GNUC__) || defined(__clang__)) && defined(__POPCNT__)
+    return (unsigned)__builtin_popcount(x);
+#else
+    x = x - ((x >> 1) & 0x55555555u);
+    x = (x & 0x33333333u) + ((x >> 2) & 0x33333333u);
+    return ((x + (x >> 4)) & 0x0F0F0F0Fu) * 0x01010101u >> 24;
+#endif
+}
+
 /* Returns WHY from voxdagi_validate_records, for the record at AT. */
 #define VOXDAGI_BAD(why) \
     do { \
@@ -3875,12 +3887,12 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
         if (size - at < 2) VOXDAGI_BAD("record runs past its level");
         header = voxdagi_le16(rec);
         if (!header) VOXDAGI_BAD("node without children");
-        bits = voxdagi_record_bits(lv, header);
+        bit = voxdagi_child_bit(lv, header, 0); /* the first pointer; then each one's width, in octant order */
+        bits = bit + lv->ptr_bits[header & 0xFF] + lv->ptr_bits[header >> 8]; /* voxdagi_record_bits */
         bytes = (bits + 7) / 8;
         if (size - at < bytes) VOXDAGI_BAD("record runs past its level");
         if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) VOXDAGI_BAD("record padding bits not zero");
-        next_private = voxdagi_get_bits(rec, 16 + count_bits, lv->base_bits * voxdagi_has_private(header));
-        bit = voxdagi_child_bit(lv, header, 0); /* then each pointer's width, in octant order */
+        next_private = voxdagi_get_bits(rec, 16 + count_bits, bit - 16 - count_bits); /* the base, when there is one */
         for (h = header; h; h >>= 2) { /* the present octants' tags, lowest first */
             unsigned t, private_child, used;
             uint64_t v, target, c, r;
@@ -3901,7 +3913,7 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
             } else {
                 uint64_t w = start[target >> 5];
                 if (!(w >> (target & 31) & 1)) VOXDAGI_BAD("child pointer does not land on a node");
-                r = (w >> 32) + (uint64_t)voxdagi_popcount64((uint32_t)w & ((1u << (target & 31)) - 1));
+                r = (w >> 32) + voxdagi_popcount32((uint32_t)w & ((1u << (target & 31)) - 1));
             }
             if (!wide) {
                 uint32_t e = rec32[r];
