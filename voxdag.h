@@ -3867,8 +3867,9 @@ static unsigned voxdagi_popcount32(uint32_t x) {
    then CHILD's reference bits are partly set. After the last record, *AT is
    the level's size and *RECORD the number of records. */
 VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
-                                                    const voxdagi_vlevel *cur, uint64_t *at_out,
-                                                    uint64_t *record_out, const int bricks, const int wide) {
+                                                    const voxdagi_vlevel *cur, const uint16_t *tag_seq,
+                                                    uint64_t *at_out, uint64_t *record_out, const int bricks,
+                                                    const int wide) {
     const voxdagi_level level = d->level[l], *lv = &level; /* a copy, which the stores below cannot change */
     const uint64_t wmask[4] = {0, (1ull << level.width[1]) - 1, (1ull << level.width[2]) - 1,
                                (1ull << level.width[3]) - 1}; /* each class's pointer bits */
@@ -3893,11 +3894,11 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
         if (size - at < bytes) VOXDAGI_BAD("record runs past its level");
         if (voxdagi_get_bits(rec, bits, (unsigned)(8 * bytes - bits))) VOXDAGI_BAD("record padding bits not zero");
         next_private = voxdagi_get_bits(rec, 16 + count_bits, bit - 16 - count_bits); /* the base, when there is one */
-        for (h = header; h; h >>= 2) { /* the present octants' tags, lowest first */
-            unsigned t, private_child, used;
+        h = tag_seq[header & 0xFF];
+        h = (h & 0xFF) | (tag_seq[header >> 8] & 0xFFu) << (h >> 8);
+        for (; h; h >>= 2) { /* the present octants' tags, lowest first */
+            unsigned t = h & 3, private_child, used;
             uint64_t v, target, c, r;
-            h >>= voxdagi_lowest_bit(h) & ~1u; /* past the absent octants */
-            t = h & 3;
             private_child = t == private_tag;
             if (private_child) {
                 target = next_private;
@@ -3949,10 +3950,25 @@ VOXDAGI_INLINE const char *voxdagi_validate_records(const voxdag *d, uint32_t l,
 
 /* voxdagi_validate_records for level L, one loop per case. */
 static const char *voxdagi_validate_level(const voxdag *d, uint32_t l, voxdagi_vlevel *child,
-                                          const voxdagi_vlevel *cur, uint64_t *at, uint64_t *record) {
-    if (l + 3 == d->levels) return voxdagi_validate_records(d, l, child, cur, at, record, 1, 0);
-    if (child->rec32) return voxdagi_validate_records(d, l, child, cur, at, record, 0, 0);
-    return voxdagi_validate_records(d, l, child, cur, at, record, 0, 1);
+                                          const voxdagi_vlevel *cur, const uint16_t *tag_seq, uint64_t *at,
+                                          uint64_t *record) {
+    if (l + 3 == d->levels) return voxdagi_validate_records(d, l, child, cur, tag_seq, at, record, 1, 0);
+    if (child->rec32) return voxdagi_validate_records(d, l, child, cur, tag_seq, at, record, 0, 0);
+    return voxdagi_validate_records(d, l, child, cur, tag_seq, at, record, 0, 1);
+}
+
+/* TAG_SEQ[b] for each header byte b (4 octants' tags): its non-zero tags
+   packed from bit 0, lowest octant first, and their bits (2 each) from bit
+   8; the pointer loop then takes one tag after the other, with no search for
+   the next present octant on its critical path. */
+static void voxdagi_tag_seq_init(uint16_t tag_seq[256]) {
+    unsigned b, k;
+    for (b = 0; b < 256; b++) {
+        unsigned seq = 0, n = 0;
+        for (k = 0; k < 4; k++)
+            if (b >> (2 * k) & 3) seq |= (b >> (2 * k) & 3) << (2 * n++);
+        tag_seq[b] = (uint16_t)(seq | n << 9);
+    }
 }
 
 /* Every record of every inner level, bottom-up: sizes, zero padding, pointer
@@ -3965,6 +3981,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
     uint32_t brick_level = d->levels - 2, l;
     uint64_t base = brick_level ? (uint64_t)(d->level[0].data - d->image) : 0, i; /* no node data when L = 2 */
     voxdagi_vlevel child, cur;
+    uint16_t tag_seq[256];
     voxdag_status st = VOXDAG_OK;
     const char *msg = NULL;
     uint64_t where = UINT64_MAX, node = UINT64_MAX;
@@ -3987,6 +4004,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
     if (!voxdagi_vlevel_alloc(m, &child, d->brick_count, d->brick_count, 1, 0))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate validation bitmaps");
     for (i = 0; i < d->brick_count; i++) child.rec32[i] = (uint32_t)voxdagi_popcount64(voxdagi_brick(d, i));
+    voxdagi_tag_seq_init(tag_seq);
     for (l = brick_level; st == VOXDAG_OK && l-- > 0;) {
         const voxdagi_level *lv = &d->level[l];
         uint64_t at, records;
@@ -3995,7 +4013,7 @@ static voxdag_status voxdagi_validate_nodes(const voxdag *d, voxdagi_mem *m, vox
             msg = "cannot allocate validation bitmaps";
             break;
         }
-        msg = voxdagi_validate_level(d, l, &child, &cur, &at, &records);
+        msg = voxdagi_validate_level(d, l, &child, &cur, tag_seq, &at, &records);
         if (msg) {
             st = VOXDAG_ERR_CORRUPT, where = base + (uint64_t)(lv->data - d->level[0].data) + at, node = records;
         } else if (records != lv->nodes) {
