@@ -14,10 +14,10 @@ CSTD    := -std=c99
 OPT     ?= -O2
 THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
-HEADERS := voxdag.h voxcolor.h
+HEADERS := voxdag.h voxcolor.h voxdag_gpu.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
 # libstb-dev, a header compiled into the tool: nothing at run time. `make`
@@ -42,7 +42,7 @@ $(STB_IMAGE):
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
 $(BUILD)/opt/examples/image_stb.o $(BUILD)/san/examples/image_stb.o: $(STB_IMAGE)

@@ -1,0 +1,415 @@
+/* voxdag_gpu.h in its C mode, against the library and brute force: the 48
+   symmetries against FORMAT.md's definitions, lookups and indices against a
+   dense grid and the Morton rank, colours against voxdag_color, and rays
+   against voxdag_raycast / voxdag_occluded. The header traces in float32
+   where the library is exact in double, so a ray may differ at a near-tie:
+   an answer that differs is accepted only when the exact answer of a ray
+   moved by a few float32 roundings at the grid's scale (EPS below) is the
+   same, and such answers are counted and bounded. The same rays run on
+   Vulkan in tests/test_vk.c, against this C build bit for bit. */
+#include "test.h"
+#include "voxdag.h"
+#include "voxcolor.h"
+#include "voxdag_gpu.h"
+#include "rscene.h"
+#include "golden.h"
+
+#include <math.h>
+
+// -- The 48 symmetries, by FORMAT.md's words
+
+static void ref_perm(unsigned p, unsigned perm[3]) { /* lexicographic */
+    static const unsigned table[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+    memcpy(perm, table[p], sizeof table[p]);
+}
+
+static unsigned ref_act(unsigned t, unsigned i) {
+    unsigned perm[3], a, r = 0;
+    ref_perm(t >> 3, perm);
+    for (a = 0; a < 3; a++) r |= (i >> a & 1) << perm[a];
+    return r ^ (t & 7);
+}
+
+static void test_gpu_transforms(void) {
+    unsigned a, b, i, w, x;
+    uint64_t r = 0x6E0;
+    for (a = 0; a < 48; a++) {
+        unsigned inv = voxdag_gpui_inverse(a);
+        for (i = 0; i < 8; i++) {
+            CHECK(voxdag_gpui_act(a, i) == ref_act(a, i));
+            CHECK(ref_act(inv, ref_act(a, i)) == i);
+        }
+        for (b = 0; b < 48; b++) {
+            unsigned c = voxdag_gpui_compose(a, b);
+            for (i = 0; i < 8; i++) CHECK(ref_act(c, i) == ref_act(a, ref_act(b, i)));
+        }
+        /* octant sets: world bit w is stored bit MI(w) */
+        for (x = 0; x < 256; x++) {
+            unsigned got = voxdag_gpui_bytes_to_world(x * 0x01010101u, a), want = 0;
+            for (w = 0; w < 8; w++) want |= (x >> ref_act(a, w) & 1) << w;
+            CHECK(got == want * 0x01010101u);
+        }
+        /* brick masks: both coordinate-bit triples */
+        for (i = 0; i < 64; i++) {
+            uint64_t m = test_rand(&r) & test_rand(&r), want = 0, got;
+            voxdag_gpui_mask gm;
+            unsigned p;
+            if (i < 6) m = 1ull << test_rand_below(&r, 64);
+            gm.lo = (uint32_t)m, gm.hi = (uint32_t)(m >> 32);
+            gm = voxdag_gpui_brick_to_world(gm, a);
+            got = (uint64_t)gm.hi << 32 | gm.lo;
+            for (p = 0; p < 64; p++) want |= (m >> (ref_act(a, p & 7) | ref_act(a, p >> 3) << 3) & 1) << p;
+            CHECK(got == want);
+        }
+    }
+}
+
+// -- Queries of one loaded file
+
+typedef struct gpu_stats {
+    uint64_t rays, hits, lod_hits, near_ties, lookups, colors, private_levels;
+    double worst_t; /* largest |t - exact t| * |dir|, grid units */
+} gpu_stats;
+
+static voxdag_gpu_buf gpu_buffer(const voxdag *d) {
+    voxdag_gpu_buf buf;
+    size_t size;
+    buf.bytes = (const unsigned char *)voxdag_image(d, &size);
+    buf.size = size;
+    return buf;
+}
+
+static voxdag_gpu_ray gpu_ray(const voxdag_ray *ray, double lod, int want_index) {
+    voxdag_gpu_ray g;
+    g.ox = (float)ray->origin[0], g.oy = (float)ray->origin[1], g.oz = (float)ray->origin[2];
+    g.dx = (float)ray->dir[0], g.dy = (float)ray->dir[1], g.dz = (float)ray->dir[2];
+    g.t_min = (float)ray->t_min, g.t_max = (float)ray->t_max, g.lod = (float)lod;
+    g.flags = want_index ? VOXDAG_GPU_WANT_INDEX : 0u;
+    return g;
+}
+
+/* Whether the exact answer to RAY is G's (voxel, level, normal, index). */
+static int same_answer(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g) {
+    voxdag_ray_opts o;
+    voxdag_hit h;
+    int r;
+    memset(&o, 0, sizeof o);
+    o.want_index = 1, o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0;
+    r = voxdag_raycast(d, ray, &o, &h);
+    if (r != (int)g->hit) return 0;
+    return !r || (h.xyz[0] == g->x && h.xyz[1] == g->y && h.xyz[2] == g->z && h.level == g->level &&
+                  h.normal[0] == g->nx && h.normal[1] == g->ny && h.normal[2] == g->nz &&
+                  h.index == ((uint64_t)g->index_hi << 32 | g->index_lo));
+}
+
+/* A near-tie: the exact answer of RAY moved by EPS grid units along an axis,
+   or with a limit moved by EPS, is G's. */
+static int near_tie(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g, double eps) {
+    double m = fmax(fabs(ray->dir[0]), fmax(fabs(ray->dir[1]), fabs(ray->dir[2])));
+    int a, s;
+    for (a = 0; a < 5; a++)
+        for (s = -1; s <= 1; s += 2) {
+            voxdag_ray p = *ray;
+            if (a < 3) p.origin[a] += s * eps;
+            else if (a == 3) p.t_min += s * eps / m;
+            else if (p.t_max != HUGE_VAL) p.t_max += s * eps / m;
+            if (same_answer(d, &p, lod, g)) return 1;
+        }
+    return 0;
+}
+
+/* One ray, with and without level of detail, and as a shadow query. */
+static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, const voxdag_ray *ray, double lod,
+                      gpu_stats *st) {
+    voxdag_info info;
+    voxdag_gpu_hit g = voxdag_gpu_raycast(buf, f, gpu_ray(ray, lod, 1));
+    double m = fmax(fabs(ray->dir[0]), fmax(fabs(ray->dir[1]), fabs(ray->dir[2]))), eps;
+    voxdag_get_info(d, &info);
+    eps = ldexp((double)(1u << info.levels) + fabs(ray->origin[0]) + fabs(ray->origin[1]) + fabs(ray->origin[2]), -20);
+    st->rays++;
+    st->hits += g.hit;
+    st->lod_hits += g.hit && g.level < info.levels;
+    if (same_answer(d, ray, lod, &g)) {
+        if (g.hit) {
+            voxdag_ray_opts o;
+            voxdag_hit h;
+            memset(&o, 0, sizeof o);
+            o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0;
+            voxdag_raycast(d, ray, &o, &h);
+            st->worst_t = fmax(st->worst_t, fabs(g.t - h.t) * m);
+            CHECK_MSG(fabs(g.t - h.t) * m <= eps, "t %.9g, exact %.17g", g.t, h.t);
+        }
+    } else {
+        int tie = near_tie(d, ray, lod, &g, eps);
+        st->near_ties++;
+        CHECK_MSG(tie, "ray (%.9g %.9g %.9g) dir (%.9g %.9g %.9g) t [%.9g %.9g] lod %g: gpu hit %u (%u %u %u) "
+                  "level %u normal (%d %d %d)", ray->origin[0], ray->origin[1], ray->origin[2], ray->dir[0],
+                  ray->dir[1], ray->dir[2], ray->t_min, ray->t_max, lod, g.hit, g.x, g.y, g.z, g.level, g.nx, g.ny,
+                  g.nz);
+    }
+    if (lod == 0) {
+        unsigned occ = voxdag_gpu_occluded(buf, f, gpu_ray(ray, 0, 0));
+        CHECK(occ == g.hit);
+        if (occ != (unsigned)voxdag_occluded(d, ray)) CHECK(near_tie(d, ray, 0, &g, eps));
+    }
+}
+
+/* A ray from make_ray with every component rounded to float (the GPU's input). */
+static voxdag_ray float_ray(uint64_t *r, uint32_t n) {
+    voxdag_ray ray = make_ray(r, n);
+    int a;
+    for (a = 0; a < 3; a++) ray.origin[a] = (float)ray.origin[a], ray.dir[a] = (float)ray.dir[a];
+    ray.t_min = (float)ray.t_min;
+    if (ray.t_max != HUGE_VAL) ray.t_max = (float)ray.t_max;
+    return ray;
+}
+
+static void check_file(const voxdag *d, const rscene *s, uint64_t seed, uint32_t rays, gpu_stats *st) {
+    voxdag_gpu_buf buf = gpu_buffer(d);
+    voxdag_gpu_file f = voxdag_gpu_open(buf, 0);
+    voxdag_info info;
+    uint64_t r = seed, i, n;
+    uint32_t l;
+    voxdag_get_info(d, &info);
+    CHECK(f.levels == info.levels && ((uint64_t)f.voxels_hi << 32 | f.voxels_lo) == info.voxels);
+    CHECK(f.color_kind == (uint32_t)info.color_kind);
+    for (l = 0; l + 2 < info.levels; l++) st->private_levels += voxdag_gpui_level_at(buf, f, l).private_children;
+    /* lookups: every cell of small grids, else a sample, against the dense grid */
+    n = (uint64_t)1 << (3 * info.levels);
+    for (i = 0; i < (n <= 32768 ? n : 32768); i++) {
+        uint32_t x, y, z;
+        voxdag_gpu_lookup_result g;
+        uint64_t want_index = 0;
+        int want;
+        if (n <= 32768) voxdag_morton_decode(i, &x, &y, &z);
+        else x = test_rand_below(&r, 1u << info.levels), y = test_rand_below(&r, 1u << info.levels), z = test_rand_below(&r, 1u << info.levels);
+        g = voxdag_gpu_lookup(buf, f, x, y, z);
+        want = s ? s->occ[info.levels][rcell(s->n, x, y, z)] : voxdag_lookup(d, x, y, z, &want_index);
+        if (s && want) want_index = s->rank[rcell(s->n, x, y, z)];
+        st->lookups++;
+        CHECK_MSG((int)g.found == want, "(%u %u %u): found %u, want %d", x, y, z, g.found, want);
+        if (want) CHECK(((uint64_t)g.index_hi << 32 | g.index_lo) == want_index);
+    }
+    CHECK(voxdag_gpu_lookup(buf, f, 1u << info.levels, 0, 0).found == 0);
+    /* colours: every index */
+    for (i = 0; i < info.voxels && i < 200000; i++) {
+        uint8_t want[3];
+        uint32_t got = voxdag_gpu_color(buf, f, (uint32_t)i, (uint32_t)(i >> 32));
+        st->colors++;
+        if (voxdag_color(d, i, want))
+            CHECK_MSG(got == ((uint32_t)want[0] | (uint32_t)want[1] << 8 | (uint32_t)want[2] << 16),
+                      "colour %llu: %06x, want %02x%02x%02x", (unsigned long long)i, got, want[2], want[1], want[0]);
+        else
+            CHECK(got == VOXDAG_GPU_NO_COLOR);
+    }
+    /* rays, with and without level of detail */
+    for (i = 0; i < rays; i++) {
+        voxdag_ray ray = float_ray(&r, 1u << info.levels);
+        check_ray(d, buf, f, &ray, 0, st);
+        if (info.levels > 2) check_ray(d, buf, f, &ray, (float)rand_in(&r, 0.01, 0.6), st);
+    }
+}
+
+/* D with a voxcolor section of its colours (max error E, page shift S). */
+static voxdag *with_voxcolor(const voxdag *d, double e, unsigned s) {
+    voxdag_info info;
+    voxcolor_encode_opts eo;
+    voxdag *v = NULL;
+    uint8_t *rgb, *stream;
+    size_t cap, len, i;
+    voxdag_get_info(d, &info);
+    rgb = (uint8_t *)malloc(3 * (size_t)info.voxels + 3);
+    for (i = 0; i < info.voxels; i++) voxdag_color(d, i, rgb + 3 * i);
+    cap = voxcolor_encode_bound((size_t)info.voxels);
+    stream = (uint8_t *)malloc(cap);
+    memset(&eo, 0, sizeof eo);
+    eo.max_error = e, eo.page_shift = s;
+    len = voxcolor_encode(stream, cap, rgb, (size_t)info.voxels, &eo, NULL);
+    CHECK(len > 0);
+    CHECK(voxdag_with_colors(d, VOXDAG_COLORS_VOXCOLOR, stream, len, &v, NULL) == VOXDAG_OK);
+    free(rgb);
+    free(stream);
+    return v;
+}
+
+static void report(const char *what, const gpu_stats *st) {
+    fprintf(stderr, "  %s: %llu rays (%llu hits, %llu LOD hits), %llu near-ties, worst t error %.3g voxel; "
+            "%llu lookups, %llu colours; %llu levels with private children\n", what,
+            (unsigned long long)st->rays, (unsigned long long)st->hits, (unsigned long long)st->lod_hits,
+            (unsigned long long)st->near_ties, st->worst_t, (unsigned long long)st->lookups,
+            (unsigned long long)st->colors, (unsigned long long)st->private_levels);
+}
+
+static void test_gpu_scenes(void) {
+    gpu_stats st;
+    uint32_t levels;
+    int kind, sym;
+    memset(&st, 0, sizeof st);
+    for (levels = 2; levels <= 7; levels++)
+        for (kind = 0; kind < RS_COUNT; kind++)
+            for (sym = 0; sym < 3; sym++) {
+                rscene s;
+                uint64_t seed = 0x69B0 + (uint64_t)kind * 1000 + levels * 10 + (uint64_t)sym;
+                voxdag *d = rscene_make(&s, kind, levels, sym, seed);
+                if (d) {
+                    check_file(d, &s, seed, 150, &st);
+                    if ((kind + levels + (unsigned)sym) % 3 == 0) { /* voxcolor: lossless, lossy, both index widths */
+                        voxdag *v = with_voxcolor(d, (kind & 1) ? 0.0 : 0.08, levels & 1 ? 10 : 4 + levels);
+                        if (v) check_file(v, &s, seed + 1, 20, &st);
+                        voxdag_free(v);
+                    }
+                }
+                voxdag_free(d);
+                rscene_free(&s);
+            }
+    report("dense scenes, L = 2..7", &st);
+    CHECK(st.rays > 40000 && st.hits > st.rays / 4 && st.lod_hits > 1000);
+    CHECK(st.private_levels > 20);
+    CHECK(st.near_ties * 200 <= st.rays); /* at most 0.5 % */
+}
+
+/* The golden files, and one placed at an offset inside a larger buffer. */
+static void test_gpu_golden(void) {
+    gpu_stats st;
+    int k;
+    memset(&st, 0, sizeof st);
+    for (k = 0; k < GOLDEN_COUNT; k++) {
+        voxdag *d = NULL;
+        CHECK(golden_build(k, NULL, &d) == VOXDAG_OK);
+        if (!d) continue;
+        check_file(d, NULL, 0x601D + (uint64_t)k, 300, &st);
+        {
+            size_t size;
+            const uint8_t *img = (const uint8_t *)voxdag_image(d, &size);
+            uint8_t *big = (uint8_t *)calloc(size + 24, 1);
+            voxdag_gpu_buf a = gpu_buffer(d), b;
+            voxdag_gpu_file fa = voxdag_gpu_open(a, 0), fb;
+            uint64_t r = 7;
+            int i;
+            memcpy(big + 16, img, size);
+            b.bytes = big, b.size = size + 24;
+            fb = voxdag_gpu_open(b, 16);
+            for (i = 0; i < 200; i++) {
+                voxdag_ray ray = float_ray(&r, 1u << fa.levels);
+                voxdag_gpu_ray g = gpu_ray(&ray, 0, 1);
+                voxdag_gpu_hit ha, hb;
+                ha = voxdag_gpu_raycast(a, fa, g), hb = voxdag_gpu_raycast(b, fb, g);
+                CHECK(!memcmp(&ha, &hb, sizeof ha));
+            }
+            free(big);
+        }
+        voxdag_free(d);
+    }
+    report("golden files", &st);
+}
+
+/* Larger grids from the voxelizer (a sphere shell and a box), L = 9 and 11,
+   against the library's own queries. */
+static void test_gpu_large(void) {
+    gpu_stats st;
+    uint32_t levels;
+    memset(&st, 0, sizeof st);
+    for (levels = 9; levels <= 11; levels += 2) {
+        voxdag_build_opts o;
+        voxdag_builder *b;
+        voxdag *d = NULL, *v;
+        uint32_t n = 1u << levels, *xyz, k = 0, i;
+        uint8_t *rgb;
+        uint64_t r = levels;
+        size_t cap = 400000;
+        xyz = (uint32_t *)malloc(cap * 3 * sizeof *xyz), rgb = (uint8_t *)malloc(cap * 3);
+        while (k < cap) { /* points on a sphere and on the faces of a box */
+            double u = rand_unit(&r) * 2 - 1, phi = rand_unit(&r) * 6.283185307179586, c = n * 0.45, rad = n * 0.3;
+            double p[3];
+            p[0] = c + rad * sqrt(1 - u * u) * cos(phi), p[1] = c + rad * sqrt(1 - u * u) * sin(phi), p[2] = c + rad * u;
+            if (k & 1) {
+                p[0] = n * (0.6 + 0.3 * rand_unit(&r)), p[1] = n * (0.1 + 0.2 * rand_unit(&r));
+                p[2] = (r & 1) ? n * 0.7 : n * 0.9;
+            }
+            for (i = 0; i < 3; i++) xyz[3 * k + i] = (uint32_t)p[i] < n ? (uint32_t)p[i] : n - 1;
+            for (i = 0; i < 3; i++) rgb[3 * k + i] = (uint8_t)(xyz[3 * k + i] >> (levels - 6));
+            k++;
+        }
+        memset(&o, 0, sizeof o);
+        o.levels = levels, o.colors = 1, o.symmetry = VOXDAG_SYMMETRY_FULL;
+        CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+        CHECK(voxdag_builder_add(b, xyz, rgb, k, NULL) == VOXDAG_OK);
+        CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+        free(xyz), free(rgb);
+        if (!d) continue;
+        check_file(d, NULL, 0xB16 + levels, 1500, &st);
+        v = with_voxcolor(d, 0.02, 10);
+        if (v) check_file(v, NULL, 0xB17 + levels, 100, &st);
+        voxdag_free(v);
+        voxdag_free(d);
+    }
+    report("voxelized, L = 9 and 11", &st);
+    CHECK(st.near_ties * 200 <= st.rays);
+}
+
+/* The documented domain: non-finite input misses, tiny components are 0. */
+static void test_gpu_domain(void) {
+    voxdag *d = NULL;
+    voxdag_gpu_buf buf;
+    voxdag_gpu_file f;
+    voxdag_gpu_ray g;
+    voxdag_ray ray;
+    voxdag_gpu_hit h, h0;
+    float bad[4];
+    int k, a;
+    CHECK(golden_build(GOLDEN_MIRRORED_BLOB, NULL, &d) == VOXDAG_OK);
+    if (!d) return;
+    buf = gpu_buffer(d), f = voxdag_gpu_open(buf, 0);
+    memset(&ray, 0, sizeof ray);
+    ray.origin[0] = -3, ray.origin[1] = 10.5, ray.origin[2] = 9.25, ray.dir[0] = 1, ray.dir[1] = -0.25;
+    ray.dir[2] = -0.125, ray.t_max = HUGE_VAL;
+    g = gpu_ray(&ray, 0, 1);
+    h0 = voxdag_gpu_raycast(buf, f, g);
+    CHECK(h0.hit && same_answer(d, &ray, 0, &h0));
+    g.t_max = 0; /* no limit */
+    h = voxdag_gpu_raycast(buf, f, g);
+    CHECK(!memcmp(&h, &h0, sizeof h));
+    bad[0] = NAN, bad[1] = INFINITY, bad[2] = -INFINITY, bad[3] = 1e10f; /* beyond 2^32 */
+    for (k = 0; k < 4; k++)
+        for (a = 0; a < 7; a++) {
+            voxdag_gpu_ray b = gpu_ray(&ray, 0, 1);
+            float *field[7];
+            field[0] = &b.ox, field[1] = &b.oy, field[2] = &b.oz, field[3] = &b.dx, field[4] = &b.dy, field[5] = &b.dz;
+            field[6] = &b.t_min;
+            *field[a] = bad[k];
+            if (a == 6 && k == 2) continue; /* t_min = -inf is a valid window */
+            CHECK_MSG(voxdag_gpu_raycast(buf, f, b).hit == 0 && voxdag_gpu_occluded(buf, f, b) == 0, "field %d value %g", a,
+                      (double)bad[k]);
+        }
+    /* a direction component below 2^-64 is 0 */
+    g = gpu_ray(&ray, 0, 1);
+    g.dz = 1e-20f;
+    ray.dir[2] = 0;
+    h = voxdag_gpu_raycast(buf, f, g);
+    CHECK(same_answer(d, &ray, 0, &h));
+    /* bytes that are not a version-3 image: every query misses */
+    {
+        size_t size;
+        uint8_t *copy;
+        const void *img = voxdag_image(d, &size);
+        voxdag_gpu_buf cb;
+        copy = (uint8_t *)malloc(size);
+        memcpy(copy, img, size);
+        copy[8] = 4;
+        cb.bytes = copy, cb.size = size;
+        f = voxdag_gpu_open(cb, 0);
+        CHECK(f.levels == 0 && voxdag_gpu_raycast(cb, f, gpu_ray(&ray, 0, 1)).hit == 0);
+        CHECK(voxdag_gpu_lookup(cb, f, 0, 0, 0).found == 0);
+        free(copy);
+    }
+    voxdag_free(d);
+}
+
+const test_case test_gpu_cases[] = {
+    {"gpu/transforms: the 48 symmetries as FORMAT.md defines them", test_gpu_transforms},
+    {"gpu/scenes: lookups, colours and rays against brute force and the library", test_gpu_scenes},
+    {"gpu/golden: the golden files, at offset 0 and inside a larger buffer", test_gpu_golden},
+    {"gpu/large: voxelized scenes at L = 9 and 11", test_gpu_large},
+    {"gpu/domain: non-finite and tiny inputs", test_gpu_domain},
+    {NULL, NULL},
+};

@@ -1,0 +1,847 @@
+/* voxdag_gpu.h - voxdag traversal for GLSL, HLSL and C from one text.      version 0.1.0
+
+   Point lookups, ray casts (closest hit and any hit, with level of detail)
+   and colours on the bytes of a .vdag file (FORMAT.md) as they are: one
+   storage buffer holding the file image, zero-padded to a multiple of 4
+   bytes. No tables, no per-file constants, no shader extension: every 64-bit
+   quantity is a pair of 32-bit words, so it runs on any Vulkan 1.1 device.
+   Validation stays on the CPU: upload only images that voxdag_load_memory
+   (voxdag.h) accepted; on other bytes the functions still terminate, but
+   their answers mean nothing.
+
+   TARGETS (define one before including)
+     VOXDAG_GPU_GLSL   GLSL 4.50 (Vulkan). Declare the file's storage buffer
+                       first and name its uint array:
+                         layout(std430, binding = 0) readonly buffer Dag { uint dag_words[]; };
+                         #define VOXDAG_GPU_BUFFER dag_words
+                         #include "voxdag_gpu.h"
+     VOXDAG_GPU_HLSL   HLSL (shader model 6.0 subset; compiled by glslang's
+                       HLSL front end in the tests, untested with DXC):
+                         StructuredBuffer<uint> dag_words : register(t0);
+                         #define VOXDAG_GPU_BUFFER dag_words
+     (neither)         C99 or C++: the buffer is a voxdag_gpu_buf, the image
+                       bytes and their size (voxdag_image gives both; bytes
+                       past the size read as zero). Define VOXDAG_GPU_FUNC to
+                       qualify the functions (default: static inline), e.g.
+                       for CUDA: __device__ static inline.
+   In GLSL and HLSL the buffer argument of every function is a placeholder
+   (pass 0u); several files may share one buffer at 4-aligned byte offsets
+   below 4 GiB (voxdag_gpu_open's BASE).
+
+   QUICK START (GLSL; HLSL and C alike)
+       voxdag_gpu_file f = voxdag_gpu_open(0u, 0u);  // the header, once
+       voxdag_gpu_ray r;
+       r.ox = ...; r.oy = ...; r.oz = ...;   // grid units: voxel (x, y, z) is
+       r.dx = ...; r.dy = ...; r.dz = ...;   // [x, x+1) x [y, y+1) x [z, z+1)
+       r.t_min = 0.0; r.t_max = 0.0;         // 0: no limit
+       r.lod = 0.0; r.flags = VOXDAG_GPU_WANT_INDEX;
+       voxdag_gpu_hit h = voxdag_gpu_raycast(0u, f, r);
+       if (h.hit != 0u) { uint rgb = voxdag_gpu_color(0u, f, h.index_lo, h.index_hi); ... }
+
+   PRECISION. Rays are traced in float32 with operations whose rounding is
+   fixed (add, subtract, multiply, compare, int to float of integers below
+   2^24), marked precise, never producing an infinity, a NaN or a denormal:
+   the C build and a conforming GPU give the same bits (the tests check it on
+   Mesa's lavapipe). The reciprocal of each direction component comes from
+   bit operations and four Newton steps, the same everywhere. Domain: finite
+   inputs; a direction component below 2^-64 in magnitude counts as 0, a ray
+   with one above 2^32, or an origin coordinate beyond 2^30, misses, and an
+   origin coordinate below 2^-32 in magnitude counts as 0. Against
+   voxdag_raycast's exact double-precision answers a hit is the same voxel,
+   normal and index except at near-ties: where two planes' t differ by about
+   float32 rounding at the grid's scale (2^-24 relative: at 65536^3 about
+   0.004 voxel near the far side).
+
+   C mode needs float arithmetic without excess precision or contraction:
+   it sets #pragma STDC FP_CONTRACT OFF (clang) and refuses x87 maths
+   (FLT_EVAL_METHOD != 0: compile with -msse2 -mfpmath=sse); GCC contracts
+   only under -ffp-contract=fast on FMA targets, where the few products
+   that feed a sum are kept apart.
+*/
+#ifndef VOXDAG_GPU_H
+#define VOXDAG_GPU_H
+
+// -- Target layer: types, casts, bit operations, buffer reads
+
+#if defined(VOXDAG_GPU_GLSL)
+#define voxdag_gpu_u32 uint
+#define voxdag_gpu_i32 int
+#define voxdag_gpu_f32 float
+#define voxdag_gpu_bool bool
+#define voxdag_gpu_buf uint
+#define VOXDAG_GPU_FUNC
+#define VOXDAG_GPU_PRECISE precise
+#define VOXDAG_GPU_U32(x) uint(x)
+#define VOXDAG_GPU_F32(x) float(x)
+#define VOXDAG_GPU_I32(x) int(x)
+#define VOXDAG_GPU_FLOAT_BITS(x) floatBitsToUint(x)
+#define VOXDAG_GPU_BITS_FLOAT(x) uintBitsToFloat(x)
+#define voxdag_gpui_popcount(x) uint(bitCount(x))
+#define voxdag_gpui_msb(x) uint(findMSB(x))
+#define voxdag_gpui_word(buf, i) VOXDAG_GPU_BUFFER[i]
+#define VOXDAG_GPUI_FALSE false
+#define VOXDAG_GPUI_TRUE true
+#elif defined(VOXDAG_GPU_HLSL)
+#define voxdag_gpu_u32 uint
+#define voxdag_gpu_i32 int
+#define voxdag_gpu_f32 float
+#define voxdag_gpu_bool bool
+#define voxdag_gpu_buf uint
+#define VOXDAG_GPU_FUNC
+#define VOXDAG_GPU_PRECISE precise
+#define VOXDAG_GPU_U32(x) ((uint)(x))
+#define VOXDAG_GPU_F32(x) ((float)(x))
+#define VOXDAG_GPU_I32(x) ((int)(x))
+#define VOXDAG_GPU_FLOAT_BITS(x) asuint(x)
+#define VOXDAG_GPU_BITS_FLOAT(x) asfloat(x)
+#define voxdag_gpui_popcount(x) countbits(x)
+#define voxdag_gpui_msb(x) firstbithigh(x)
+#define voxdag_gpui_word(buf, i) VOXDAG_GPU_BUFFER[i]
+#define VOXDAG_GPUI_FALSE false
+#define VOXDAG_GPUI_TRUE true
+#else
+#define VOXDAG_GPU_C 1
+#include <float.h>
+#include <stdint.h>
+#include <string.h>
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
+#error "voxdag_gpu.h: float arithmetic must round to float (FLT_EVAL_METHOD 0): compile with SSE maths (-msse2 -mfpmath=sse)"
+#endif
+#if defined(__clang__)
+#pragma STDC FP_CONTRACT OFF
+#endif
+typedef uint32_t voxdag_gpu_u32;
+typedef int32_t voxdag_gpu_i32;
+typedef float voxdag_gpu_f32;
+typedef int voxdag_gpu_bool;
+typedef struct voxdag_gpu_buf {
+    const unsigned char *bytes; /* the file image (voxdag_image) */
+    uint64_t size;
+} voxdag_gpu_buf;
+#ifndef VOXDAG_GPU_FUNC
+#if defined(_MSC_VER) && !defined(__cplusplus)
+#define VOXDAG_GPU_FUNC static __inline
+#else
+#define VOXDAG_GPU_FUNC static inline
+#endif
+#endif
+#define VOXDAG_GPU_PRECISE
+#define VOXDAG_GPUI_FALSE 0
+#define VOXDAG_GPUI_TRUE 1
+#define VOXDAG_GPU_U32(x) ((uint32_t)(x))
+#define VOXDAG_GPU_F32(x) ((float)(x))
+#define VOXDAG_GPU_I32(x) ((int32_t)(x))
+#define VOXDAG_GPU_FLOAT_BITS(x) voxdag_gpui_float_bits(x)
+#define VOXDAG_GPU_BITS_FLOAT(x) voxdag_gpui_bits_float(x)
+VOXDAG_GPU_FUNC uint32_t voxdag_gpui_float_bits(float x) {
+    uint32_t u;
+    memcpy(&u, &x, 4);
+    return u;
+}
+VOXDAG_GPU_FUNC float voxdag_gpui_bits_float(uint32_t u) {
+    float x;
+    memcpy(&x, &u, 4);
+    return x;
+}
+VOXDAG_GPU_FUNC uint32_t voxdag_gpui_popcount(uint32_t x) {
+    x = x - (x >> 1 & 0x55555555u);
+    x = (x & 0x33333333u) + (x >> 2 & 0x33333333u);
+    return ((x + (x >> 4)) & 0x0F0F0F0Fu) * 0x01010101u >> 24;
+}
+VOXDAG_GPU_FUNC uint32_t voxdag_gpui_msb(uint32_t x) { /* X > 0 */
+    uint32_t n = 0;
+    while (x >>= 1) n++;
+    return n;
+}
+/* Word I of the image, little-endian on every host; zeros past its end. */
+VOXDAG_GPU_FUNC uint32_t voxdag_gpui_word(voxdag_gpu_buf buf, uint32_t i) {
+    uint64_t at = (uint64_t)i * 4;
+    uint32_t v = 0, k;
+    for (k = 0; k < 4; k++)
+        if (at + k < buf.size) v |= (uint32_t)buf.bytes[at + k] << (8 * k);
+    return v;
+}
+/* A product kept apart from the sum it feeds (no contraction into an FMA,
+   whatever the compiler's default). */
+VOXDAG_GPU_FUNC float voxdag_gpui_mul_apart(float a, float b) {
+    volatile float r = a * b;
+    return r;
+}
+typedef struct voxdag_gpu_file voxdag_gpu_file;
+typedef struct voxdag_gpu_ray voxdag_gpu_ray;
+typedef struct voxdag_gpu_hit voxdag_gpu_hit;
+typedef struct voxdag_gpu_lookup_result voxdag_gpu_lookup_result;
+#endif
+
+#ifndef VOXDAG_GPU_C
+#define voxdag_gpui_mul_apart(a, b) ((a) * (b))
+#endif
+
+// -- Public types
+
+#define VOXDAG_GPU_VERSION 1      /* of this header's interface */
+#define VOXDAG_GPU_WANT_INDEX 1u  /* voxdag_gpu_ray.flags: fill the hit's voxel index */
+#define VOXDAG_GPU_COLORS_NONE 0u /* voxdag_gpu_file.color_kind, as voxdag_color_kind */
+#define VOXDAG_GPU_COLORS_RGB8 1u
+#define VOXDAG_GPU_COLORS_VOXCOLOR 2u
+#define VOXDAG_GPU_NO_COLOR 0xFF000000u /* voxdag_gpu_color without colours */
+
+/* What the queries need of a file, read from its header and section table
+   by voxdag_gpu_open (once per invocation). levels is 0 when the bytes are
+   not a version-3 .vdag image: every query then misses. */
+struct voxdag_gpu_file {
+    voxdag_gpu_u32 base;        /* byte offset of the image in the buffer */
+    voxdag_gpu_u32 levels;      /* L */
+    voxdag_gpu_u32 root_inverse;/* the root transform's inverse */
+    voxdag_gpu_u32 level_table; /* byte offsets in the buffer: LEVELS, */
+    voxdag_gpu_u32 nodes;       /* NODES, */
+    voxdag_gpu_u32 bricks;      /* BRICKS */
+    voxdag_gpu_u32 colors;      /* and the colour section's payload */
+    voxdag_gpu_u32 color_kind;  /* VOXDAG_GPU_COLORS_* */
+    voxdag_gpu_u32 voxels_lo, voxels_hi;
+    voxdag_gpu_u32 box_lo_x, box_lo_y, box_lo_z, box_hi_x, box_hi_y, box_hi_z; /* half-open */
+};
+
+/* A ray in grid units: points o + t d for t in [t_min, t_max] (t_max 0: no
+   limit), as voxdag_ray. lod: stop at a full cell whose side is below lod *
+   t (voxdag_ray_opts' lod_factor * lod_pixels; 0: full detail). */
+struct voxdag_gpu_ray {
+    voxdag_gpu_f32 ox, oy, oz, dx, dy, dz, t_min, t_max, lod;
+    voxdag_gpu_u32 flags; /* VOXDAG_GPU_WANT_INDEX */
+};
+
+/* A ray's answer, as voxdag_hit: hit is 0 on a miss (the rest is then 0). */
+struct voxdag_gpu_hit {
+    voxdag_gpu_u32 hit;
+    voxdag_gpu_f32 t;              /* where the ray enters the cell (t_min when it starts inside) */
+    voxdag_gpu_u32 x, y, z;        /* the voxel, or the lowest voxel of the cell */
+    voxdag_gpu_i32 nx, ny, nz;     /* entry face normal; 0 0 0 when starting inside */
+    voxdag_gpu_u32 level;          /* L for a voxel, lower for a level-of-detail cell */
+    voxdag_gpu_u32 index_lo, index_hi; /* voxel index (the cell's first voxel) with WANT_INDEX */
+};
+
+struct voxdag_gpu_lookup_result {
+    voxdag_gpu_u32 found;
+    voxdag_gpu_u32 index_lo, index_hi;
+};
+
+// -- Byte and bit-field reads
+
+/* Byte AT of the buffer. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_byte(voxdag_gpu_buf buf, voxdag_gpu_u32 at) {
+    return voxdag_gpui_word(buf, at >> 2) >> (8u * (at & 3u)) & 0xFFu;
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_u16(voxdag_gpu_buf buf, voxdag_gpu_u32 at) {
+    return voxdag_gpui_byte(buf, at) | voxdag_gpui_byte(buf, at + 1u) << 8u;
+}
+
+/* N <= 32 bits from bit POS of the bytes at byte AT, least significant bit
+   first; any AT, any POS (a field crosses at most two words). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_bits(voxdag_gpu_buf buf, voxdag_gpu_u32 at, voxdag_gpu_u32 pos,
+                                                 voxdag_gpu_u32 n) {
+    voxdag_gpu_u32 bit = (at & 3u) * 8u + (pos & 31u);
+    voxdag_gpu_u32 word = (at >> 2) + (pos >> 5) + (bit >> 5), v;
+    bit &= 31u;
+    if (n == 0u) return 0u;
+    v = voxdag_gpui_word(buf, word) >> bit;
+    if (bit + n > 32u) v |= voxdag_gpui_word(buf, word + 1u) << (32u - bit);
+    return n == 32u ? v : v & ((1u << n) - 1u);
+}
+
+// -- The 48 cube symmetries, computed (FORMAT.md, Transforms)
+//
+// T = perm * 8 + m. Permutations as the images of the three axes, two bits
+// each, in FORMAT.md's numbering: (0,1,2) (0,2,1) (1,0,2) (1,2,0) (2,0,1) (2,1,0).
+
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_perm_images(voxdag_gpu_u32 p) {
+    return (p < 4u ? 0x09211824u >> (8u * p) : 0x0612u >> (8u * (p & 3u))) & 0x3Fu;
+}
+
+/* The octant I with bit a moved to bit perm[a], for permutation images IMG. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_permute(voxdag_gpu_u32 i, voxdag_gpu_u32 img) {
+    return (i & 1u) << (img & 3u) | (i >> 1 & 1u) << (img >> 2 & 3u) | (i >> 2 & 1u) << (img >> 4 & 3u);
+}
+
+/* T(i): the octant transform T moves octant I to. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_act(voxdag_gpu_u32 t, voxdag_gpu_u32 i) {
+    return voxdag_gpui_permute(i, voxdag_gpui_perm_images(t >> 3)) ^ (t & 7u);
+}
+
+/* A o B (B first), from the composed permutation's images. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_compose(voxdag_gpu_u32 a, voxdag_gpu_u32 b) {
+    voxdag_gpu_u32 ia = voxdag_gpui_perm_images(a >> 3), ib = voxdag_gpui_perm_images(b >> 3);
+    voxdag_gpu_u32 c0 = ia >> (2u * (ib & 3u)) & 3u, c1 = ia >> (2u * (ib >> 2 & 3u)) & 3u;
+    /* the permutation from its first two images: key c0 * 3 + c1 in 1..7 */
+    voxdag_gpu_u32 p = 0x00B18440u >> (3u * (c0 * 3u + c1)) & 7u;
+    return p * 8u + (voxdag_gpui_permute(b & 7u, ia) ^ (a & 7u));
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_inverse(voxdag_gpu_u32 t) {
+    voxdag_gpu_u32 p = t >> 3, q = p == 3u ? 4u : p == 4u ? 3u : p; /* 3 and 4 are each other's inverse */
+    return q * 8u + voxdag_gpui_permute(t & 7u, voxdag_gpui_perm_images(q));
+}
+
+/* Swaps the bit pairs (i, i + D) of X for the positions i in MASK. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_swap(voxdag_gpu_u32 x, voxdag_gpu_u32 mask, voxdag_gpu_u32 d) {
+    voxdag_gpu_u32 t = (x >> d ^ x) & mask;
+    return x ^ t ^ t << d;
+}
+
+/* Octant sets (bit w: octant w) seen through world-to-stored transform MI,
+   four bytes at once: bit w of a result byte is bit MI(w) of the same byte.
+   MI(w) = perm(w) ^ m: the bytes are reindexed by the mirrors, then by the
+   permutation as at most two transpositions of index bits. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_bytes_to_world(voxdag_gpu_u32 x, voxdag_gpu_u32 mi) {
+    voxdag_gpu_u32 p = mi >> 3;
+    x = voxdag_gpui_swap(x, (mi & 1u) != 0u ? 0x55555555u : 0u, 1u);
+    x = voxdag_gpui_swap(x, (mi & 2u) != 0u ? 0x33333333u : 0u, 2u);
+    x = voxdag_gpui_swap(x, (mi & 4u) != 0u ? 0x0F0F0F0Fu : 0u, 4u);
+    /* transpositions (0 1): positions 1, 5 by 1; (1 2): 2, 3 by 2; (0 2): 1, 3 by 3 */
+    if (p == 2u || p == 3u) x = voxdag_gpui_swap(x, 0x22222222u, 1u);
+    if (p == 1u || p == 3u || p == 4u) x = voxdag_gpui_swap(x, 0x0C0C0C0Cu, 2u);
+    if (p == 4u) x = voxdag_gpui_swap(x, 0x22222222u, 1u);
+    if (p == 5u) x = voxdag_gpui_swap(x, 0x0A0A0A0Au, 3u);
+    return x;
+}
+
+/* A 64-bit value as two words: brick masks, counts, voxel indices. */
+struct voxdag_gpui_mask {
+    voxdag_gpu_u32 lo, hi;
+};
+#ifdef VOXDAG_GPU_C
+typedef struct voxdag_gpui_mask voxdag_gpui_mask;
+#endif
+
+/* The 64-bit swap of bit pairs (i, i + D) for i in the low word's MASK,
+   when D is 16 or 24 (the pairs cross words). */
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_swap_across(voxdag_gpui_mask m, voxdag_gpu_u32 mask, voxdag_gpu_u32 d) {
+    voxdag_gpu_u32 t = ((m.lo >> d | m.hi << (32u - d)) ^ m.lo) & mask;
+    m.lo ^= t ^ t << d;
+    m.hi ^= t >> (32u - d);
+    return m;
+}
+
+/* A brick mask in world order (FORMAT.md, Bricks): bit p of the result is
+   stored bit MI(p), MI acting on both coordinate-bit triples. Bits within
+   each byte as above, then the bytes themselves, the same way. */
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_brick_to_world(voxdag_gpui_mask m, voxdag_gpu_u32 mi) {
+    voxdag_gpu_u32 p = mi >> 3, t;
+    m.lo = voxdag_gpui_bytes_to_world(m.lo, mi);
+    m.hi = voxdag_gpui_bytes_to_world(m.hi, mi);
+    /* the bytes: mirrors swap bytes by 1, halves by 2, words by 4 */
+    m.lo = voxdag_gpui_swap(m.lo, (mi & 1u) != 0u ? 0x00FF00FFu : 0u, 8u);
+    m.hi = voxdag_gpui_swap(m.hi, (mi & 1u) != 0u ? 0x00FF00FFu : 0u, 8u);
+    m.lo = voxdag_gpui_swap(m.lo, (mi & 2u) != 0u ? 0x0000FFFFu : 0u, 16u);
+    m.hi = voxdag_gpui_swap(m.hi, (mi & 2u) != 0u ? 0x0000FFFFu : 0u, 16u);
+    if ((mi & 4u) != 0u) t = m.lo, m.lo = m.hi, m.hi = t;
+    /* transpositions of byte-index bits: (0 1) bytes 1, 5 by one byte;
+       (1 2) bytes 2, 3 by two; (0 2) bytes 1, 3 by three */
+    if (p == 2u || p == 3u) m.lo = voxdag_gpui_swap(m.lo, 0x0000FF00u, 8u), m.hi = voxdag_gpui_swap(m.hi, 0x0000FF00u, 8u);
+    if (p == 1u || p == 3u || p == 4u) m = voxdag_gpui_swap_across(m, 0xFFFF0000u, 16u);
+    if (p == 4u) m.lo = voxdag_gpui_swap(m.lo, 0x0000FF00u, 8u), m.hi = voxdag_gpui_swap(m.hi, 0x0000FF00u, 8u);
+    if (p == 5u) m = voxdag_gpui_swap_across(m, 0xFF00FF00u, 24u);
+    return m;
+}
+
+// -- Opening a file image
+
+VOXDAG_GPU_FUNC voxdag_gpu_file voxdag_gpu_open(voxdag_gpu_buf buf, voxdag_gpu_u32 base) {
+    voxdag_gpu_file f;
+    voxdag_gpu_u32 n, k, ok;
+    f.base = base;
+    f.level_table = 0u, f.nodes = 0u, f.bricks = 0u, f.colors = 0u, f.color_kind = 0u;
+    f.box_lo_x = voxdag_gpui_word(buf, (base >> 2) + 14u), f.box_lo_y = voxdag_gpui_word(buf, (base >> 2) + 15u);
+    f.box_lo_z = voxdag_gpui_word(buf, (base >> 2) + 16u), f.box_hi_x = voxdag_gpui_word(buf, (base >> 2) + 17u);
+    f.box_hi_y = voxdag_gpui_word(buf, (base >> 2) + 18u), f.box_hi_z = voxdag_gpui_word(buf, (base >> 2) + 19u);
+    f.voxels_lo = voxdag_gpui_word(buf, (base >> 2) + 8u), f.voxels_hi = voxdag_gpui_word(buf, (base >> 2) + 9u);
+    k = voxdag_gpui_word(buf, (base >> 2) + 10u);
+    f.levels = k & 0xFFu;
+    f.root_inverse = voxdag_gpui_inverse(k >> 8 & 63u);
+    ok = voxdag_gpui_word(buf, base >> 2) == 0x41445689u && voxdag_gpui_word(buf, (base >> 2) + 2u) == 3u &&
+                 f.levels >= 2u && f.levels <= 21u && (k >> 8 & 0xFFu) < 48u
+             ? 1u
+             : 0u;
+    n = voxdag_gpui_word(buf, (base >> 2) + 11u);
+    for (k = 0u; k < n && k < 16u; k++) { /* the section table: type, offset */
+        voxdag_gpu_u32 e = (base >> 2) + 24u + 8u * k, type = voxdag_gpui_word(buf, e);
+        voxdag_gpu_u32 at = base + voxdag_gpui_word(buf, e + 2u);
+        if (type == 1u) f.level_table = at;
+        if (type == 2u) f.nodes = at;
+        if (type == 3u) f.bricks = at;
+        if (type == 4u) f.colors = at, f.color_kind = VOXDAG_GPU_COLORS_RGB8;
+        if (type == 5u) f.colors = at, f.color_kind = VOXDAG_GPU_COLORS_VOXCOLOR;
+    }
+    if (ok == 0u || f.bricks == 0u) f.levels = 0u;
+    return f;
+}
+
+// -- Node records (FORMAT.md, Node records)
+
+/* A level's description, from its LEVELS entry: where its records start,
+   C, P, whether tag 3 marks private children, the three pointer classes'
+   code bits K and widths W, and its transform table's place. */
+struct voxdag_gpui_level {
+    voxdag_gpu_u32 data, count_bits, base_bits, private_children, k1, k2, k3, w1, w2, w3, table;
+};
+#ifdef VOXDAG_GPU_C
+typedef struct voxdag_gpui_level voxdag_gpui_level;
+#endif
+
+VOXDAG_GPU_FUNC voxdag_gpui_level voxdag_gpui_level_at(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l) {
+    voxdag_gpui_level lv;
+    voxdag_gpu_u32 e = f.level_table + 80u * l, a = voxdag_gpui_word(buf, (e >> 2) + 5u);
+    voxdag_gpu_u32 b = voxdag_gpui_word(buf, (e >> 2) + 6u), c = voxdag_gpui_word(buf, (e >> 2) + 7u);
+    lv.data = f.nodes + voxdag_gpui_word(buf, e >> 2);
+    lv.count_bits = a & 0xFFu;
+    lv.k1 = b >> 8 & 0xFFu, lv.k2 = b >> 16 & 0xFFu, lv.k3 = b >> 24;
+    lv.w1 = (a >> 16 & 0xFFu) + lv.k1, lv.w2 = (a >> 24) + lv.k2, lv.w3 = (b & 0xFFu) + lv.k3;
+    lv.private_children = c & 0xFFu;
+    lv.base_bits = c >> 8 & 0xFFu;
+    lv.table = e + 32u;
+    return lv;
+}
+
+/* The bit where the pointer of stored octant S starts in a record with
+   HEADER (S = 8: the record's size in bits): count, base, then the lower
+   octants' pointers. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_child_bit(voxdag_gpui_level lv, voxdag_gpu_u32 header, voxdag_gpu_u32 s) {
+    voxdag_gpu_u32 h = s >= 8u ? header : header & ((1u << (2u * s)) - 1u);
+    voxdag_gpu_u32 lo = h & 0x5555u, hi = h >> 1 & 0x5555u;
+    voxdag_gpu_u32 base = (header & header >> 1 & 0x5555u) != 0u && lv.private_children != 0u ? lv.base_bits : 0u;
+    return 16u + lv.count_bits + base + lv.w1 * voxdag_gpui_popcount(lo & ~hi) + lv.w2 * voxdag_gpui_popcount(hi & ~lo) +
+           lv.w3 * voxdag_gpui_popcount(lo & hi);
+}
+
+/* The octants with a child (bit i: tag i non-zero). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_presence(voxdag_gpu_u32 header) {
+    voxdag_gpu_u32 x = (header | header >> 1) & 0x5555u;
+    x = (x | x >> 1) & 0x3333u;
+    x = (x | x >> 2) & 0x0F0Fu;
+    return (x | x >> 4) & 0xFFu;
+}
+
+/* The child of stored octant S (present) of the record at byte AT of level
+   L: its offset in the next level (or its brick index) and the inverse of
+   its pointer's transform, what traversals compose. */
+struct voxdag_gpui_ref {
+    voxdag_gpu_u32 at, inverse;
+};
+#ifdef VOXDAG_GPU_C
+typedef struct voxdag_gpui_ref voxdag_gpui_ref;
+#endif
+
+VOXDAG_GPU_FUNC voxdag_gpui_ref voxdag_gpui_child(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
+                                                  voxdag_gpu_u32 at, voxdag_gpu_u32 header, voxdag_gpu_u32 s) {
+    voxdag_gpui_level lv = voxdag_gpui_level_at(buf, f, l);
+    voxdag_gpu_u32 tag = header >> (2u * s) & 3u, rec = lv.data + at;
+    voxdag_gpui_ref r;
+    if (tag == 3u && lv.private_children != 0u) {
+        /* the base, then one record (or brick) further per lower private child */
+        voxdag_gpu_u32 k = voxdag_gpui_popcount(header & header >> 1 & 0x5555u & ((1u << (2u * s)) - 1u));
+        r.at = voxdag_gpui_bits(buf, rec, 16u + lv.count_bits, lv.base_bits < 32u ? lv.base_bits : 32u);
+        r.inverse = 0u;
+        if (l + 3u < f.levels) {
+            voxdag_gpui_level next = voxdag_gpui_level_at(buf, f, l + 1u);
+            for (; k > 0u; k--)
+                r.at += (voxdag_gpui_child_bit(next, voxdag_gpui_u16(buf, next.data + r.at), 8u) + 7u) >> 3;
+        } else {
+            r.at += k;
+        }
+    } else {
+        voxdag_gpu_u32 pos = voxdag_gpui_child_bit(lv, header, s);
+        voxdag_gpu_u32 kb = tag == 1u ? lv.k1 : tag == 2u ? lv.k2 : lv.k3;
+        voxdag_gpu_u32 wb = (tag == 1u ? lv.w1 : tag == 2u ? lv.w2 : lv.w3) - kb;
+        voxdag_gpu_u32 code = voxdag_gpui_bits(buf, rec, pos, kb);
+        r.at = voxdag_gpui_bits(buf, rec, pos + kb, wb < 32u ? wb : 32u); /* targets of files below 4 GiB */
+        r.inverse = voxdag_gpui_inverse(voxdag_gpui_byte(buf, lv.table + code));
+    }
+    return r;
+}
+
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_brick(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 index) {
+    voxdag_gpui_mask m;
+    m.lo = voxdag_gpui_word(buf, (f.bricks >> 2) + 2u * index);
+    m.hi = voxdag_gpui_word(buf, (f.bricks >> 2) + 2u * index + 1u);
+    return m;
+}
+
+// -- Voxel counts and indices (FORMAT.md, Voxel index)
+
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_add64(voxdag_gpui_mask a, voxdag_gpu_u32 lo, voxdag_gpu_u32 hi) {
+    voxdag_gpu_u32 s = a.lo + lo;
+    a.hi += hi + (s < lo ? 1u : 0u);
+    a.lo = s;
+    return a;
+}
+
+/* Voxels below the node at byte AT of level L (brick AT when L = L-2) whose
+   level stores its counts. */
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_stored_count(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
+                                                          voxdag_gpu_u32 at) {
+    voxdag_gpui_mask c;
+    if (l + 2u == f.levels) {
+        voxdag_gpui_mask m = voxdag_gpui_brick(buf, f, at);
+        c.lo = voxdag_gpui_popcount(m.lo) + voxdag_gpui_popcount(m.hi), c.hi = 0u;
+    } else {
+        voxdag_gpui_level lv = voxdag_gpui_level_at(buf, f, l);
+        voxdag_gpu_u32 n = lv.count_bits;
+        c.lo = voxdag_gpui_bits(buf, lv.data + at, 16u, n < 32u ? n : 32u);
+        c.hi = n > 32u ? voxdag_gpui_bits(buf, lv.data + at, 48u, n - 32u) : 0u;
+    }
+    return c;
+}
+
+/* Voxels below the node at byte AT of level L (or brick AT): stored, or the
+   sum of its children's (C = 0). */
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_count(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
+                                                   voxdag_gpu_u32 at) {
+    voxdag_gpui_mask sum;
+    voxdag_gpu_u32 header, set, s;
+    if (l + 2u == f.levels || voxdag_gpui_level_at(buf, f, l).count_bits != 0u) return voxdag_gpui_stored_count(buf, f, l, at);
+    header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at);
+    set = voxdag_gpui_presence(header);
+    sum.lo = 0u, sum.hi = 0u;
+    for (s = 0u; s < 8u; s++)
+        if ((set >> s & 1u) != 0u) {
+            voxdag_gpui_mask c = voxdag_gpui_stored_count(buf, f, l + 1u, voxdag_gpui_child(buf, f, l, at, header, s).at);
+            sum = voxdag_gpui_add64(sum, c.lo, c.hi);
+        }
+    return sum;
+}
+
+/* The voxels of the children of the record at AT (level L, HEADER, reached
+   with world-to-stored transform MI) in world octants below W. */
+VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_preceding(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
+                                                       voxdag_gpu_u32 at, voxdag_gpu_u32 header, voxdag_gpu_u32 mi,
+                                                       voxdag_gpu_u32 w) {
+    voxdag_gpui_mask sum;
+    voxdag_gpu_u32 present = voxdag_gpui_presence(header), j;
+    sum.lo = 0u, sum.hi = 0u;
+    for (j = 0u; j < w; j++) {
+        voxdag_gpu_u32 s = voxdag_gpui_act(mi, j);
+        if ((present >> s & 1u) != 0u) {
+            voxdag_gpui_mask c = voxdag_gpui_count(buf, f, l + 1u, voxdag_gpui_child(buf, f, l, at, header, s).at);
+            sum = voxdag_gpui_add64(sum, c.lo, c.hi);
+        }
+    }
+    return sum;
+}
+
+/* Voxels of world-order brick mask M before Morton position P. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_before(voxdag_gpui_mask m, voxdag_gpu_u32 p) {
+    if (p >= 32u) return voxdag_gpui_popcount(m.lo) + voxdag_gpui_popcount(m.hi & ((1u << (p - 32u)) - 1u));
+    return voxdag_gpui_popcount(m.lo & ((1u << p) - 1u));
+}
+
+/* Morton position in a brick of the voxel (X, Y, Z). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_brick_pos(voxdag_gpu_u32 x, voxdag_gpu_u32 y, voxdag_gpu_u32 z) {
+    return (x & 1u) | (y & 1u) << 1 | (z & 1u) << 2 | (x & 2u) << 2 | (y & 2u) << 3 | (z & 2u) << 4;
+}
+
+// -- Point lookup
+
+VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 x,
+                                                           voxdag_gpu_u32 y, voxdag_gpu_u32 z) {
+    voxdag_gpu_lookup_result r;
+    voxdag_gpui_mask idx, m;
+    voxdag_gpu_u32 l, at = 0u, mi = f.root_inverse, p;
+    r.found = 0u, r.index_lo = 0u, r.index_hi = 0u;
+    idx.lo = 0u, idx.hi = 0u;
+    if (f.levels == 0u || (f.voxels_lo | f.voxels_hi) == 0u || ((x | y | z) >> f.levels) != 0u) return r;
+    for (l = 0u; l + 2u < f.levels; l++) {
+        voxdag_gpu_u32 sh = f.levels - 1u - l, w = (x >> sh & 1u) | (y >> sh & 1u) << 1 | (z >> sh & 1u) << 2;
+        voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at), s = voxdag_gpui_act(mi, w);
+        voxdag_gpui_ref ref;
+        if ((header >> (2u * s) & 3u) == 0u) return r;
+        m = voxdag_gpui_preceding(buf, f, l, at, header, mi, w);
+        idx = voxdag_gpui_add64(idx, m.lo, m.hi);
+        ref = voxdag_gpui_child(buf, f, l, at, header, s);
+        mi = voxdag_gpui_compose(ref.inverse, mi);
+        at = ref.at;
+    }
+    m = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
+    p = voxdag_gpui_brick_pos(x, y, z);
+    if (((p < 32u ? m.lo >> p : m.hi >> (p - 32u)) & 1u) == 0u) return r;
+    idx = voxdag_gpui_add64(idx, voxdag_gpui_before(m, p), 0u);
+    r.found = 1u, r.index_lo = idx.lo, r.index_hi = idx.hi;
+    return r;
+}
+
+// -- Ray casting
+//
+// The hierarchical integer DDA of voxdag_raycast in float32 (voxdag.h, Ray
+// casting): cells c at cell level q, the ray's entry event (te, ae), every t
+// from a plane as (plane - origin) * reciprocal, so a plane has one t at
+// every level; after a step the highest changed bit of c names the level to
+// return to. Levels 0 .. L-3 are records; a brick is walked as a node of
+// 2^3 cells (a byte of its world-order mask each), and each cell as a node
+// of 8 voxels. Per level the walk keeps the record, header, transform and
+// world occupancy to return to, which also give the voxel index at the hit.
+
+#define VOXDAG_GPU_MAX_LEVELS 21
+#define VOXDAG_GPUI_FAR 1.329228e36f   /* 2^120: the t of a plane never met */
+#define VOXDAG_GPUI_LIMIT 1.2676506e30f /* 2^100: t limits are clamped to it */
+
+/* The reciprocal of D (2^-64 <= |D| <= 2^32): a first guess from the bits,
+   then four Newton steps (relative error 12 %, 1.4e-2, 2e-4, 4e-8, then
+   rounding), the same bits on every target. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_recip(voxdag_gpu_f32 d) {
+    voxdag_gpu_u32 bits = VOXDAG_GPU_FLOAT_BITS(d), k;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 a = VOXDAG_GPU_BITS_FLOAT(bits & 0x7FFFFFFFu);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 r = VOXDAG_GPU_BITS_FLOAT(0x7EF311C3u - (bits & 0x7FFFFFFFu));
+    for (k = 0u; k < 4u; k++) {
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 e = 2.0f - voxdag_gpui_mul_apart(a, r);
+        r = r * e;
+    }
+    return VOXDAG_GPU_BITS_FLOAT(VOXDAG_GPU_FLOAT_BITS(r) | (bits & 0x80000000u));
+}
+
+/* X with magnitudes below 2^-E2 flushed to 0 (E2 as a biased exponent
+   bound), for the domain rules. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_flush(voxdag_gpu_f32 x, voxdag_gpu_u32 min_bits) {
+    return (VOXDAG_GPU_FLOAT_BITS(x) & 0x7FFFFFFFu) < min_bits ? 0.0f : x;
+}
+
+/* X clamped to [-2^100, 2^100] (infinities too). */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_clamp_t(voxdag_gpu_f32 x) {
+    voxdag_gpu_u32 bits = VOXDAG_GPU_FLOAT_BITS(x);
+    return (bits & 0x7FFFFFFFu) >= 0x71800000u ? VOXDAG_GPU_BITS_FLOAT((bits & 0x80000000u) | 0x71800000u) : x;
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_bool voxdag_gpui_is_nan(voxdag_gpu_f32 x) {
+    return (VOXDAG_GPU_FLOAT_BITS(x) & 0x7FFFFFFFu) > 0x7F800000u;
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray,
+                                                 voxdag_gpu_bool any_hit) {
+    voxdag_gpu_hit h;
+    voxdag_gpu_f32 o[3], ix[3], box[6], dir[3];
+    voxdag_gpu_i32 sgn[3];
+    voxdag_gpu_u32 c[3], up[3], fr_at[VOXDAG_GPU_MAX_LEVELS], fr_info[VOXDAG_GPU_MAX_LEVELS];
+    voxdag_gpu_u32 nl = f.levels, bl = nl - 2u, q = 0u, l = 0u, a, b, ae = 0u, ax = 0u, mi = f.root_inverse;
+    voxdag_gpu_u32 at = 0u, header = 0u, occ = 0u, bad = 0u;
+    voxdag_gpui_mask mask;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 te = -VOXDAG_GPUI_FAR, tx = VOXDAG_GPUI_FAR, t_stop, t_min, t_max, lod;
+    h.hit = 0u, h.t = 0.0f, h.x = 0u, h.y = 0u, h.z = 0u, h.nx = 0, h.ny = 0, h.nz = 0, h.level = 0u;
+    h.index_lo = 0u, h.index_hi = 0u;
+    mask.lo = 0u, mask.hi = 0u;
+    if (nl == 0u || (f.voxels_lo | f.voxels_hi) == 0u) return h;
+    if (voxdag_gpui_is_nan(ray.t_min) || voxdag_gpui_is_nan(ray.t_max) || voxdag_gpui_is_nan(ray.lod)) return h;
+    /* the domain: t limits within 2^100 (t_max 0: none), lod 0 or within [2^-20, 2^20] */
+    t_min = voxdag_gpui_flush(voxdag_gpui_clamp_t(ray.t_min), 0x1F800000u);
+    t_max = (VOXDAG_GPU_FLOAT_BITS(ray.t_max) & 0x7FFFFFFFu) == 0u ? VOXDAG_GPUI_LIMIT : voxdag_gpui_clamp_t(ray.t_max);
+    lod = any_hit || !(ray.lod > 0.0f) ? 0.0f : voxdag_gpui_flush(ray.lod < 1048576.0f ? ray.lod : 1048576.0f, 0x35800000u);
+    o[0] = ray.ox, o[1] = ray.oy, o[2] = ray.oz, dir[0] = ray.dx, dir[1] = ray.dy, dir[2] = ray.dz;
+    /* the voxel box without level of detail (a hit is a voxel, inside it),
+       else the grid (a coarse cell may reach outside the box) */
+    box[0] = VOXDAG_GPU_F32(f.box_lo_x), box[1] = VOXDAG_GPU_F32(f.box_lo_y), box[2] = VOXDAG_GPU_F32(f.box_lo_z);
+    box[3] = VOXDAG_GPU_F32(f.box_hi_x), box[4] = VOXDAG_GPU_F32(f.box_hi_y), box[5] = VOXDAG_GPU_F32(f.box_hi_z);
+    for (a = 0u; a < 3u; a++) {
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 lo = lod > 0.0f ? 0.0f : box[a];
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 hi = lod > 0.0f ? VOXDAG_GPU_F32(1u << nl) : box[a + 3u];
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 t0, t1;
+        voxdag_gpu_u32 ob = VOXDAG_GPU_FLOAT_BITS(o[a]) & 0x7FFFFFFFu, db = VOXDAG_GPU_FLOAT_BITS(dir[a]) & 0x7FFFFFFFu;
+        if (ob >= 0x4E800000u || db > 0x4F800000u) bad = 1u; /* |o| >= 2^30, |d| > 2^32, NaN, infinite */
+        o[a] = voxdag_gpui_flush(o[a], 0x2F800000u);      /* |o| < 2^-32: 0 */
+        dir[a] = voxdag_gpui_flush(dir[a], 0x1F800000u);  /* |d| < 2^-64: 0 */
+        c[a] = 0u, ix[a] = 0.0f;
+        if (dir[a] == 0.0f) {
+            if (!(o[a] >= lo && o[a] < hi)) bad = 1u;
+            sgn[a] = 0, up[a] = 0u;
+            continue;
+        }
+        sgn[a] = dir[a] > 0.0f ? 1 : -1, up[a] = dir[a] > 0.0f ? 1u : 0u;
+        ix[a] = voxdag_gpui_recip(dir[a]);
+        t0 = ((dir[a] > 0.0f ? lo : hi) - o[a]) * ix[a];
+        t1 = ((dir[a] > 0.0f ? hi : lo) - o[a]) * ix[a];
+        if (t0 >= te) te = t0, ae = a; /* on ties the last axis enters last */
+        if (t1 < tx) tx = t1, ax = a;  /* and the first axis leaves first */
+    }
+    if (bad != 0u) return h;
+    if (t_min >= te) te = t_min, ae = 3u;
+    if (tx < te || (tx == te && ax < ae) || te > t_max) return h;
+    t_stop = tx == VOXDAG_GPUI_FAR ? te : t_max < tx ? t_max : tx;
+
+    for (;;) {
+        /* Enter node l, cell c of level q = l: its occupancy in world order. */
+        voxdag_gpu_u32 sh = nl - q - 1u;
+        if (l < bl) {
+            header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at);
+            occ = voxdag_gpui_bytes_to_world(voxdag_gpui_presence(header), mi) & 0xFFu;
+            fr_at[l] = at;
+            fr_info[l] = header | mi << 16 | occ << 24;
+        } else {
+            if (l == bl) { /* the brick: its 2^3 cells, full when a byte is */
+                mask = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
+                occ = 0u;
+                for (b = 0u; b < 8u; b++) occ |= ((b < 4u ? mask.lo : mask.hi) >> (8u * (b & 3u)) & 0xFFu) != 0u ? 1u << b : 0u;
+            } else { /* a 2^3 cell: its byte */
+                b = (c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2;
+                occ = (b < 4u ? mask.lo : mask.hi) >> (8u * (b & 3u)) & 0xFFu;
+            }
+            fr_info[l] = occ << 24;
+        }
+        /* The child cell: which mid planes (te, ae) has crossed. */
+        for (b = 0u; b < 3u; b++) {
+            voxdag_gpu_u32 mid = (2u * c[b] + 1u) << sh, upper;
+            if (sgn[b] == 0) {
+                upper = o[b] >= VOXDAG_GPU_F32(mid) ? 1u : 0u;
+            } else {
+                VOXDAG_GPU_PRECISE voxdag_gpu_f32 tm = (VOXDAG_GPU_F32(mid) - o[b]) * ix[b];
+                voxdag_gpu_bool crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
+                upper = (sgn[b] > 0) == crossed ? 1u : 0u;
+            }
+            c[b] = 2u * c[b] + upper;
+        }
+        q++;
+        /* Step through the node's cells until a full one. */
+        for (;;) {
+            VOXDAG_GPU_PRECISE voxdag_gpu_f32 t = VOXDAG_GPUI_FAR, t1 = VOXDAG_GPUI_FAR, t2 = VOXDAG_GPUI_FAR;
+            voxdag_gpu_u32 old;
+            voxdag_gpu_i32 k;
+            if ((occ >> ((c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2) & 1u) != 0u) break;
+            sh = nl - q;
+            if (sgn[0] != 0) t = (VOXDAG_GPU_F32((c[0] + up[0]) << sh) - o[0]) * ix[0];
+            if (sgn[1] != 0) t1 = (VOXDAG_GPU_F32((c[1] + up[1]) << sh) - o[1]) * ix[1];
+            if (sgn[2] != 0) t2 = (VOXDAG_GPU_F32((c[2] + up[2]) << sh) - o[2]) * ix[2];
+            a = 0u;
+            if (t1 < t) t = t1, a = 1u;
+            if (t2 < t) t = t2, a = 2u;
+            if (!(t <= t_stop)) return h;
+            old = c[a];
+            c[a] = sgn[a] > 0 ? c[a] + 1u : c[a] - 1u;
+            te = t, ae = a;
+            sh = voxdag_gpui_msb(old ^ c[a]);
+            k = VOXDAG_GPU_I32(q) - 1 - VOXDAG_GPU_I32(sh); /* the node level whose child changed */
+            if (k < VOXDAG_GPU_I32(l)) {
+                if (k < 0) return h; /* left the grid */
+                c[0] >>= sh, c[1] >>= sh, c[2] >>= sh;
+                q -= sh, l = VOXDAG_GPU_U32(k);
+                occ = fr_info[l] >> 24;
+                if (l < bl) at = fr_at[l], header = fr_info[l] & 0xFFFFu, mi = fr_info[l] >> 16 & 63u;
+            }
+        }
+        /* Cell c of level q is full: a hit, or go down into it. */
+        if (q == nl || VOXDAG_GPU_F32(1u << (nl - q)) < lod * te) {
+            h.hit = 1u;
+            if (any_hit) return h;
+            h.t = te;
+            h.x = c[0] << (nl - q), h.y = c[1] << (nl - q), h.z = c[2] << (nl - q);
+            h.nx = ae == 0u ? -sgn[0] : 0, h.ny = ae == 1u ? -sgn[1] : 0, h.nz = ae == 2u ? -sgn[2] : 0;
+            h.level = q;
+            if ((ray.flags & VOXDAG_GPU_WANT_INDEX) != 0u) {
+                /* the voxels of all preceding siblings on the path */
+                voxdag_gpui_mask idx;
+                voxdag_gpu_u32 top = q < bl ? q : bl, j;
+                idx.lo = 0u, idx.hi = 0u;
+                for (j = 0u; j < top; j++) {
+                    voxdag_gpu_u32 s = q - 1u - j, w = (c[0] >> s & 1u) | (c[1] >> s & 1u) << 1 | (c[2] >> s & 1u) << 2;
+                    voxdag_gpui_mask m = voxdag_gpui_preceding(buf, f, j, fr_at[j], fr_info[j] & 0xFFFFu,
+                                                               fr_info[j] >> 16 & 63u, w);
+                    idx = voxdag_gpui_add64(idx, m.lo, m.hi);
+                }
+                if (q > bl) idx = voxdag_gpui_add64(idx, voxdag_gpui_before(mask, voxdag_gpui_brick_pos(h.x, h.y, h.z)), 0u);
+                h.index_lo = idx.lo, h.index_hi = idx.hi;
+            }
+            return h;
+        }
+        if (l < bl) {
+            voxdag_gpui_ref ref = voxdag_gpui_child(buf, f, l, at, header,
+                                                    voxdag_gpui_act(mi, (c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2));
+            mi = voxdag_gpui_compose(ref.inverse, mi);
+            at = ref.at;
+        }
+        l++;
+    }
+}
+
+/* The first full voxel (or level-of-detail cell) along RAY. */
+VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpu_raycast(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray) {
+    return voxdag_gpui_trace(buf, f, ray, VOXDAG_GPUI_FALSE);
+}
+
+/* Whether any full voxel lies along RAY (level of detail ignored): 1 or 0. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_occluded(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray) {
+    return voxdag_gpui_trace(buf, f, ray, VOXDAG_GPUI_TRUE).hit;
+}
+
+// -- Colours (FORMAT.md, Colour section)
+
+/* A voxcolor endpoint at bit POS of the payload at byte AT: RGB565 widened,
+   or RGB888 when PRECISE; as 0x00BBGGRR. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_endpoint(voxdag_gpu_buf buf, voxdag_gpu_u32 at, voxdag_gpu_u32 pos,
+                                                    voxdag_gpu_u32 wide) {
+    voxdag_gpu_u32 v, r, g, b;
+    if (wide != 0u) return voxdag_gpui_bits(buf, at, pos, 24u);
+    v = voxdag_gpui_bits(buf, at, pos, 16u);
+    r = v & 31u, g = v >> 5 & 63u, b = v >> 11;
+    return (r << 3 | r >> 2) | (g << 2 | g >> 4) << 8 | (b << 3 | b >> 2) << 16;
+}
+
+/* Colour INDEX (INDEX_LO + 2^32 INDEX_HI) of a voxcolor stream at byte S. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_voxcolor(voxdag_gpu_buf buf, voxdag_gpu_u32 s, voxdag_gpu_u32 index_lo,
+                                                    voxdag_gpu_u32 index_hi) {
+    voxdag_gpu_u32 shift = voxdag_gpui_byte(buf, s + 6u), wide_table = voxdag_gpui_byte(buf, s + 7u) & 1u;
+    voxdag_gpu_u32 count_lo = voxdag_gpui_word(buf, (s >> 2) + 2u), count_hi = voxdag_gpui_word(buf, (s >> 2) + 3u);
+    voxdag_gpu_u32 page = index_lo >> shift | index_hi << (32u - shift), j = index_lo & ((1u << shift) - 1u);
+    voxdag_gpu_u32 pages = ((count_lo - 1u) >> shift | (count_hi - (count_lo == 0u ? 1u : 0u)) << (32u - shift)) + 1u;
+    voxdag_gpu_u32 isz = shift > 8u ? 2u : 1u, data = s + 24u + pages * (4u << wide_table);
+    voxdag_gpu_u32 at = data + voxdag_gpui_word(buf, (s + 24u) / 4u + (page << wide_table));
+    voxdag_gpu_u32 blocks = voxdag_gpui_bits(buf, at, 0u, 8u * isz) + 1u, groups = ((blocks - 1u) >> 3) + 1u;
+    voxdag_gpu_u32 ends = at + isz, block_ends = ends + groups * isz, nibbles = block_ends + (blocks - groups) * isz;
+    voxdag_gpu_u32 payload = nibbles + (blocks + 1u) / 2u + (groups - 1u) * 2u;
+    voxdag_gpu_u32 lo = 0u, hi = groups, g, n, r, k, b, pos = 0u, start = 0u, mode, nib, len, e0, e1, wbits, t;
+    /* the group: the number of group ends below j, by bisection */
+    while (lo < hi) {
+        voxdag_gpu_u32 mid = (lo + hi) / 2u;
+        if (voxdag_gpui_bits(buf, ends, mid * 8u * isz, 8u * isz) < j) lo = mid + 1u;
+        else hi = mid;
+    }
+    g = lo;
+    /* the block: the group's first plus the number of its other ends below j */
+    n = blocks - 8u * g - 1u < 7u ? blocks - 8u * g - 1u : 7u;
+    for (r = 0u; r < n; r++)
+        if (!(voxdag_gpui_bits(buf, block_ends, (7u * g + r) * 8u * isz, 8u * isz) < j)) break;
+    if (g > 0u) {
+        pos = voxdag_gpui_u16(buf, payload - (groups - 1u) * 2u + (g - 1u) * 2u);
+        start = voxdag_gpui_bits(buf, ends, (g - 1u) * 8u * isz, 8u * isz) + 1u;
+    }
+    /* the payloads of the blocks before it in the group */
+    for (k = 0u; k < r; k++) {
+        voxdag_gpu_u32 end = voxdag_gpui_bits(buf, block_ends, (7u * g + k) * 8u * isz, 8u * isz) + 1u;
+        nib = voxdag_gpui_bits(buf, nibbles, (8u * g + k) * 4u, 4u);
+        mode = nib & 7u;
+        pos += (mode == 0u ? 16u : mode == 5u ? 0u : 32u) * ((nib & 8u) != 0u ? 3u : 2u) / 2u +
+               (end - start) * (mode == 5u ? 24u : mode);
+        start = end;
+    }
+    nib = voxdag_gpui_bits(buf, nibbles, (8u * g + r) * 4u, 4u);
+    mode = nib & 7u, len = j - start;
+    if (mode == 5u) return voxdag_gpui_bits(buf, payload, pos + 24u * len, 24u);
+    e0 = voxdag_gpui_endpoint(buf, payload, pos, nib >> 3);
+    if (mode == 0u) return e0;
+    e1 = voxdag_gpui_endpoint(buf, payload, pos + ((nib & 8u) != 0u ? 24u : 16u), nib >> 3);
+    wbits = ((nib & 8u) != 0u ? 48u : 32u) + len * mode;
+    k = voxdag_gpui_bits(buf, payload, pos + wbits, mode);
+    n = (1u << mode) - 1u;
+    t = (128u * k + n) / (2u * n); /* round(64 k / (2^w - 1)) */
+    r = 0u;
+    for (b = 0u; b < 24u; b += 8u) /* per channel */
+        r |= (((e0 >> b & 0xFFu) * (64u - t) + (e1 >> b & 0xFFu) * t + 32u) >> 6) << b;
+    return r;
+}
+
+/* The colour of voxel INDEX as 0x00BBGGRR, or VOXDAG_GPU_NO_COLOR when the
+   file has none (INDEX must be below the voxel count). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_color(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 index_lo,
+                                                voxdag_gpu_u32 index_hi) {
+    if (f.color_kind == VOXDAG_GPU_COLORS_RGB8) {
+        voxdag_gpu_u32 at = f.colors + 3u * index_lo; /* below 4 GiB: INDEX_HI is 0 */
+        return voxdag_gpui_byte(buf, at) | voxdag_gpui_byte(buf, at + 1u) << 8 | voxdag_gpui_byte(buf, at + 2u) << 16;
+    }
+    if (f.color_kind == VOXDAG_GPU_COLORS_VOXCOLOR) return voxdag_gpui_voxcolor(buf, f.colors, index_lo, index_hi);
+    return VOXDAG_GPU_NO_COLOR;
+}
+
+#endif /* VOXDAG_GPU_H */
