@@ -694,7 +694,10 @@ int vdag_vk_run(vdag_vk *vk, const uint32_t *spirv, size_t spirv_bytes, const ch
             vk->vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 1,
                                      &barrier, 0, NULL, 0, NULL);
         }
-        if (timed) vk->vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, s.queries, 2 * k);
+        /* The start is stamped once earlier compute work has finished (a
+           top-of-pipe stamp could be written while the previous dispatch
+           still runs, adding its tail to this one's time). */
+        if (timed) vk->vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, s.queries, 2 * k);
         vk->vkCmdDispatch(cb, groups_x, groups_y, 1);
         if (timed) vk->vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, s.queries, 2 * k + 1);
     }

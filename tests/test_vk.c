@@ -139,7 +139,7 @@ int main(void) {
         int rc;
         setenv("VDAG_VK_DEVICE", "99", 1);
         rc = vdag_vk_open(&none, err, sizeof err);
-        printf("VDAG_VK_DEVICE=99: %s\n", err);
+        printf("device 99: %s\n", err);
         check(rc != 0 && none == NULL, "VDAG_VK_DEVICE=99 fails", 0);
         check(strstr(err, "VDAG_VK_DEVICE=99") && strstr(err, "Vulkan device"), "VDAG_VK_DEVICE=99 message", 0);
         setenv("VDAG_VK_DEVICE", "0", 1);
