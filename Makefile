@@ -16,7 +16,7 @@ THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 HEADERS := voxdag.h voxcolor.h voxdag_gpu.h
 
-VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c
+VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c examples/gpu_vulkan.c
 TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
@@ -27,6 +27,56 @@ STB_IMAGE := /usr/include/stb/stb_image.h
 # compiled with $(CXX); the test program links with the C++ driver).
 OIIO_CFLAGS = $(shell pkg-config --cflags OpenImageIO)
 OIIO_LIBS   = $(shell pkg-config --libs OpenImageIO)
+
+# The GPU path (examples/gpu_vulkan.c) runs compute shaders on Vulkan. It is
+# built when the Vulkan headers and glslangValidator are here: the loader is
+# opened at run time, so the tool still needs nothing installed to run. The
+# first `make` in a build directory installs libvulkan-dev and glslang-tools
+# when missing (examples/deps.sh; a failure leaves the GPU path out) and
+# records what it found in $(BUILD)/vulkan.mk (delete it to look again).
+# VULKAN=1 or VULKAN= on the command line forces the choice.
+VULKAN_H := /usr/include/vulkan/vulkan.h
+ifeq ($(origin VULKAN),undefined)
+ifneq ($(MAKECMDGOALS),clean)
+-include $(BUILD)/vulkan.mk
+endif
+VULKAN = $(VULKAN_FOUND)
+endif
+$(BUILD)/vulkan.mk:
+	@mkdir -p $(@D)
+	@sh examples/deps.sh || :
+	@if test -f $(VULKAN_H) && command -v glslangValidator >/dev/null; then \
+	    echo 'VULKAN_FOUND := 1' >$@; else echo 'VULKAN_FOUND :=' >$@; fi
+# Rewritten only when the choice changes, so that objects built with the
+# other choice are rebuilt.
+$(BUILD)/vulkan.flag: FORCE
+	@mkdir -p $(@D)
+	@echo '$(VULKAN)' | cmp -s - $@ || echo '$(VULKAN)' >$@
+.PHONY: FORCE
+VULKAN_CFLAGS = $(if $(VULKAN),-DVDAG_HAVE_VULKAN)
+VULKAN_LIBS   = $(if $(VULKAN),-ldl)
+
+# Compute shaders become SPIR-V for Vulkan 1.1, embedded as C arrays:
+# NAME.comp (GLSL) gives $(BUILD)/shaders/NAME_glsl.h with the array NAME_glsl,
+# NAME.hlsl (HLSL, entry point main) gives NAME_hlsl.h with NAME_hlsl; the
+# .spv beside each is what tests/spirv_check.sh validates. Shaders live in
+# examples/shaders (the tool's) and tests/shaders (the tests'); a program
+# that includes NAME_glsl.h lists it as a prerequisite and adds
+# -I$(BUILD)/shaders.
+GLSLANG       := glslangValidator -V --target-env vulkan1.1 -I.
+SHADER_DEPS   := $(wildcard examples/shaders/*.h examples/shaders/*.glsl examples/shaders/*.hlsli)
+define shader_rules
+$$(BUILD)/shaders/%_glsl.h $$(BUILD)/shaders/%_glsl.spv: $(1)/%.comp $$(SHADER_DEPS)
+	@mkdir -p $$(@D)
+	$$(GLSLANG) --vn $$*_glsl -o $$(BUILD)/shaders/$$*_glsl.h $$<
+	$$(GLSLANG) -o $$(BUILD)/shaders/$$*_glsl.spv $$< >/dev/null
+$$(BUILD)/shaders/%_hlsl.h $$(BUILD)/shaders/%_hlsl.spv: $(1)/%.hlsl $$(SHADER_DEPS)
+	@mkdir -p $$(@D)
+	$$(GLSLANG) -D -e main -S comp --vn $$*_hlsl -o $$(BUILD)/shaders/$$*_hlsl.h $$<
+	$$(GLSLANG) -D -e main -S comp -o $$(BUILD)/shaders/$$*_hlsl.spv $$< >/dev/null
+endef
+$(eval $(call shader_rules,examples/shaders))
+$(eval $(call shader_rules,tests/shaders))
 
 .PHONY: all test deps demo bench clean
 
@@ -50,11 +100,16 @@ $(BUILD)/san/oiio_ref.o: tests/oiio_ref.cpp tests/oiio_ref.h
 	@mkdir -p $(@D)
 	$(CXX) -std=c++14 $(OIIO_CFLAGS) $(WARN) -O1 -g $(SAN) -c -o $@ tests/oiio_ref.cpp
 
+# gpu_vulkan.c with or without the GPU path (see VULKAN above).
+$(BUILD)/opt/examples/gpu_vulkan.o: examples/gpu_vulkan.c examples/gpu_vulkan.h $(BUILD)/vulkan.flag
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) $(OPT) $(VULKAN_CFLAGS) -I. -c -o $@ $<
+
 # import.c includes import_scene.c (.spm and .ac share its helpers).
 $(BUILD)/opt/examples/import.o $(BUILD)/san/examples/import.o: examples/import_scene.c
 
 $(BUILD)/vdag: $(VDAG_SRC:%.c=$(BUILD)/opt/%.o)
-	$(CC) $(OPT) -o $@ $^ $(THREADS) -lm
+	$(CC) $(OPT) -o $@ $^ $(THREADS) -lm $(VULKAN_LIBS)
 
 # Tests run with AddressSanitizer and UndefinedBehaviorSanitizer.
 $(BUILD)/test: $(TEST_SRC:%.c=$(BUILD)/san/%.o) $(BUILD)/san/oiio_ref.o
@@ -67,6 +122,14 @@ $(BUILD)/test_voxcolor_ndebug: tests/test_voxcolor_ndebug.c tests/tally.h voxcol
 # The same for voxdag.h: its options and NULL arguments in a release build.
 $(BUILD)/test_voxdag_ndebug: tests/test_voxdag_ndebug.c tests/tally.h voxdag.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g -DNDEBUG $(SAN) $(THREADS) -I. -o $@ $< -lm
+
+# The Vulkan runner on the machine's device (lavapipe without a GPU),
+# sanitized, with the smoke shaders in GLSL and HLSL (tests/shaders).
+VK_SMOKE := $(BUILD)/shaders/vk_smoke_glsl.h $(BUILD)/shaders/vk_smoke_hlsl.h
+$(BUILD)/test_vk: tests/test_vk.c tests/tally.h examples/gpu_vulkan.c examples/gpu_vulkan.h $(BUILD)/vulkan.flag \
+                  $(if $(VULKAN),$(VK_SMOKE)) | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) $(VULKAN_CFLAGS) -I. -I$(BUILD)/shaders -o $@ tests/test_vk.c \
+	    examples/gpu_vulkan.c $(VULKAN_LIBS)
 
 # Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):
 #   import     the scene importers (the first byte picks the format)
@@ -123,7 +186,8 @@ check-all:
 $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk \
+                 $(if $(VULKAN),$(VK_SMOKE:.h=.spv))
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
 

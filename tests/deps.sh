@@ -9,6 +9,12 @@ command -v assimp >/dev/null 2>&1 || need="$need assimp-utils"
 command -v clang >/dev/null 2>&1 || need="$need clang"
 command -v g++ >/dev/null 2>&1 || need="$need g++"
 command -v strace >/dev/null 2>&1 || need="$need strace" # signals during a save (tests/cli.sh)
+# The Vulkan runner (tests/test_vk.c) on lavapipe, the shaders' compiler and
+# the SPIR-V checks (tests/spirv_check.sh).
+ls /usr/share/vulkan/icd.d/lvp_icd.*.json >/dev/null 2>&1 || need="$need mesa-vulkan-drivers"
+[ -f /usr/include/vulkan/vulkan.h ] || need="$need libvulkan-dev"
+command -v glslangValidator >/dev/null 2>&1 || need="$need glslang-tools"
+command -v spirv-val >/dev/null 2>&1 || need="$need spirv-tools"
 matrix=""
 # The portability matrix (tests/check_all.sh): 32-bit x86 and big-endian
 # s390x cross compilers run under qemu-user, MinGW-w64 under Wine. (Debian's

@@ -38,6 +38,8 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
 run unit "$build/test" $unit_args
 run voxcolor-ndebug "$build/test_voxcolor_ndebug"
 run voxdag-ndebug "$build/test_voxdag_ndebug"
+run vulkan "$build/test_vk"
+run spirv sh tests/spirv_check.sh "$build"
 run cli sh tests/cli.sh "$build/vdag"
 run third-party sh tests/third_party.sh "$build"
 run fuzz-import "$build/fuzz_import" $sweep tests/data/fuzz/import
