@@ -47,7 +47,9 @@
      VOXDAG_WITH_VOXCOLOR include "voxcolor.h" (beside voxdag.h) so that
                           voxdag_color decodes voxcolor colour sections; the
                           same happens when voxcolor.h is included before
-                          the implementation
+                          the implementation. Without it, such a file loads
+                          but voxdag_info.colors_decodable is 0 and each
+                          voxdag_color call returns -1 (see there)
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
@@ -427,7 +429,8 @@ typedef enum voxdag_color_kind {
     VOXDAG_COLORS_NONE = 0,
     VOXDAG_COLORS_RGB8 = 1,     /* 3 bytes per voxel, in voxel-index order */
     VOXDAG_COLORS_VOXCOLOR = 2, /* a voxcolor.h stream (decoded by voxdag_color
-                                   when voxcolor.h is compiled in, see there) */
+                                   when voxcolor.h is compiled in, see there;
+                                   voxdag_info.colors_decodable says) */
     VOXDAG_COLORS_FORCE_32BIT = 0x7fffffff
 } voxdag_color_kind;
 
@@ -457,6 +460,10 @@ typedef struct voxdag_info {
     uint64_t brick_bytes;
     uint64_t color_bytes;
     voxdag_color_kind color_kind;
+    int colors_decodable;       /* 1: voxdag_color gives every voxel's colour (an
+                                   RGB8 section, or a voxcolor one with voxcolor.h
+                                   compiled in); 0: no colours, or a voxcolor
+                                   section this implementation cannot decode */
     int has_bounds;
     double bounds[6];           /* world-space min xyz, max xyz */
 } voxdag_info;
@@ -488,9 +495,13 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
    Then loading also validates the stream (VOXDAG_ERR_CORRUPT for a bad one,
    err->byte_offset in the file) and each call decodes one colour in place,
    with no allocation. From a ray hit: voxdag_color(dag, hit.index, rgb) with
-   ray opts.want_index set. Returns 1, or 0 (RGB untouched) when the DAG has
-   no colours, a voxcolor stream without voxcolor.h compiled in, INDEX >=
-   the voxel count, or DAG or RGB is NULL. Thread-safe. */
+   ray opts.want_index set. Returns 1; 0 (RGB untouched) when the DAG has no
+   colours, INDEX >= the voxel count, or DAG or RGB is NULL; -1 when the
+   colours are a voxcolor stream and this implementation was compiled
+   without voxcolor.h: every such call fails, and writes magenta (255, 0,
+   255) to RGB so that a caller that tests only for nonzero shows it. Check
+   voxdag_info.colors_decodable once after loading to catch that case (the
+   DAG is never changed). Thread-safe. */
 VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]);
 
 /* Calls FN (may be NULL: counts) for every full voxel in voxel-index order;
@@ -4706,6 +4717,11 @@ VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]) {
         voxcolor_view_get(&dag->color_view, index, rgb);
         return 1;
     }
+#else
+    if (dag->color_kind == VOXDAG_COLORS_VOXCOLOR) { /* no decoder here: loud, see the declaration */
+        rgb[0] = 255, rgb[1] = 0, rgb[2] = 255;
+        return -1;
+    }
 #endif
     return 0;
 }
@@ -4805,6 +4821,11 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
     info->brick_bytes = 8 * dag->brick_count;
     info->color_bytes = dag->color_size;
     info->color_kind = dag->color_kind;
+#ifdef VOXDAGI_VOXCOLOR
+    info->colors_decodable = dag->color_kind != VOXDAG_COLORS_NONE;
+#else
+    info->colors_decodable = dag->color_kind == VOXDAG_COLORS_RGB8;
+#endif
     info->has_bounds = dag->has_bounds;
     memcpy(info->bounds, dag->bounds, sizeof info->bounds);
 }

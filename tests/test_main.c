@@ -13,6 +13,7 @@ extern const test_case test_voxcolor_cases[];
 extern const test_case test_format_cases[];
 extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
+extern const test_case test_no_voxcolor_cases[];
 #ifndef TEST_PORTABLE
 extern const test_case test_import_cases[];
 extern const test_case test_import_scene_cases[];
@@ -31,6 +32,7 @@ static const test_case *const suites[] = {
     test_format_cases,
     test_voxelize_cases,
     test_raytrace_cases,
+    test_no_voxcolor_cases,
 #ifndef TEST_PORTABLE
     test_image_cases,
     test_api_cases,
