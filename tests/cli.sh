@@ -219,6 +219,14 @@ printf 'not an image' >"$T/broken.png"
 printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl t\nf 1/1 2/2 3/3\n' >"$T/tex.obj"
 check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
 check "--no-colors --no-alpha-test skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors --no-alpha-test 2>'$T/err' && ! grep -q warning '$T/err'"
+# A usemtl name that no library defines stays white, with one warning naming it
+# (a missing material used to pass for white in silence).
+printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nusemtl hull\nf 1 2 3\nusemtl hull\nf 3 2 1\n' >"$T/boat.obj"
+check "an undefined usemtl warns once, naming the material; its voxels are white" sh -c "
+    '$VDAG' build '$T/boat.obj' '$T/boat.vdag' --levels 3 --up z 2>'$T/err' &&
+    [ \$(grep -c warning '$T/err') = 1 ] &&
+    grep -q 'warning: $T/boat.obj: usemtl names 1 material that no material library defines (white): \"hull\"' '$T/err' &&
+    '$VDAG' export-voxels '$T/boat.vdag' | awk 'NF != 6 || \$4 != 255 || \$5 != 255 || \$6 != 255 { exit 1 } END { exit NR == 0 }'"
 
 # -- alpha testing: texels with alpha below one half make no voxel (the same
 # voxels with --no-colors); --no-alpha-test voxelizes every texel. The
