@@ -47,7 +47,9 @@
      VOXDAG_WITH_VOXCOLOR include "voxcolor.h" (beside voxdag.h) so that
                           voxdag_color decodes voxcolor colour sections; the
                           same happens when voxcolor.h is included before
-                          the implementation
+                          the implementation. Without it, such a file loads
+                          but voxdag_info.colors_decodable is 0 and each
+                          voxdag_color call returns -1 (see there)
      VOXDAG_STATIC        give every function internal linkage
      VOXDAG_MAX_LEVELS    largest L accepted (default and maximum 21)
 
@@ -108,6 +110,7 @@ typedef enum voxdag_status {
     VOXDAG_ERR_CHECKSUM,         /* a checksum does not match */
     VOXDAG_ERR_CORRUPT,          /* a field is inconsistent or out of range */
     VOXDAG_ERR_IO,               /* a file could not be read or written */
+    VOXDAG_ERR_CANCELLED,        /* the build's progress_cancel callback stopped it */
     VOXDAG_STATUS_COUNT,
     VOXDAG_STATUS_FORCE_32BIT = 0x7fffffff
 } voxdag_status;
@@ -166,7 +169,26 @@ typedef enum voxdag_symmetry {
    compiled with different VOXDAG_MAX_LEVELS agree on every layout. */
 #define VOXDAG_LEVEL_CAPACITY 21
 
+/* Progress of a build, from the building thread (voxdag_build_opts.progress
+   and progress_cancel, both given progress_user). STAGE and FRACTION (0..1,
+   never decreasing within a stage of one call):
+     "voxelize"  voxdag_builder_add_mesh: the share of its (chunk, triangle)
+                 pairs done, after each round of chunks;
+     "reduce"    voxels added by voxdag_builder_add, reduced by the next
+                 voxdag_builder_flush or by voxdag_builder_finish: the share of
+                 those voxels reduced, every 2^16 (on one thread; the threaded
+                 reduction reports when it is done); voxdag_builder_add_bricks:
+                 the share of the call's bricks, every 2^14; and once at 1
+                 when voxdag_builder_finish has reduced everything;
+     "encode"    voxdag_builder_finish: 0 before the file image is encoded, 1
+                 after. */
 typedef void (*voxdag_progress_fn)(void *user, const char *stage, double fraction);
+/* The same reports, for a host that may stop the build: return 0 to go on,
+   nonzero to cancel. The call that reported then fails with
+   VOXDAG_ERR_CANCELLED and the builder keeps that failure (later calls
+   return it; voxdag_builder_finish frees the builder as on any failure, and
+   any DAG it had made: *out stays NULL). Nothing leaks. */
+typedef int (*voxdag_progress_cancel_fn)(void *user, const char *stage, double fraction);
 
 /* A job of the builder's parallel work: run once for each INDEX of a batch. */
 typedef void (*voxdag_job_fn)(void *job_user, uint32_t index);
@@ -212,7 +234,10 @@ typedef struct voxdag_build_opts {
     const double *bounds;        /* optional world-space min xyz, max xyz (6) */
     voxdag_allocator allocator;
     voxdag_progress_fn progress; /* optional; called from the building thread */
-    void *progress_user;
+    void *progress_user;         /* given to progress and progress_cancel; it must
+                                    stay valid until the builder is finished or freed */
+    voxdag_progress_cancel_fn progress_cancel; /* optional, beside or instead of
+                                    progress: the same reports, and it can cancel */
     /* Optional, with colors: receives the colours (RGB8) in voxel-index order,
        N at a time, as voxels are reduced (from the building thread); returns
        0 to go on, non-zero to fail the build with VOXDAG_ERR_IO. The DAG then
@@ -427,7 +452,8 @@ typedef enum voxdag_color_kind {
     VOXDAG_COLORS_NONE = 0,
     VOXDAG_COLORS_RGB8 = 1,     /* 3 bytes per voxel, in voxel-index order */
     VOXDAG_COLORS_VOXCOLOR = 2, /* a voxcolor.h stream (decoded by voxdag_color
-                                   when voxcolor.h is compiled in, see there) */
+                                   when voxcolor.h is compiled in, see there;
+                                   voxdag_info.colors_decodable says) */
     VOXDAG_COLORS_FORCE_32BIT = 0x7fffffff
 } voxdag_color_kind;
 
@@ -457,6 +483,10 @@ typedef struct voxdag_info {
     uint64_t brick_bytes;
     uint64_t color_bytes;
     voxdag_color_kind color_kind;
+    int colors_decodable;       /* 1: voxdag_color gives every voxel's colour (an
+                                   RGB8 section, or a voxcolor one with voxcolor.h
+                                   compiled in); 0: no colours, or a voxcolor
+                                   section this implementation cannot decode */
     int has_bounds;
     double bounds[6];           /* world-space min xyz, max xyz */
 } voxdag_info;
@@ -488,9 +518,13 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
    Then loading also validates the stream (VOXDAG_ERR_CORRUPT for a bad one,
    err->byte_offset in the file) and each call decodes one colour in place,
    with no allocation. From a ray hit: voxdag_color(dag, hit.index, rgb) with
-   ray opts.want_index set. Returns 1, or 0 (RGB untouched) when the DAG has
-   no colours, a voxcolor stream without voxcolor.h compiled in, INDEX >=
-   the voxel count, or DAG or RGB is NULL. Thread-safe. */
+   ray opts.want_index set. Returns 1; 0 (RGB untouched) when the DAG has no
+   colours, INDEX >= the voxel count, or DAG or RGB is NULL; -1 when the
+   colours are a voxcolor stream and this implementation was compiled
+   without voxcolor.h: every such call fails, and writes magenta (255, 0,
+   255) to RGB so that a caller that tests only for nonzero shows it. Check
+   voxdag_info.colors_decodable once after loading to catch that case (the
+   DAG is never changed). Thread-safe. */
 VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]);
 
 /* Calls FN (may be NULL: counts) for every full voxel in voxel-index order;
@@ -770,6 +804,7 @@ VOXDAG_API const char *voxdag_status_string(voxdag_status status) {
     case VOXDAG_ERR_CHECKSUM: return "checksum mismatch";
     case VOXDAG_ERR_CORRUPT: return "corrupt data";
     case VOXDAG_ERR_IO: return "i/o error";
+    case VOXDAG_ERR_CANCELLED: return "cancelled";
     default: return "unknown status";
     }
 }
@@ -2249,10 +2284,24 @@ static uint64_t voxdagi_builder_nodes(const voxdag_builder *b) {
 }
 
 static const char *voxdagi_reduce_message(voxdag_status st) {
-    return st == VOXDAG_ERR_LIMIT ? "more nodes than max_nodes"
-           : st == VOXDAG_ERR_IO  ? "the colour sink failed"
-                                  : "out of memory while reducing voxels";
+    return st == VOXDAG_ERR_LIMIT       ? "more nodes than max_nodes"
+           : st == VOXDAG_ERR_IO        ? "the colour sink failed"
+           : st == VOXDAG_ERR_CANCELLED ? "the build was cancelled (progress_cancel)"
+                                        : "out of memory while reducing voxels";
 }
+
+/* Reports progress (voxdag_progress_fn). Returns VOXDAG_ERR_CANCELLED when
+   progress_cancel asks to stop, else VOXDAG_OK. */
+static voxdag_status voxdagi_progress(const voxdag_builder *b, const char *stage, double fraction) {
+    if (b->opts.progress) b->opts.progress(b->opts.progress_user, stage, fraction);
+    if (b->opts.progress_cancel && b->opts.progress_cancel(b->opts.progress_user, stage, fraction))
+        return VOXDAG_ERR_CANCELLED;
+    return VOXDAG_OK;
+}
+
+/* Voxels (and bricks) between two progress reports while reducing. */
+#define VOXDAGI_PROGRESS_VOXELS ((size_t)1 << 16)
+#define VOXDAGI_PROGRESS_BRICKS ((size_t)1 << 14)
 
 /* Sorts, deduplicates and reduces the buffered voxels. FINAL: no voxel follows. */
 static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
@@ -2315,9 +2364,18 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
 #else
     (void)final;
 #endif
-    if (!done)
+    if (!done) {
+        double total = (double)n * b->red_count;
         for (k = 0; k < b->red_count; k++)
-            for (i = 0; i < n; i++) voxdagi_reducer_voxel(&b->red[k], code[i]);
+            for (i = 0; i < n;) {
+                size_t end = n - i > VOXDAGI_PROGRESS_VOXELS ? i + VOXDAGI_PROGRESS_VOXELS : n;
+                for (; i < end; i++) voxdagi_reducer_voxel(&b->red[k], code[i]);
+                if ((st = voxdagi_progress(b, "reduce", ((double)k * (double)n + (double)i) / total)) != VOXDAG_OK)
+                    return st;
+            }
+    } else if ((st = voxdagi_progress(b, "reduce", 1.0)) != VOXDAG_OK) {
+        return st;
+    }
     for (k = 0; k < b->red_count; k++)
         if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
     b->voxels += n;
@@ -2365,16 +2423,22 @@ static voxdag_status voxdagi_check_bricks(const voxdag_builder *b, const uint64_
    packed 0xRRGGBB in RGB32 when not NULL): the voxelizer's path and
    voxdag_builder_add_bricks'. */
 static voxdag_status voxdagi_builder_bricks(voxdag_builder *b, const uint64_t *bricks, const uint8_t *rgb8,
-                                            const uint32_t *rgb32, size_t n, uint64_t voxels) {
+                                            const uint32_t *rgb32, size_t n, uint64_t voxels, int report) {
     voxdag_status st;
     uint64_t m = 0, key = 0;
-    size_t i;
+    size_t i, end;
     unsigned k;
-    if (!voxels) return VOXDAG_OK;
+    if (!voxels) return report ? voxdagi_progress(b, "reduce", 1.0) : VOXDAG_OK;
     if ((st = voxdagi_builder_colors(b, rgb32, rgb8, (size_t)voxels)) != VOXDAG_OK) return st;
     for (k = 0; k < b->red_count; k++) {
-        for (i = 0; i < n; i++)
-            if (bricks[2 * i + 1]) voxdagi_reducer_brick(&b->red[k], bricks[2 * i], bricks[2 * i + 1]);
+        for (i = 0; i < n;) {
+            end = report && n - i > VOXDAGI_PROGRESS_BRICKS ? i + VOXDAGI_PROGRESS_BRICKS : n;
+            for (; i < end; i++)
+                if (bricks[2 * i + 1]) voxdagi_reducer_brick(&b->red[k], bricks[2 * i], bricks[2 * i + 1]);
+            if (report && (st = voxdagi_progress(b, "reduce", ((double)k * (double)n + (double)i) /
+                                                                    ((double)n * b->red_count))) != VOXDAG_OK)
+                return st;
+        }
         if (b->red[k].failed) return VOXDAG_ERR_OUT_OF_MEMORY;
     }
     for (i = n; i-- > 0;)
@@ -2407,7 +2471,7 @@ VOXDAG_API voxdag_status voxdag_builder_add_bricks(voxdag_builder *b, const uint
     if (st == VOXDAG_ERR_ORDER)
         return voxdagi_fail(err, st, "brick key does not follow the bricks and voxels before it", UINT64_MAX,
                             (uint64_t)bad);
-    st = voxdagi_builder_bricks(b, bricks, rgb, NULL, n, voxels);
+    st = voxdagi_builder_bricks(b, bricks, rgb, NULL, n, voxels, 1);
     if (st != VOXDAG_OK) {
         b->failed = st;
         return VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
@@ -2752,7 +2816,7 @@ static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk
     size_t bad;
     if (c->failed) return VOXDAG_ERR_OUT_OF_MEMORY;
     if (voxdagi_check_bricks(b, c->brick, c->bricks, &bad, &voxels) != VOXDAG_OK) return VOXDAG_ERR_ORDER;
-    return voxdagi_builder_bricks(b, c->brick, NULL, c->rgb, c->bricks, voxels);
+    return voxdagi_builder_bricks(b, c->brick, NULL, c->rgb, c->bricks, voxels, 0);
 }
 
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
@@ -2853,8 +2917,7 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
             voxdagi_run_parallel(b, voxdagi_chunk_run, next, sizeof *chunk, m);
         }
-        if (b->opts.progress)
-            b->opts.progress(b->opts.progress_user, "voxelize", (double)p / (double)pairs);
+        if (st == VOXDAG_OK) st = voxdagi_progress(b, "voxelize", (double)p / (double)pairs);
         cur = (unsigned)(next - chunk);
         t = st == VOXDAG_OK ? m : 0;
     }
@@ -4636,7 +4699,11 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
         voxdag_builder_free(b);
         return st;
     }
-    if (b->opts.progress) b->opts.progress(b->opts.progress_user, "reduce", 1.0);
+    if ((st = voxdagi_progress(b, "reduce", 1.0)) != VOXDAG_OK) {
+        st = VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+        voxdag_builder_free(b);
+        return st;
+    }
     for (k = 0; k < b->red_count; k++) {
         voxdagi_reducer_finish(&b->red[k]);
         if (b->red[k].failed) {
@@ -4673,12 +4740,21 @@ VOXDAG_API voxdag_status voxdag_builder_finish(voxdag_builder *b, voxdag **out,
     b->pend_code = NULL;
     b->pend_rgb = NULL;
     b->pend_cap = 0;
+    if ((st = voxdagi_progress(b, "encode", 0.0)) != VOXDAG_OK) {
+        st = VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+        voxdag_builder_free(b);
+        return st;
+    }
     st = voxdagi_builder_encode(b, out, err);
     if (stats) stats->peak_memory = b->mem.peak;
-    if (b->opts.progress) b->opts.progress(b->opts.progress_user, "encode", 1.0);
     /* The DAG's memory came from the builder's allocator; keep it out of the
        builder's accounting so freeing the builder balances. */
     if (*out) b->mem.used -= sizeof(voxdag) + (*out)->owned_size;
+    if (st == VOXDAG_OK && (st = voxdagi_progress(b, "encode", 1.0)) != VOXDAG_OK) {
+        voxdag_free(*out);
+        *out = NULL;
+        st = VOXDAGI_FAIL(err, st, voxdagi_reduce_message(st));
+    }
     if (st == VOXDAG_ERR_OUT_OF_MEMORY) st = voxdagi_mem_fail(&b->mem, err, st, err ? err->message : NULL);
     voxdag_builder_free(b);
     if (st == VOXDAG_OK) voxdagi_ok(err);
@@ -4705,6 +4781,11 @@ VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]) {
     if (dag->color_kind == VOXDAG_COLORS_VOXCOLOR) { /* count = voxels: checked by voxdagi_open_colors */
         voxcolor_view_get(&dag->color_view, index, rgb);
         return 1;
+    }
+#else
+    if (dag->color_kind == VOXDAG_COLORS_VOXCOLOR) { /* no decoder here: loud, see the declaration */
+        rgb[0] = 255, rgb[1] = 0, rgb[2] = 255;
+        return -1;
     }
 #endif
     return 0;
@@ -4805,6 +4886,11 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
     info->brick_bytes = 8 * dag->brick_count;
     info->color_bytes = dag->color_size;
     info->color_kind = dag->color_kind;
+#ifdef VOXDAGI_VOXCOLOR
+    info->colors_decodable = dag->color_kind != VOXDAG_COLORS_NONE;
+#else
+    info->colors_decodable = dag->color_kind == VOXDAG_COLORS_RGB8;
+#endif
     info->has_bounds = dag->has_bounds;
     memcpy(info->bounds, dag->bounds, sizeof info->bounds);
 }

@@ -1,6 +1,6 @@
 #!/bin/sh
 # Image quality of compressed colours: each scene is built by `vdag build`
-# with raw 24-bit colours and with --color-error E for a few E, every file is
+# with raw 24-bit colours (--raw-colors) and with --color-error E for a few E, every file is
 # rendered from the same camera, and OpenImageIO's idiff compares each
 # compressed render with the raw one; the voxels' own colours are compared
 # too (vdag export-voxels), and bench/ssim.c gives the renders' SSIM. Prints
@@ -32,7 +32,7 @@ CG-57|$C|11|1024|1250 -700 550|512 61 110|40"
 
 echo "## Image quality"
 echo
-echo "Each scene built by \`vdag build IN OUT.vdag [--levels L]\` with raw 24-bit colours and with \`--color-error E\`, rendered by \`vdag render --size $size --shadows\` from the same camera; PSNR of each compressed render against the raw one by OpenImageIO \`idiff\` (over the whole picture, RGB, background included); SSIM: mean structural similarity of the two renders' luma (\`bench/ssim.c\`: 11x11 Gaussian window, sigma 1.5, the usual constants; whole picture). Voxel PSNR: over the voxels' decoded colours (\`vdag export-voxels\`, RGB, as in the colour tables). Colour bytes: the colour section of the file (\`vdag info --json\`)."
+echo "Each scene built by \`vdag build IN OUT.vdag [--levels L]\` with raw 24-bit colours (\`--raw-colors\`) and with \`--color-error E\`, rendered by \`vdag render --size $size --shadows\` from the same camera; PSNR of each compressed render against the raw one by OpenImageIO \`idiff\` (over the whole picture, RGB, background included); SSIM: mean structural similarity of the two renders' luma (\`bench/ssim.c\`: 11x11 Gaussian window, sigma 1.5, the usual constants; whole picture). Voxel PSNR: over the voxels' decoded colours (\`vdag export-voxels\`, RGB, as in the colour tables). Colour bytes: the colour section of the file (\`vdag info --json\`)."
 echo
 echo "| scene | L | voxels | e_t | colour bytes | bits/colour | % of raw | voxel PSNR (dB) | image PSNR (dB) | image SSIM | max pixel error | pixels differing |"
 echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
@@ -42,7 +42,7 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     lv=""; [ "$L" = 0 ] || lv="--levels $L"
     echo "image_quality: $name raw" >&2
     # shellcheck disable=SC2086
-    "$vdag" build "$data/$in" "$work/raw.vdag" $lv 2>/dev/null
+    "$vdag" build "$data/$in" "$work/raw.vdag" $lv --raw-colors 2>/dev/null
     "$vdag" info "$work/raw.vdag" --json >"$work/raw.json"
     levels=$(json "$work/raw.json" levels) voxels=$(json "$work/raw.json" voxels) raw=$(json "$work/raw.json" colors)
     cam=$(echo "$eye $target" | awk -v n="$levels" -v g="$grid" '{ s = 2 ^ n / g; for (i = 1; i <= 6; i++) printf "%g ", $i * s }')

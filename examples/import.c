@@ -1647,6 +1647,7 @@ typedef struct vi_obj {
     vi_buf names;        /* vi_span per material named by usemtl, first use first */
     vi_map name_map;
     vi_buf mtllibs;      /* vi_span per mtllib line */
+    uint8_t *defined;    /* per name: 1 when a material library read defines it */
     int any_rgb, any_vt;
     int32_t material;    /* current material, or -1 */
 } vi_obj;
@@ -1903,6 +1904,7 @@ static int vi_obj_mtllib(vi_obj *o, vdag_scene *out, vi_texcache *cache, vi_span
         key.name = m->name;
         if (!vi_map_find(&sub, &o->name_map, vi_hash_bytes(m->name), vi_same_name, &key, VI_NONE, &index)) goto done;
         if (index == VI_NONE) continue;
+        o->defined[index] = 1;
         memcpy(out->materials[index].rgb, m->rgb, 3);
         if (vi_len(m->map) && !vi_texture(&sub, out, cache, dir, m->map, &out->materials[index].image)) goto done;
     }
@@ -1923,6 +1925,30 @@ static int vi_obj_mtllib_or_warn(vi_obj *o, vdag_scene *out, vi_texcache *cache,
     return r != 0;
 }
 
+/* One warning for the names given to usemtl that no material library read
+   defines (they stay white), naming the first few. */
+static void vi_obj_undefined_warn(vi_obj *o) {
+    enum { SHOWN = 4 };
+    char list[4 * 64 + 16];
+    size_t i, n = 0, at = 0;
+    for (i = 0; i < o->names.count; i++) {
+        vi_span name = ((const vi_span *)o->names.data)[i];
+        size_t len = vi_len(name);
+        if (o->defined[i]) continue;
+        if (n < SHOWN && at < sizeof list) {
+            int w = snprintf(list + at, sizeof list - at, "%s\"%.*s\"%s", n ? ", " : "",
+                             (int)(len > 48 ? 48 : len), name.s, len > 48 ? "..." : "");
+            if (w > 0) at += (size_t)w;
+        }
+        n++;
+    }
+    if (!n) return;
+    if (at > sizeof list - 1) at = sizeof list - 1;
+    list[at] = 0;
+    vi_warn(o->c, "usemtl names %llu material%s that no material library defines (white): %s%s%s", (vi_ull)n,
+            n == 1 ? "" : "s", list, n > SHOWN ? ", ..." : "", o->mtllibs.count ? "" : " (no mtllib line)");
+}
+
 /* One material per name given to usemtl: white until a library says more.
    An mtllib line names one file, spaces included, or else several. */
 static int vi_obj_materials(vi_obj *o, vdag_scene *out) {
@@ -1932,6 +1958,8 @@ static int vi_obj_materials(vi_obj *o, vdag_scene *out) {
     if (!o->names.count || !out->triangle_count) return 1;
     out->triangle_material = (int32_t *)o->tri_mat.data;
     o->tri_mat.data = NULL;
+    if (!(o->defined = (uint8_t *)vi_alloc(o->c, o->names.count, 1))) return 0;
+    memset(o->defined, 0, o->names.count);
     if (!(out->materials = (vdag_material *)vi_alloc(o->c, o->names.count, sizeof *out->materials))) return 0;
     out->material_count = o->names.count;
     for (i = 0; i < o->names.count; i++) {
@@ -1949,6 +1977,7 @@ static int vi_obj_materials(vi_obj *o, vdag_scene *out) {
         }
     }
     vi_tex_free(&cache);
+    if (ok) vi_obj_undefined_warn(o);
     return ok;
 }
 
@@ -1968,6 +1997,7 @@ static int vi_parse_obj(vi_ctx *c, vi_text *t, vdag_scene *out) {
     vi_buf_free(&o.poly);
     vi_buf_free(&o.names);
     vi_buf_free(&o.mtllibs);
+    free(o.defined);
     free(o.name_map.slots);
     return ok;
 }

@@ -1,7 +1,7 @@
 /* vdag: build, inspect, query and render .vdag files.
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
-              [--no-symmetry] [--color-error E] [--color-bits W|auto]
+              [--no-symmetry] [--color-error E] [--raw-colors] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
               [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
               [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--quiet]
@@ -160,15 +160,19 @@ static const struct {
      "                     reflections) or full (all 48 cube symmetries) (default: full)\n"
      "  --no-symmetry      the same as --symmetry none (default: full symmetry)\n"
      "  --color-error E    compress colours with voxcolor, each within E (RGB distance / 255,\n"
-     "                     0 = lossless) (default: colours stored raw, 24 bits each); an E\n"
-     "                     above sqrt(3) = 1.732 warns: every colour is within it\n"
+     "                     0 = lossless) (default: 0, lossless voxcolor: runs of one colour\n"
+     "                     cost next to nothing); an E above sqrt(3) = 1.732 warns: every\n"
+     "                     colour is within it\n"
+     "  --raw-colors       store colours raw, 24 bits each (RGB8), instead of voxcolor; not\n"
+     "                     with the other colour options (default: voxcolor, lossless)\n"
      "  --color-bits W|auto  voxcolor weight bits 1..4 (default: auto)\n"
      "  --color-effort smallest|fast  colour encoder effort: fast searches one endpoint precision,\n"
      "                     a little larger near e_t 0.02-0.04 (default: smallest)\n"
      "  --verify-colors    after compressing, decode every colour and compare it with the\n"
      "                     raw colour; fail when one is off by more than E (default: off)\n"
      "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
-     "                     alpha test, the voxels stay the same\n"
+     "                     alpha test, the voxels stay the same\n"},
+    {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
      "  --chunk-levels C   voxelize meshes in chunks of 2^C voxels per axis, 2..8 (default:\n"
@@ -279,7 +283,9 @@ typedef struct build_args {
     const char *in, *out;
     uint32_t levels, threads;
     voxdag_symmetry symmetry;
-    int no_colors, stats, compress;
+    int no_colors, stats;
+    int compress;           /* voxcolor (the default); 0: --raw-colors, RGB8 */
+    const char *color_option; /* the last colour-compression option given, for the clash with --raw-colors */
     int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
     int verify_colors;      /* --verify-colors */
     double color_error;
@@ -1118,6 +1124,7 @@ static int cmd_build(int argc, char **argv) {
     memset(&a, 0, sizeof a);
     memset(&spill, 0, sizeof spill);
     a.spill = &spill;
+    a.compress = 1; /* lossless voxcolor (color_error 0) unless --raw-colors */
     a.t0 = t0;
     a.threads = vdag_cpu_count();
     a.tty = isatty(2);
@@ -1168,21 +1175,24 @@ static int cmd_build(int argc, char **argv) {
         } else if (!strcmp(argv[k], "--color-error") && k + 1 < argc) {
             if (!parse_double(argv[++k], &a.color_error) || a.color_error < 0)
                 return vdag_fail("build: --color-error takes a number >= 0");
-            a.compress = 1;
+            a.color_option = "--color-error";
+        } else if (!strcmp(argv[k], "--raw-colors")) {
+            a.compress = 0;
         } else if (!strcmp(argv[k], "--color-effort") && k + 1 < argc) {
             k++;
             if (!strcmp(argv[k], "smallest")) a.color_effort = VOXCOLOR_EFFORT_SMALLEST;
             else if (!strcmp(argv[k], "fast")) a.color_effort = VOXCOLOR_EFFORT_FAST;
             else return vdag_fail("build: --color-effort takes smallest or fast");
-            a.compress = 1;
+            a.color_option = "--color-effort";
         } else if (!strcmp(argv[k], "--verify-colors")) {
             a.verify_colors = 1;
+            a.color_option = "--verify-colors";
         } else if (!strcmp(argv[k], "--color-bits") && k + 1 < argc) {
             k++;
             if (!strcmp(argv[k], "auto")) a.color_bits = 0;
             else if (!parse_u32(argv[k], &a.color_bits) || a.color_bits < 1 || a.color_bits > 4)
                 return vdag_fail("build: --color-bits takes 1..4 or auto");
-            a.compress = 1;
+            a.color_option = "--color-bits";
         } else if (argv[k][0] == '-' && argv[k][1]) {
             return vdag_fail("build: unknown option %s", argv[k]);
         } else if (!a.in) {
@@ -1194,7 +1204,8 @@ static int cmd_build(int argc, char **argv) {
         }
     }
     if (!a.in || !a.out) return vdag_fail("usage: vdag build IN OUT.vdag [--levels L] [--symmetry G] ...");
-    if (a.verify_colors && !a.compress) return vdag_fail("build: --verify-colors checks compressed colours: add --color-error E");
+    if (!a.compress && a.color_option)
+        return vdag_fail("build: --raw-colors stores colours uncompressed: %s is for voxcolor colours", a.color_option);
     if (a.color_error > sqrt(3.0)) /* the distance from black to white */
         fprintf(stderr, "vdag: warning: --color-error %g is above sqrt(3) = 1.732, the largest RGB distance / 255: "
                         "every colour is within it\n", a.color_error);
@@ -1501,8 +1512,9 @@ static int cmd_gen(int argc, char **argv) {
 static int usage(FILE *f) {
     fputs("usage: vdag COMMAND ...   (vdag COMMAND --help: its options and defaults; vdag --version)\n"
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
-          "                    [--color-error E] [--color-bits W|auto] [--color-effort smallest|fast]\n"
-          "                    [--verify-colors] [--no-colors] [--no-alpha-test] [--chunk-levels C]\n"
+          "                    [--color-error E] [--raw-colors] [--color-bits W|auto]\n"
+          "                    [--color-effort smallest|fast] [--verify-colors] [--no-colors]\n"
+          "                    [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
           "                    [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats]\n"
           "                    [--quiet]\n"

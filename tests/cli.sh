@@ -97,6 +97,37 @@ check "build with --color-error 0" "$VDAG" build "$T/in.xyz" "$T/l.vdag" --level
 "$VDAG" export-voxels "$T/l.vdag" >"$T/export_l" 2>/dev/null
 check "lossless colours exact" cmp -s "$T/export_l" "$T/expected_export"
 
+# -- colours are lossless voxcolor by default (a run of one colour costs next to
+# nothing); --raw-colors stores RGB8, 3 bytes a voxel
+check "a default build stores lossless voxcolor: the same file as --color-error 0" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/d.vdag' --levels 5 2>/dev/null && cmp -s '$T/d.vdag' '$T/l.vdag' &&
+    '$VDAG' info '$T/d.vdag' --json | grep -q '\"color_format\": \"voxcolor\"'"
+check "--raw-colors stores RGB8, 3 bytes a voxel, the same colours" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/r.vdag' --levels 5 --raw-colors 2>/dev/null &&
+    '$VDAG' info '$T/r.vdag' --json | grep -q '\"color_format\": \"rgb8\"' &&
+    '$VDAG' info '$T/r.vdag' --json | grep -q '\"colors\": '\$((3 * \$(wc -l <'$T/expected_export')))'}' &&
+    '$VDAG' export-voxels '$T/r.vdag' 2>/dev/null | cmp -s - '$T/expected_export'"
+python3 -c "
+import random
+random.seed(3)
+with open('$T/white.xyz', 'w') as f:
+    for x in range(64):
+        for y in range(64):
+            f.write('%d %d %d 255 255 255\n' % (x, y, random.randrange(64)))
+"
+check "one colour everywhere: under 2 % of raw RGB8 by default (a few bytes a page), exact" python3 -c "
+import json, subprocess
+def info(p):
+    return json.loads(subprocess.check_output(['$VDAG', 'info', p, '--json']))
+subprocess.check_call(['$VDAG', 'build', '$T/white.xyz', '$T/w.vdag', '--quiet'])
+subprocess.check_call(['$VDAG', 'build', '$T/white.xyz', '$T/wr.vdag', '--quiet', '--raw-colors'])
+d, r = info('$T/w.vdag'), info('$T/wr.vdag')
+assert r['bytes']['colors'] == 3 * 4096 and r['color_format'] == 'rgb8', r
+assert d['color_format'] == 'voxcolor' and d['bytes']['colors'] * 50 < r['bytes']['colors'], d['bytes']
+out = subprocess.check_output(['$VDAG', 'export-voxels', '$T/w.vdag']).decode().split('\n')
+assert len(out) == 4097 and all(l.endswith(' 255 255 255') for l in out[:-1])
+"
+
 # -- colour compression on threads, fast effort; the colour spill in $TMPDIR
 check "colour compression threads do not change the file" sh -c "
     '$VDAG' build '$T/in.xyz' '$T/c1.vdag' --levels 5 --color-error 0.03 --threads 1 2>/dev/null &&
@@ -116,7 +147,14 @@ check "--verify-colors compares every colour and reports the max error" sh -c "
     '$VDAG' build '$T/in.xyz' '$T/v.vdag' --levels 5 --color-error 0.03 --verify-colors 2>'$T/err' &&
     grep -q 'colour check: all '\$(wc -l <'$T/expected_export')' colours decoded .*: max error 0\.0[0-2][0-9]* <= e_t 0.03' '$T/err' &&
     cmp -s '$T/v.vdag' '$T/c1.vdag'"
-check "--verify-colors needs --color-error" sh -c "! '$VDAG' build '$T/in.xyz' '$T/x.vdag' --verify-colors 2>/dev/null"
+check "--verify-colors checks the default lossless colours" sh -c "
+    '$VDAG' build '$T/in.xyz' '$T/v0.vdag' --levels 5 --verify-colors 2>'$T/err' &&
+    grep -q 'colour check: all '\$(wc -l <'$T/expected_export')' colours decoded .*: max error 0\.000000 <= e_t 0' '$T/err'"
+for o in "--color-error 0.1" "--color-bits 2" "--color-effort fast" --verify-colors; do
+    check "--raw-colors with $o fails with one line naming it" sh -c "
+        ! '$VDAG' build '$T/in.xyz' '$T/rc.vdag' --levels 5 $o --raw-colors 2>'$T/err' &&
+        [ \$(wc -l <'$T/err') = 1 ] && grep -q -- '--raw-colors .*${o%% *}' '$T/err' && [ ! -e '$T/rc.vdag' ]"
+done
 check "--color-effort takes smallest or fast" sh -c "! '$VDAG' build '$T/in.xyz' '$T/x.vdag' --color-effort best 2>/dev/null"
 mkdir -p "$T/spill"
 check "the colour spill goes to TMPDIR, is reported up front and at the end, and is removed" sh -c "
@@ -181,6 +219,14 @@ printf 'not an image' >"$T/broken.png"
 printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nvt 0 0\nvt 1 0\nvt 1 1\nusemtl t\nf 1/1 2/2 3/3\n' >"$T/tex.obj"
 check "an undecodable texture warns" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 2>'$T/err' && grep -q warning '$T/err'"
 check "--no-colors --no-alpha-test skips textures" sh -c "'$VDAG' build '$T/tex.obj' '$T/tx.vdag' --levels 3 --no-colors --no-alpha-test 2>'$T/err' && ! grep -q warning '$T/err'"
+# A usemtl name that no library defines stays white, with one warning naming it
+# (a missing material used to pass for white in silence).
+printf 'mtllib tex.mtl\nv 0 0 0\nv 8 0 0\nv 8 8 0\nusemtl hull\nf 1 2 3\nusemtl hull\nf 3 2 1\n' >"$T/boat.obj"
+check "an undefined usemtl warns once, naming the material; its voxels are white" sh -c "
+    '$VDAG' build '$T/boat.obj' '$T/boat.vdag' --levels 3 --up z 2>'$T/err' &&
+    [ \$(grep -c warning '$T/err') = 1 ] &&
+    grep -q 'warning: $T/boat.obj: usemtl names 1 material that no material library defines (white): \"hull\"' '$T/err' &&
+    '$VDAG' export-voxels '$T/boat.vdag' | awk 'NF != 6 || \$4 != 255 || \$5 != 255 || \$6 != 255 { exit 1 } END { exit NR == 0 }'"
 
 # -- alpha testing: texels with alpha below one half make no voxel (the same
 # voxels with --no-colors); --no-alpha-test voxelizes every texel. The
@@ -565,7 +611,7 @@ for c in build info validate lookup rays render export-voxels gen; do
     check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
 done
 check "every build and render option in --help with its default" sh -c "
-    for o in --levels --up --symmetry --no-symmetry --color-error --color-bits --color-effort --no-colors --chunk-levels --threads --allow-empty --force --stats --quiet; do
+    for o in --levels --up --symmetry --no-symmetry --color-error --raw-colors --color-bits --color-effort --no-colors --chunk-levels --threads --allow-empty --force --stats --quiet; do
         '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
     for o in --size --eye --target --fov --shadows --lod --threads; do
         '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done

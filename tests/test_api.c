@@ -337,6 +337,11 @@ static void test_color_voxcolor(void) {
         CHECK(voxdag_with_colors(d, VOXDAG_COLORS_VOXCOLOR, stream, len, &v, &err) == VOXDAG_OK);
         img = voxdag_image(v, &size);
         CHECK(voxdag_load_memory(img, size, NULL, &loaded, &err) == VOXDAG_OK);
+        {
+            voxdag_info li; /* voxcolor.h came first: decodable (tests/test_no_voxcolor.c: not) */
+            voxdag_get_info(loaded, &li);
+            CHECK(li.color_kind == VOXDAG_COLORS_VOXCOLOR && li.colors_decodable == 1);
+        }
         /* The oracle: the stream decoded by its own view, and the original colours. */
         CHECK(voxcolor_view_init(&view, stream, len, NULL) == VOXCOLOR_OK);
         for (i = 0; i < info.voxels; i++) {

@@ -962,6 +962,138 @@ static void test_mutations_rejected(void) {
     scene_free(&s);
 }
 
+// -- Progress reports and cancelling
+
+/* What a build reported: every call of progress and of progress_cancel, the
+   latter cancelling at its call CANCEL_AT (-1: never). */
+typedef struct progress_log {
+    long calls, cancel_calls, cancel_at;
+    long intermediate;        /* reports with 0 < fraction < 1 */
+    int bad;                  /* a fraction outside [0, 1], or decreasing in a stage */
+    int cancel_seen;          /* progress and progress_cancel got the same reports */
+    const char *stage;        /* of the last report */
+    double fraction;
+    const char *last_stage;   /* of the last cancel report */
+} progress_log;
+
+static void log_progress(void *user, const char *stage, double fraction) {
+    progress_log *g = (progress_log *)user;
+    if (fraction < 0 || fraction > 1 || (g->stage && !strcmp(g->stage, stage) && fraction < g->fraction &&
+                                         strcmp(stage, "reduce")))
+        g->bad = 1; /* "reduce" starts again at each flush */
+    g->intermediate += fraction > 0 && fraction < 1;
+    g->stage = stage;
+    g->fraction = fraction;
+    g->calls++;
+}
+
+static int log_cancel(void *user, const char *stage, double fraction) {
+    progress_log *g = (progress_log *)user;
+    if (g->stage != stage || g->fraction != fraction) g->bad = 1; /* just after progress, the same report */
+    g->last_stage = stage;
+    return g->cancel_calls++ == g->cancel_at;
+}
+
+enum { PROGRESS_VOXELS, PROGRESS_BRICKS, PROGRESS_MESH, PROGRESS_KINDS };
+
+static void progress_mesh_color(void *user, size_t tri, const double bary[3], uint8_t rgb[3]) {
+    (void)user, (void)bary;
+    rgb[0] = rgb[1] = rgb[2] = (uint8_t)(tri * 50);
+}
+
+/* Builds one input of KIND (voxels: 300k voxels in two adds and a flush;
+   bricks: 60k in one call; a mesh: two triangles in chunks of 4^3) with
+   both callbacks on G and a counting allocator. Returns the first failing
+   status (every call after a failure is still made), with *OUT the DAG. */
+static voxdag_status progress_build(int kind, progress_log *g, count_alloc *ca, voxdag **out) {
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag_status st = VOXDAG_OK, s2;
+    size_t i, n;
+    memset(&o, 0, sizeof o);
+    o.levels = kind == PROGRESS_MESH ? 6 : 9;
+    o.colors = 1;
+    o.threads = 1;
+    o.chunk_levels = 2;
+    o.allocator = ca_start(ca, -1);
+    o.progress = log_progress;
+    o.progress_cancel = log_cancel;
+    o.progress_user = g;
+    *out = NULL;
+    if (voxdag_builder_create(&o, &b, NULL) != VOXDAG_OK) return VOXDAG_ERR_INVALID_ARGUMENT;
+    if (kind == PROGRESS_VOXELS) {
+        uint64_t seed = 3;
+        n = 300000;
+        uint32_t *xyz = (uint32_t *)malloc(3 * n * sizeof *xyz);
+        uint8_t *rgb = (uint8_t *)malloc(3 * n);
+        for (i = 0; i < 3 * n; i++) xyz[i] = test_rand_below(&seed, 512), rgb[i] = (uint8_t)i;
+        for (i = 0; i < n; i++) xyz[3 * i + 2] = xyz[3 * i + 2] / 2 + (i < n / 2 ? 0 : 256); /* z halves: Morton order */
+        st = voxdag_builder_add(b, xyz, rgb, n / 2, NULL);
+        s2 = voxdag_builder_flush(b, NULL);
+        if (st == VOXDAG_OK) st = s2;
+        s2 = voxdag_builder_add(b, xyz + 3 * (n / 2), rgb + 3 * (n / 2), n - n / 2, NULL);
+        if (st == VOXDAG_OK) st = s2;
+        free(xyz);
+        free(rgb);
+    } else if (kind == PROGRESS_BRICKS) {
+        n = 60000;
+        uint64_t *bricks = (uint64_t *)malloc(2 * n * sizeof *bricks);
+        uint8_t *rgb = (uint8_t *)malloc(3 * n);
+        for (i = 0; i < n; i++) bricks[2 * i] = 3 * i, bricks[2 * i + 1] = 1, rgb[3 * i] = rgb[3 * i + 1] = rgb[3 * i + 2] = 9;
+        st = voxdag_builder_add_bricks(b, bricks, rgb, n, NULL);
+        free(bricks);
+        free(rgb);
+    } else {
+        static const double pos[] = {0, 0, 5, 64, 0, 30, 64, 64, 50, 0, 64, 20};
+        static const uint32_t idx[] = {0, 1, 2, 0, 2, 3};
+        voxdag_mesh m;
+        memset(&m, 0, sizeof m);
+        m.positions = pos, m.vertex_count = 4, m.indices = idx, m.triangle_count = 2;
+        m.color = progress_mesh_color;
+        st = voxdag_builder_add_mesh(b, &m, NULL);
+    }
+    s2 = voxdag_builder_finish(b, out, NULL, NULL);
+    return st == VOXDAG_OK ? s2 : st;
+}
+
+/* Every input kind reports real progress (fractions between 0 and 1, not
+   just two reports at 100 %), ending with "encode" at 1; progress and
+   progress_cancel see the same reports. Cancelling at each report in turn
+   fails the build with VOXDAG_ERR_CANCELLED, no DAG, the builder freed by
+   finish and nothing leaked; the previous void callback keeps working. */
+static void test_progress_cancel(void) {
+    static const char *const names[PROGRESS_KINDS] = {"voxels", "bricks", "mesh"};
+    int kind;
+    CHECK(strcmp(voxdag_status_string(VOXDAG_ERR_CANCELLED), "cancelled") == 0);
+    for (kind = 0; kind < PROGRESS_KINDS; kind++) {
+        progress_log g;
+        count_alloc ca;
+        voxdag *d = NULL;
+        long reports, k;
+        memset(&g, 0, sizeof g);
+        g.cancel_at = -1;
+        CHECK_MSG(progress_build(kind, &g, &ca, &d) == VOXDAG_OK && d, "%s", names[kind]);
+        voxdag_free(d);
+        reports = g.calls;
+        CHECK_MSG(!g.bad && g.cancel_calls == reports, "%s: %ld and %ld reports", names[kind], reports, g.cancel_calls);
+        CHECK_MSG(g.intermediate >= 3, "%s: %ld of %ld reports between 0 and 1", names[kind], g.intermediate, reports);
+        CHECK_MSG(g.stage && !strcmp(g.stage, "encode") && g.fraction == 1.0, "%s", names[kind]);
+        CHECK_MSG(ca.held == 0 && !ca.bad_free, "%s: %llu bytes held", names[kind], (unsigned long long)ca.held);
+        for (k = 0; k < reports; k++) {
+            voxdag_status st;
+            memset(&g, 0, sizeof g);
+            g.cancel_at = k;
+            st = progress_build(kind, &g, &ca, &d);
+            CHECK_MSG(st == VOXDAG_ERR_CANCELLED && !d, "%s, cancelled at report %ld (%s): %s", names[kind], k,
+                      g.last_stage ? g.last_stage : "?", voxdag_status_string(st));
+            CHECK_MSG(g.cancel_calls == k + 1, "%s: reports went on after cancelling at %ld", names[kind], k);
+            CHECK_MSG(ca.held == 0 && !ca.bad_free, "%s, cancelled at report %ld: %llu bytes held", names[kind], k,
+                      (unsigned long long)ca.held);
+            voxdag_free(d);
+        }
+    }
+}
+
 const test_case test_core_cases[] = {
     {"core/oracle_scenes", test_oracle_scenes},
     {"core/mirrored_blob_merges", test_mirrored_blob_merges},
@@ -974,5 +1106,6 @@ const test_case test_core_cases[] = {
     {"core/allocation_failures", test_allocation_failures},
     {"core/build_limits", test_build_limits},
     {"core/mutations_rejected", test_mutations_rejected},
+    {"core/progress_cancel", test_progress_cancel},
     {NULL, NULL},
 };

@@ -889,6 +889,78 @@ static void test_obj_file(void) {
 }
 
 
+/* Imports file PATH with warnings on, returning what went to stderr in WARN. */
+static int import_file_warnings(const char *path, vdag_scene *s, char *err, size_t err_size, char *warn,
+                                size_t warn_size) {
+    FILE *tmp = tmpfile();
+    int saved = dup(2), ok;
+    size_t n;
+    warn[0] = 0;
+    CHECK(tmp != NULL && saved >= 0);
+    if (!tmp || saved < 0) return 0;
+    fflush(stderr);
+    dup2(fileno(tmp), 2);
+    ok = vdag_import_file(path, NULL, s, err, err_size);
+    fflush(stderr);
+    dup2(saved, 2);
+    close(saved);
+    rewind(tmp);
+    n = fread(warn, 1, warn_size - 1, tmp);
+    warn[n] = 0;
+    fclose(tmp);
+    return ok;
+}
+
+/* A usemtl name that no material library read defines stays white, with one
+   warning per .obj naming such names (the first few): none when every name
+   is defined; one line for several undefined names, or several uses. */
+static void test_obj_undefined_material(void) {
+    static const char *const mtl = "newmtl red\nKd 1 0 0\n";
+    static const struct {
+        const char *obj, *want; /* WANT: the warning's text after the file name; NULL: no warning */
+    } cases[] = {
+        {"mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\n", NULL},
+        {"mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl red\nf 1 2 3\nusemtl hull\nf 3 2 1\nusemtl hull\nf 1 3 2\n",
+         ": usemtl names 1 material that no material library defines (white): \"hull\"\n"},
+        {"mtllib lib.mtl gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl red\nf 3 2 1\nusemtl b\nf 1 3 2\n",
+         ": usemtl names 2 materials that no material library defines (white): \"a\", \"b\"\n"},
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\nusemtl b\nf 3 2 1\nusemtl c\nf 1 3 2\nusemtl d\nf 2 1 3\n"
+         "usemtl e\nf 2 3 1\n",
+         ": usemtl names 5 materials that no material library defines (white): \"a\", \"b\", \"c\", \"d\", ... "
+         "(no mtllib line)\n"},
+    };
+    char dir[] = "/tmp/vdag-mtlname-XXXXXX", path[256], lib[256], err[512], warn[2048];
+    size_t k, i, white;
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/boat.obj", dir);
+    snprintf(lib, sizeof lib, "%s/lib.mtl", dir);
+    CHECK(write_file(lib, mtl, strlen(mtl)));
+    for (k = 0; k < sizeof cases / sizeof cases[0]; k++) {
+        vdag_scene s;
+        CHECK(write_file(path, cases[k].obj, strlen(cases[k].obj)));
+        if (!import_file_warnings(path, &s, err, sizeof err, warn, sizeof warn)) {
+            CHECK_MSG(0, "case %zu: %s", k, err);
+            continue;
+        }
+        if (!cases[k].want) {
+            CHECK_MSG(!warn[0], "case %zu warned \"%s\"", k, warn);
+        } else { /* the warning ends the output: one line (a missing library has its own, before it) */
+            const char *m = strstr(warn, "vdag: warning: ");
+            while (m && strstr(m + 1, "vdag: warning: ")) m = strstr(m + 1, "vdag: warning: ");
+            m = m ? strstr(m, "boat.obj: usemtl") : NULL;
+            CHECK_MSG(m && !strcmp(m + strlen("boat.obj"), cases[k].want), "case %zu warned \"%s\"", k, warn);
+            CHECK_MSG(strstr(warn, "usemtl") == m + strlen("boat.obj: "), "case %zu warned \"%s\"", k, warn);
+        }
+        for (i = white = 0; i < s.material_count; i++) /* red is red, the undefined ones white */
+            white += s.materials[i].rgb[0] == 255 && s.materials[i].rgb[1] == 255 && s.materials[i].rgb[2] == 255;
+        CHECK_MSG(white + (k != 3) == s.material_count, "case %zu: %zu white of %zu", k, white, s.material_count);
+        vdag_scene_free(&s);
+    }
+    remove(path);
+    remove(lib);
+    rmdir(dir);
+}
+
 /* Side files (material libraries, textures) are read only when they are
    regular files of at most VDAG_IMPORT_MAX_SIDE_FILE_BYTES: a device (no
    4 GiB read of /dev/zero), a FIFO (no wait for a writer) or an oversized
@@ -1896,6 +1968,7 @@ const test_case test_import_cases[] = {
     {"import/vox scene graph", test_vox_scene_graph},
     {"import/vox errors", test_vox_errors},
     {"import/integers out of range refused", test_integer_overflow},
+    {"import/obj: an undefined usemtl warns once per file", test_obj_undefined_material},
     {"import/side files: regular files only", test_side_files},
     {"import/textures by file identity, pixel budget", test_texture_budget},
     {"import/vox voxel budget", test_vox_voxel_budget},
