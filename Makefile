@@ -16,7 +16,7 @@ THREADS := -pthread
 SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer
 HEADERS := voxdag.h voxcolor.h voxdag_gpu.h
 
-VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c examples/gpu_vulkan.c
+VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c examples/gpu_vulkan.c examples/gpu.c
 TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_no_voxcolor.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
@@ -64,7 +64,7 @@ VULKAN_LIBS   = $(if $(VULKAN),-ldl)
 # that includes NAME_glsl.h lists it as a prerequisite and adds
 # -I$(BUILD)/shaders.
 GLSLANG       := glslangValidator -V --target-env vulkan1.1 -I.
-SHADER_DEPS   := $(wildcard examples/shaders/*.h examples/shaders/*.glsl examples/shaders/*.hlsli)
+SHADER_DEPS   := voxdag_gpu.h $(wildcard examples/shaders/*.h examples/shaders/*.glsl examples/shaders/*.hlsli)
 define shader_rules
 $$(BUILD)/shaders/%_glsl.h $$(BUILD)/shaders/%_glsl.spv: $(1)/%.comp $$(SHADER_DEPS)
 	@mkdir -p $$(@D)
@@ -104,6 +104,13 @@ $(BUILD)/san/oiio_ref.o: tests/oiio_ref.cpp tests/oiio_ref.h
 $(BUILD)/opt/examples/gpu_vulkan.o: examples/gpu_vulkan.c examples/gpu_vulkan.h $(BUILD)/vulkan.flag
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(VULKAN_CFLAGS) -I. -c -o $@ $<
+
+# gpu.c embeds the kernel's SPIR-V, compiled from examples/shaders.
+VDAG_KERNEL := $(BUILD)/shaders/vdag_kernel_glsl.h $(BUILD)/shaders/vdag_kernel_hlsl.h
+$(BUILD)/opt/examples/gpu.o: examples/gpu.c examples/gpu.h examples/gpu_vulkan.h examples/shaders/vdag_kernel.h \
+                             $(HEADERS) $(BUILD)/vulkan.flag $(if $(VULKAN),$(VDAG_KERNEL))
+	@mkdir -p $(@D)
+	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) $(VULKAN_CFLAGS) -I. -I$(BUILD)/shaders -c -o $@ $<
 
 # import.c includes import_scene.c (.spm and .ac share its helpers).
 $(BUILD)/opt/examples/import.o $(BUILD)/san/examples/import.o: examples/import_scene.c

@@ -613,16 +613,70 @@ VOXDAG_GPU_FUNC voxdag_gpu_bool voxdag_gpui_is_nan(voxdag_gpu_f32 x) {
     return (VOXDAG_GPU_FLOAT_BITS(x) & 0x7FFFFFFFu) > 0x7F800000u;
 }
 
+/* One axis of a ray: origin, reciprocal direction, sign (0: the ray does not
+   move along it), and the t where it enters and leaves [LO, HI]; bad when
+   the input is outside the domain. */
+struct voxdag_gpui_axis {
+    voxdag_gpu_f32 o, ix, t0, t1;
+    voxdag_gpu_i32 sgn;
+    voxdag_gpu_u32 bad;
+};
+#ifdef VOXDAG_GPU_C
+typedef struct voxdag_gpui_axis voxdag_gpui_axis;
+#endif
+
+VOXDAG_GPU_FUNC voxdag_gpui_axis voxdag_gpui_axis_setup(voxdag_gpu_f32 o, voxdag_gpu_f32 d, voxdag_gpu_f32 lo,
+                                                        voxdag_gpu_f32 hi) {
+    voxdag_gpui_axis x;
+    voxdag_gpu_u32 ob = VOXDAG_GPU_FLOAT_BITS(o) & 0x7FFFFFFFu, db = VOXDAG_GPU_FLOAT_BITS(d) & 0x7FFFFFFFu;
+    x.bad = ob >= 0x4E800000u || db > 0x4F800000u ? 1u : 0u; /* |o| >= 2^30, |d| > 2^32, NaN, infinite */
+    x.o = voxdag_gpui_flush(o, 0x2F800000u);                 /* |o| < 2^-32: 0 */
+    d = voxdag_gpui_flush(d, 0x1F800000u);                   /* |d| < 2^-64: 0 */
+    x.ix = 0.0f, x.t0 = -VOXDAG_GPUI_FAR, x.t1 = VOXDAG_GPUI_FAR, x.sgn = 0;
+    if (d == 0.0f) {
+        if (!(x.o >= lo && x.o < hi)) x.bad = 1u;
+    } else {
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 t0, t1;
+        x.sgn = d > 0.0f ? 1 : -1;
+        x.ix = voxdag_gpui_recip(d);
+        t0 = ((d > 0.0f ? lo : hi) - x.o) * x.ix;
+        t1 = ((d > 0.0f ? hi : lo) - x.o) * x.ix;
+        x.t0 = t0, x.t1 = t1;
+    }
+    return x;
+}
+
+/* The t at which axis X meets the plane at integer coordinate PLANE (FAR
+   when it does not move along it). */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_plane_t(voxdag_gpui_axis x, voxdag_gpu_u32 plane) {
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 t = (VOXDAG_GPU_F32(plane) - x.o) * x.ix;
+    return x.sgn == 0 ? VOXDAG_GPUI_FAR : t;
+}
+
+/* The child cell along axis X (number B) of cell coordinate C, entering at
+   (TE, AE): 1 when the ray is past the mid plane MID by then. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_upper(voxdag_gpui_axis x, voxdag_gpu_u32 mid, voxdag_gpu_f32 te,
+                                                 voxdag_gpu_u32 ae, voxdag_gpu_u32 b) {
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 tm = (VOXDAG_GPU_F32(mid) - x.o) * x.ix;
+    voxdag_gpu_bool crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
+    if (x.sgn == 0) return x.o >= VOXDAG_GPU_F32(mid) ? 1u : 0u;
+    return (x.sgn > 0) == crossed ? 1u : 0u;
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_octant(voxdag_gpu_u32 cx, voxdag_gpu_u32 cy, voxdag_gpu_u32 cz) {
+    return (cx & 1u) | (cy & 1u) << 1 | (cz & 1u) << 2;
+}
+
 VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray,
                                                  voxdag_gpu_bool any_hit) {
     voxdag_gpu_hit h;
-    voxdag_gpu_f32 o[3], ix[3], box[6], dir[3];
-    voxdag_gpu_i32 sgn[3];
-    voxdag_gpu_u32 c[3], up[3], fr_at[VOXDAG_GPU_MAX_LEVELS], fr_info[VOXDAG_GPU_MAX_LEVELS];
+    voxdag_gpui_axis x0, x1, x2;
+    voxdag_gpu_u32 fr_at[VOXDAG_GPU_MAX_LEVELS], fr_info[VOXDAG_GPU_MAX_LEVELS];
     voxdag_gpu_u32 nl = f.levels, bl = nl - 2u, q = 0u, l = 0u, a, b, ae = 0u, ax = 0u, mi = f.root_inverse;
-    voxdag_gpu_u32 at = 0u, header = 0u, occ = 0u, bad = 0u;
+    voxdag_gpu_u32 cx = 0u, cy = 0u, cz = 0u, at = 0u, header = 0u, occ = 0u;
     voxdag_gpui_mask mask;
     VOXDAG_GPU_PRECISE voxdag_gpu_f32 te = -VOXDAG_GPUI_FAR, tx = VOXDAG_GPUI_FAR, t_stop, t_min, t_max, lod;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 hi;
     h.hit = 0u, h.t = 0.0f, h.x = 0u, h.y = 0u, h.z = 0u, h.nx = 0, h.ny = 0, h.nz = 0, h.level = 0u;
     h.index_lo = 0u, h.index_hi = 0u;
     mask.lo = 0u, mask.hi = 0u;
@@ -632,33 +686,20 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
     t_min = voxdag_gpui_flush(voxdag_gpui_clamp_t(ray.t_min), 0x1F800000u);
     t_max = (VOXDAG_GPU_FLOAT_BITS(ray.t_max) & 0x7FFFFFFFu) == 0u ? VOXDAG_GPUI_LIMIT : voxdag_gpui_clamp_t(ray.t_max);
     lod = any_hit || !(ray.lod > 0.0f) ? 0.0f : voxdag_gpui_flush(ray.lod < 1048576.0f ? ray.lod : 1048576.0f, 0x35800000u);
-    o[0] = ray.ox, o[1] = ray.oy, o[2] = ray.oz, dir[0] = ray.dx, dir[1] = ray.dy, dir[2] = ray.dz;
     /* the voxel box without level of detail (a hit is a voxel, inside it),
        else the grid (a coarse cell may reach outside the box) */
-    box[0] = VOXDAG_GPU_F32(f.box_lo_x), box[1] = VOXDAG_GPU_F32(f.box_lo_y), box[2] = VOXDAG_GPU_F32(f.box_lo_z);
-    box[3] = VOXDAG_GPU_F32(f.box_hi_x), box[4] = VOXDAG_GPU_F32(f.box_hi_y), box[5] = VOXDAG_GPU_F32(f.box_hi_z);
-    for (a = 0u; a < 3u; a++) {
-        VOXDAG_GPU_PRECISE voxdag_gpu_f32 lo = lod > 0.0f ? 0.0f : box[a];
-        VOXDAG_GPU_PRECISE voxdag_gpu_f32 hi = lod > 0.0f ? VOXDAG_GPU_F32(1u << nl) : box[a + 3u];
-        VOXDAG_GPU_PRECISE voxdag_gpu_f32 t0, t1;
-        voxdag_gpu_u32 ob = VOXDAG_GPU_FLOAT_BITS(o[a]) & 0x7FFFFFFFu, db = VOXDAG_GPU_FLOAT_BITS(dir[a]) & 0x7FFFFFFFu;
-        if (ob >= 0x4E800000u || db > 0x4F800000u) bad = 1u; /* |o| >= 2^30, |d| > 2^32, NaN, infinite */
-        o[a] = voxdag_gpui_flush(o[a], 0x2F800000u);      /* |o| < 2^-32: 0 */
-        dir[a] = voxdag_gpui_flush(dir[a], 0x1F800000u);  /* |d| < 2^-64: 0 */
-        c[a] = 0u, ix[a] = 0.0f;
-        if (dir[a] == 0.0f) {
-            if (!(o[a] >= lo && o[a] < hi)) bad = 1u;
-            sgn[a] = 0, up[a] = 0u;
-            continue;
-        }
-        sgn[a] = dir[a] > 0.0f ? 1 : -1, up[a] = dir[a] > 0.0f ? 1u : 0u;
-        ix[a] = voxdag_gpui_recip(dir[a]);
-        t0 = ((dir[a] > 0.0f ? lo : hi) - o[a]) * ix[a];
-        t1 = ((dir[a] > 0.0f ? hi : lo) - o[a]) * ix[a];
-        if (t0 >= te) te = t0, ae = a; /* on ties the last axis enters last */
-        if (t1 < tx) tx = t1, ax = a;  /* and the first axis leaves first */
-    }
-    if (bad != 0u) return h;
+    hi = VOXDAG_GPU_F32(1u << nl);
+    x0 = voxdag_gpui_axis_setup(ray.ox, ray.dx, lod > 0.0f ? 0.0f : VOXDAG_GPU_F32(f.box_lo_x), lod > 0.0f ? hi : VOXDAG_GPU_F32(f.box_hi_x));
+    x1 = voxdag_gpui_axis_setup(ray.oy, ray.dy, lod > 0.0f ? 0.0f : VOXDAG_GPU_F32(f.box_lo_y), lod > 0.0f ? hi : VOXDAG_GPU_F32(f.box_hi_y));
+    x2 = voxdag_gpui_axis_setup(ray.oz, ray.dz, lod > 0.0f ? 0.0f : VOXDAG_GPU_F32(f.box_lo_z), lod > 0.0f ? hi : VOXDAG_GPU_F32(f.box_hi_z));
+    if ((x0.bad | x1.bad | x2.bad) != 0u) return h;
+    /* on ties the last axis enters last and the first leaves first */
+    if (x0.sgn != 0 && x0.t0 >= te) te = x0.t0, ae = 0u;
+    if (x1.sgn != 0 && x1.t0 >= te) te = x1.t0, ae = 1u;
+    if (x2.sgn != 0 && x2.t0 >= te) te = x2.t0, ae = 2u;
+    if (x0.t1 < tx) tx = x0.t1, ax = 0u;
+    if (x1.t1 < tx) tx = x1.t1, ax = 1u;
+    if (x2.t1 < tx) tx = x2.t1, ax = 2u;
     if (t_min >= te) te = t_min, ae = 3u;
     if (tx < te || (tx == te && ax < ae) || te > t_max) return h;
     t_stop = tx == VOXDAG_GPUI_FAR ? te : t_max < tx ? t_max : tx;
@@ -677,46 +718,41 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
                 occ = 0u;
                 for (b = 0u; b < 8u; b++) occ |= ((b < 4u ? mask.lo : mask.hi) >> (8u * (b & 3u)) & 0xFFu) != 0u ? 1u << b : 0u;
             } else { /* a 2^3 cell: its byte */
-                b = (c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2;
+                b = voxdag_gpui_octant(cx, cy, cz);
                 occ = (b < 4u ? mask.lo : mask.hi) >> (8u * (b & 3u)) & 0xFFu;
             }
             fr_info[l] = occ << 24;
         }
         /* The child cell: which mid planes (te, ae) has crossed. */
-        for (b = 0u; b < 3u; b++) {
-            voxdag_gpu_u32 mid = (2u * c[b] + 1u) << sh, upper;
-            if (sgn[b] == 0) {
-                upper = o[b] >= VOXDAG_GPU_F32(mid) ? 1u : 0u;
-            } else {
-                VOXDAG_GPU_PRECISE voxdag_gpu_f32 tm = (VOXDAG_GPU_F32(mid) - o[b]) * ix[b];
-                voxdag_gpu_bool crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
-                upper = (sgn[b] > 0) == crossed ? 1u : 0u;
-            }
-            c[b] = 2u * c[b] + upper;
-        }
+        cx = 2u * cx + voxdag_gpui_upper(x0, (2u * cx + 1u) << sh, te, ae, 0u);
+        cy = 2u * cy + voxdag_gpui_upper(x1, (2u * cy + 1u) << sh, te, ae, 1u);
+        cz = 2u * cz + voxdag_gpui_upper(x2, (2u * cz + 1u) << sh, te, ae, 2u);
         q++;
         /* Step through the node's cells until a full one. */
         for (;;) {
-            VOXDAG_GPU_PRECISE voxdag_gpu_f32 t = VOXDAG_GPUI_FAR, t1 = VOXDAG_GPUI_FAR, t2 = VOXDAG_GPUI_FAR;
-            voxdag_gpu_u32 old;
+            VOXDAG_GPU_PRECISE voxdag_gpu_f32 t, t1, t2;
+            voxdag_gpu_u32 old, moved;
             voxdag_gpu_i32 k;
-            if ((occ >> ((c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2) & 1u) != 0u) break;
+            if ((occ >> voxdag_gpui_octant(cx, cy, cz) & 1u) != 0u) break;
             sh = nl - q;
-            if (sgn[0] != 0) t = (VOXDAG_GPU_F32((c[0] + up[0]) << sh) - o[0]) * ix[0];
-            if (sgn[1] != 0) t1 = (VOXDAG_GPU_F32((c[1] + up[1]) << sh) - o[1]) * ix[1];
-            if (sgn[2] != 0) t2 = (VOXDAG_GPU_F32((c[2] + up[2]) << sh) - o[2]) * ix[2];
+            t = voxdag_gpui_plane_t(x0, (cx + (x0.sgn > 0 ? 1u : 0u)) << sh);
+            t1 = voxdag_gpui_plane_t(x1, (cy + (x1.sgn > 0 ? 1u : 0u)) << sh);
+            t2 = voxdag_gpui_plane_t(x2, (cz + (x2.sgn > 0 ? 1u : 0u)) << sh);
             a = 0u;
             if (t1 < t) t = t1, a = 1u;
             if (t2 < t) t = t2, a = 2u;
             if (!(t <= t_stop)) return h;
-            old = c[a];
-            c[a] = sgn[a] > 0 ? c[a] + 1u : c[a] - 1u;
+            old = a == 0u ? cx : a == 1u ? cy : cz;
+            moved = (a == 0u ? x0.sgn : a == 1u ? x1.sgn : x2.sgn) > 0 ? old + 1u : old - 1u;
+            if (a == 0u) cx = moved;
+            if (a == 1u) cy = moved;
+            if (a == 2u) cz = moved;
             te = t, ae = a;
-            sh = voxdag_gpui_msb(old ^ c[a]);
+            sh = voxdag_gpui_msb(old ^ moved);
             k = VOXDAG_GPU_I32(q) - 1 - VOXDAG_GPU_I32(sh); /* the node level whose child changed */
             if (k < VOXDAG_GPU_I32(l)) {
                 if (k < 0) return h; /* left the grid */
-                c[0] >>= sh, c[1] >>= sh, c[2] >>= sh;
+                cx >>= sh, cy >>= sh, cz >>= sh;
                 q -= sh, l = VOXDAG_GPU_U32(k);
                 occ = fr_info[l] >> 24;
                 if (l < bl) at = fr_at[l], header = fr_info[l] & 0xFFFFu, mi = fr_info[l] >> 16 & 63u;
@@ -727,8 +763,8 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
             h.hit = 1u;
             if (any_hit) return h;
             h.t = te;
-            h.x = c[0] << (nl - q), h.y = c[1] << (nl - q), h.z = c[2] << (nl - q);
-            h.nx = ae == 0u ? -sgn[0] : 0, h.ny = ae == 1u ? -sgn[1] : 0, h.nz = ae == 2u ? -sgn[2] : 0;
+            h.x = cx << (nl - q), h.y = cy << (nl - q), h.z = cz << (nl - q);
+            h.nx = ae == 0u ? -x0.sgn : 0, h.ny = ae == 1u ? -x1.sgn : 0, h.nz = ae == 2u ? -x2.sgn : 0;
             h.level = q;
             if ((ray.flags & VOXDAG_GPU_WANT_INDEX) != 0u) {
                 /* the voxels of all preceding siblings on the path */
@@ -736,9 +772,9 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
                 voxdag_gpu_u32 top = q < bl ? q : bl, j;
                 idx.lo = 0u, idx.hi = 0u;
                 for (j = 0u; j < top; j++) {
-                    voxdag_gpu_u32 s = q - 1u - j, w = (c[0] >> s & 1u) | (c[1] >> s & 1u) << 1 | (c[2] >> s & 1u) << 2;
-                    voxdag_gpui_mask m = voxdag_gpui_preceding(buf, f, j, fr_at[j], fr_info[j] & 0xFFFFu,
-                                                               fr_info[j] >> 16 & 63u, w);
+                    voxdag_gpu_u32 s = q - 1u - j;
+                    voxdag_gpui_mask m = voxdag_gpui_preceding(buf, f, j, fr_at[j], fr_info[j] & 0xFFFFu, fr_info[j] >> 16 & 63u,
+                                                               voxdag_gpui_octant(cx >> s, cy >> s, cz >> s));
                     idx = voxdag_gpui_add64(idx, m.lo, m.hi);
                 }
                 if (q > bl) idx = voxdag_gpui_add64(idx, voxdag_gpui_before(mask, voxdag_gpui_brick_pos(h.x, h.y, h.z)), 0u);
@@ -747,8 +783,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
             return h;
         }
         if (l < bl) {
-            voxdag_gpui_ref ref = voxdag_gpui_child(buf, f, l, at, header,
-                                                    voxdag_gpui_act(mi, (c[0] & 1u) | (c[1] & 1u) << 1 | (c[2] & 1u) << 2));
+            voxdag_gpui_ref ref = voxdag_gpui_child(buf, f, l, at, header, voxdag_gpui_act(mi, voxdag_gpui_octant(cx, cy, cz)));
             mi = voxdag_gpui_compose(ref.inverse, mi);
             at = ref.at;
         }

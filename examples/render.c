@@ -29,6 +29,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "gpu.h"
 
 #define AMBIENT 0.3
 static const double LIGHT[3] = {0.5, 0.3, 0.8};
@@ -44,12 +45,85 @@ static void print_double(double v) {
     fputs(buf, stdout);
 }
 
+/* vdag rays --gpu: every ray read first, traced in one run of the kernel
+   (origins and directions rounded to float32), printed as without --gpu. */
+static int gpu_rays(vdag_file *f, vdag_gpu_target target) {
+    char line[1024], err[256];
+    unsigned long lineno = 0;
+    uint32_t *in = NULL, *out = NULL, n = 0, cap = 0, i;
+    vdag_gpu *g;
+    vdag_gpu_work w;
+    int rc = 0;
+    while (fgets(line, sizeof line, stdin)) {
+        char *p = line, *end;
+        int k;
+        lineno++;
+        if (n == cap) {
+            uint32_t *grown = cap < (1u << 26) ? (uint32_t *)realloc(in, 10 * sizeof *in * (cap ? 2 * (size_t)cap : 1024)) : NULL;
+            if (!grown) {
+                free(in);
+                return vdag_fail("rays: out of memory at line %lu", lineno);
+            }
+            in = grown, cap = cap ? 2 * cap : 1024;
+        }
+        for (k = 0; k < 6; k++, p = end) {
+            double v = strtod(p, &end);
+            float fv = (float)v;
+            if (end == p || !isfinite(v)) {
+                free(in);
+                return vdag_fail("rays: line %lu: expected 6 numbers 'ox oy oz dx dy dz'", lineno);
+            }
+            memcpy(&in[10 * n + k], &fv, 4);
+        }
+        if (strspn(p, " \t\r\n") != strlen(p)) {
+            free(in);
+            return vdag_fail("rays: line %lu: trailing text after 6 numbers", lineno);
+        }
+        for (k = 6; k < 9; k++) in[10 * n + k] = 0; /* t_min 0, t_max none, lod 0 */
+        in[10 * n + 9] = 1;                        /* the voxel index */
+        n++;
+    }
+    memset(&w, 0, sizeof w);
+    w.mode = VDAG_GPU_RAYS, w.count = n;
+    out = (uint32_t *)malloc(12 * sizeof *out * (n ? n : 1));
+    if (!out) rc = vdag_fail("rays: out of memory");
+    else if (vdag_gpu_open(&g, target, f->dag, vdag_cpu_count(), err, sizeof err)) rc = vdag_fail("rays --gpu: %s", err);
+    else {
+        if (n && vdag_gpu_run(g, &w, in, 10 * (size_t)n, out, 12 * (size_t)n, 1, NULL, err, sizeof err))
+            rc = vdag_fail("rays --gpu: %s", err);
+        vdag_gpu_close(g);
+    }
+    for (i = 0; !rc && i < n; i++) {
+        const uint32_t *h = out + 12 * i;
+        float t;
+        if (!h[0]) {
+            puts("miss");
+            continue;
+        }
+        memcpy(&t, &h[1], 4);
+        fputs("hit ", stdout);
+        print_double(t);
+        printf(" %u %u %u %d %d %d %llu %u %u %u\n", h[2], h[3], h[4], (int)h[5], (int)h[6], (int)h[7],
+               (unsigned long long)((uint64_t)h[10] << 32 | h[9]), h[11] & 0xFF, h[11] >> 8 & 0xFF, h[11] >> 16 & 0xFF);
+    }
+    free(in);
+    free(out);
+    return rc ? rc : fflush(stdout) ? vdag_fail("rays: write error") : 0;
+}
+
 int vdag_cmd_rays(int argc, char **argv) {
     vdag_file f;
     voxdag_ray_opts opts;
     char line[1024];
     unsigned long lineno = 0;
-    if (argc != 2) return vdag_fail("usage: vdag rays FILE  (rays 'ox oy oz dx dy dz' on stdin)");
+    if (argc == 3 && (!strcmp(argv[2], "--gpu") || !strcmp(argv[2], "--gpu-emulate"))) {
+        int rc;
+        if (!vdag_open(argv[1], &f)) return 1;
+        rc = gpu_rays(&f, !strcmp(argv[2], "--gpu") ? VDAG_GPU_GLSL : VDAG_GPU_EMULATE);
+        vdag_close(&f);
+        return rc;
+    }
+    if (argc != 2) return vdag_fail("usage: vdag rays FILE [--gpu | --gpu-emulate]  (rays 'ox oy oz dx dy dz' on stdin)");
     if (!vdag_open(argv[1], &f)) return 1;
     memset(&opts, 0, sizeof opts);
     opts.want_index = 1;
@@ -290,14 +364,49 @@ static int parse_size(const char *s, uint32_t *w, uint32_t *h) {
     return 1;
 }
 
+/* vdag render --gpu: the kernel's picture model (vdag_kernel.h) on the same
+   camera, in one run. */
+static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels, unsigned threads, int quiet) {
+    const camera *c = &job->cam;
+    vdag_gpu_work w;
+    vdag_gpu *g;
+    uint32_t *out, i;
+    double secs = 0, aspect = (double)c->w / c->h;
+    char err[256];
+    int k, rc = 0;
+    memset(&w, 0, sizeof w);
+    w.mode = VDAG_GPU_RENDER, w.count = c->w * c->h, w.width = c->w, w.height = c->h, w.shadows = job->shadows;
+    for (k = 0; k < 3; k++) {
+        w.eye[k] = (float)c->eye[k], w.f[k] = (float)c->f[k], w.light[k] = (float)c->light[k];
+        w.r[k] = (float)(c->r[k] * c->s * aspect), w.u[k] = (float)(c->u[k] * c->s);
+    }
+    w.lod = (float)(job->opts.lod_factor * lod_pixels), w.ambient = (float)AMBIENT;
+    w.inv_w = 1.0f / (float)c->w, w.inv_h = 1.0f / (float)c->h;
+    out = (uint32_t *)malloc(sizeof *out * w.count);
+    if (!out) return vdag_fail("render: out of memory");
+    if (vdag_gpu_open(&g, target, job->file->dag, threads, err, sizeof err)) {
+        free(out);
+        return vdag_fail("render --gpu: %s", err);
+    }
+    if (vdag_gpu_run(g, &w, NULL, 0, out, w.count, 1, &secs, err, sizeof err)) rc = vdag_fail("render --gpu: %s", err);
+    for (i = 0; !rc && i < w.count; i++)
+        for (k = 0; k < 3; k++) job->rgb[3 * (size_t)i + k] = (uint8_t)(out[i] >> (8 * k));
+    if (!rc && !quiet)
+        fprintf(stderr, "render: %ux%u on %s in %.3f s%s, %.2f Mrays/s\n", c->w, c->h, vdag_gpu_device(g), secs,
+                target == VDAG_GPU_EMULATE ? "" : " (GPU time)", (double)w.count / (secs > 0 ? secs : 1e-9) * 1e-6);
+    vdag_gpu_close(g);
+    free(out);
+    return rc;
+}
+
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet]";
+                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet] [--gpu | --gpu-emulate]";
     render_job job;
     vdag_file f;
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, cpu0, secs, cpu;
-    int have_eye = 0, have_target = 0, quiet = 0, i, k;
+    int have_eye = 0, have_target = 0, quiet = 0, gpu = -1, i, k;
     uint32_t box[6];
     unsigned threads, t;
     pthread_t tid[64];
@@ -328,10 +437,15 @@ int vdag_cmd_render(int argc, char **argv) {
             job.shadows = 1;
         } else if (!strcmp(a, "--quiet")) {
             quiet = 1;
+        } else if (!strcmp(a, "--gpu")) {
+            gpu = VDAG_GPU_GLSL;
+        } else if (!strcmp(a, "--gpu-emulate")) {
+            gpu = VDAG_GPU_EMULATE;
         } else {
             return vdag_fail("render: unknown option '%s' (%s)", a, usage);
         }
     }
+    if (gpu == VDAG_GPU_GLSL && threads_d > 0) return vdag_fail("render: --threads is for the CPU; --gpu takes none");
     {   /* the picture is a PNG: an OUT named otherwise would hold PNG bytes under another name */
         const char *slash = strrchr(argv[2], '/'), *dot = strrchr(slash ? slash : argv[2], '.');
         if (!dot || strlen(dot) != 4 || (dot[1] | 0x20) != 'p' || (dot[2] | 0x20) != 'n' || (dot[3] | 0x20) != 'g')
@@ -377,6 +491,14 @@ int vdag_cmd_render(int argc, char **argv) {
     if (!job.rgb) {
         vdag_close(&f);
         return vdag_fail("render: out of memory");
+    }
+    if (gpu >= 0) {
+        int rc = render_gpu(&job, (vdag_gpu_target)gpu, lod, threads_d > 0 ? (unsigned)threads_d : vdag_cpu_count(), quiet);
+        if (!rc && !write_png(argv[2], job.rgb, job.cam.w, job.cam.h))
+            rc = vdag_fail("render: cannot write %s (%s)", argv[2], errno ? strerror(errno) : "write error");
+        free(job.rgb);
+        vdag_close(&f);
+        return rc;
     }
     job.tiles_x = (job.cam.w + TILE - 1) / TILE;
     job.tiles = job.tiles_x * ((job.cam.h + TILE - 1) / TILE);

@@ -203,10 +203,13 @@ static const struct {
     {"lookup", "usage: vdag lookup FILE x y z\n"
                "Prints \"0\" when voxel (x, y, z) is empty, else \"1 INDEX R G B\". Coordinates are\n"
                "grid units: integers 0..2^L-1; a voxel outside the grid is an error (exit 1).\n"},
-    {"rays", "usage: vdag rays FILE\n"
+    {"rays", "usage: vdag rays FILE [--gpu | --gpu-emulate]\n"
              "Reads rays from stdin, one a line \"ox oy oz dx dy dz\" (numbers, grid units: the grid\n"
              "spans [0, 2^L)^3), prints a line a ray: \"miss\", or \"hit T X Y Z NX NY NZ INDEX R G B\"\n"
-             "(T: distance along the ray in units of |d|; N: the entry face normal).\n"},
+             "(T: distance along the ray in units of |d|; N: the entry face normal).\n"
+             "  --gpu          trace on the GPU through Vulkan (voxdag_gpu.h, float32: numbers are\n"
+             "                 rounded to float; answers differ from the exact ones only at near-ties)\n"
+             "  --gpu-emulate  the same float32 traversal compiled for the CPU (same answers as --gpu)\n"},
     {"render", "usage: vdag render FILE OUT.png [options]\n"
                "Ray traces a shaded picture, z up, into a PNG file: OUT must end in .png (any case),\n"
                "may not be FILE, and its folder must exist and be writable.\n"
@@ -218,7 +221,10 @@ static const struct {
                "  --shadows         shadows towards the light (default: off)\n"
                "  --lod PIXELS      stop at cells smaller than PIXELS pixels (default: 0, full detail)\n"
                "  --threads T       threads, 0..64, 0 = the processors online (default: 0)\n"
-               "  --quiet           no progress or timing on stderr\n"},
+               "  --quiet           no progress or timing on stderr\n"
+               "  --gpu             render on the GPU through Vulkan (voxdag_gpu.h, float32; every option\n"
+               "                    but --threads; level of detail by depth along the view axis)\n"
+               "  --gpu-emulate     the GPU picture computed on the CPU (the same pixels as --gpu)\n"},
     {"export-voxels", "usage: vdag export-voxels FILE\n"
                       "Prints every voxel as \"x y z r g b\" (grid units), in voxel-index order.\n"},
     {"gen", "usage: vdag gen demo OUT.xyz [--levels L]\n"
