@@ -92,7 +92,7 @@ $(STB_IMAGE):
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/gpu_oracle.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
 $(BUILD)/opt/examples/image_stb.o $(BUILD)/san/examples/image_stb.o: $(STB_IMAGE)
@@ -137,6 +137,14 @@ $(BUILD)/test_vk: tests/test_vk.c tests/tally.h examples/gpu_vulkan.c examples/g
                   $(if $(VULKAN),$(VK_SMOKE)) | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) $(VULKAN_CFLAGS) -I. -I$(BUILD)/shaders -o $@ tests/test_vk.c \
 	    examples/gpu_vulkan.c $(VULKAN_LIBS)
+
+# The GPU kernel on Vulkan (GLSL and HLSL builds) against its C build and
+# the library, sanitized.
+$(BUILD)/test_gpu_vk: tests/test_gpu_vk.c tests/gpu_oracle.h tests/rscene.h tests/golden.h tests/impl.c examples/gpu.c \
+                      examples/gpu.h examples/gpu_vulkan.c examples/gpu_vulkan.h examples/shaders/vdag_kernel.h $(HEADERS) \
+                      $(BUILD)/vulkan.flag $(if $(VULKAN),$(VDAG_KERNEL)) | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) $(VULKAN_CFLAGS) -I. -Itests -I$(BUILD)/shaders -o $@ tests/test_gpu_vk.c \
+	    tests/impl.c examples/gpu.c examples/gpu_vulkan.c -lm $(VULKAN_LIBS)
 
 # Fuzz targets, one per entry point that takes bytes (tests/fuzz_NAME.c):
 #   import     the scene importers (the first byte picks the format)
@@ -193,7 +201,7 @@ check-all:
 $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk \
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
                  $(if $(VULKAN),$(VK_SMOKE:.h=.spv))
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)

@@ -38,41 +38,36 @@ struct vdag_gpu {
     unsigned threads;
 };
 
-int vdag_gpu_open(vdag_gpu **out, vdag_gpu_target target, const voxdag *dag, unsigned threads, char *err,
-                  size_t err_size) {
-    vdag_gpu *g;
+int vdag_gpu_load(vdag_gpu *g, const voxdag *dag, char *err, size_t err_size) {
     size_t size;
     const void *img = voxdag_image(dag, &size);
+    uint32_t *words;
+    if ((uint64_t)size >= (uint64_t)1 << 32)
+        return snprintf(err, err_size, "the GPU traversal addresses files below 4 GiB; this one has %.1f GiB",
+                        (double)size / (1u << 30)), 1;
+    if (g->vk && ((uint64_t)size + 3) / 4 * 4 > vdag_vk_max_storage_buffer(g->vk))
+        return snprintf(err, err_size, "%s binds storage buffers of at most %llu MiB; this file needs %llu MiB",
+                        vdag_vk_device_name(g->vk), (unsigned long long)(vdag_vk_max_storage_buffer(g->vk) >> 20),
+                        (unsigned long long)(((uint64_t)size + (1u << 20) - 1) >> 20)), 1;
+    words = (uint32_t *)calloc(size ? (size + 3) / 4 : 1, 4);
+    if (!words) return snprintf(err, err_size, "out of memory"), 1;
+    memcpy(words, img, size); /* the file's little-endian words, as the GPU reads them */
+    free(g->image);
+    g->image = words, g->image_words = (size + 3) / 4;
+    g->buf.bytes = (const unsigned char *)img, g->buf.size = size;
+    return 0;
+}
+
+int vdag_gpu_open(vdag_gpu **out, vdag_gpu_target target, const voxdag *dag, unsigned threads, char *err,
+                  size_t err_size) {
+    vdag_gpu *g = (vdag_gpu *)calloc(1, sizeof *g);
     *out = NULL;
-    if ((uint64_t)size >= (uint64_t)1 << 32) {
-        snprintf(err, err_size, "the GPU traversal addresses files below 4 GiB; this one has %.1f GiB",
-                 (double)size / (1u << 30));
-        return 1;
-    }
-    g = (vdag_gpu *)calloc(1, sizeof *g);
     if (!g) return snprintf(err, err_size, "out of memory"), 1;
     g->target = target;
     g->threads = threads ? threads : 1;
-    g->image_words = (size + 3) / 4;
-    g->image = (uint32_t *)calloc(g->image_words ? g->image_words : 1, 4);
-    if (!g->image) {
-        free(g);
-        return snprintf(err, err_size, "out of memory"), 1;
-    }
-    memcpy(g->image, img, size); /* little-endian words on the GPU */
-    g->buf.bytes = (const unsigned char *)img, g->buf.size = size;
-    if (target != VDAG_GPU_EMULATE) {
-        if (vdag_vk_open(&g->vk, err, err_size)) {
-            vdag_gpu_close(g);
-            return 1;
-        }
-        if ((uint64_t)g->image_words * 4 > vdag_vk_max_storage_buffer(g->vk)) {
-            snprintf(err, err_size, "%s binds storage buffers of at most %llu MiB; this file needs %llu MiB",
-                     vdag_vk_device_name(g->vk), (unsigned long long)(vdag_vk_max_storage_buffer(g->vk) >> 20),
-                     (unsigned long long)(((uint64_t)g->image_words * 4 + (1u << 20) - 1) >> 20));
-            vdag_gpu_close(g);
-            return 1;
-        }
+    if ((target != VDAG_GPU_EMULATE && vdag_vk_open(&g->vk, err, err_size)) || vdag_gpu_load(g, dag, err, err_size)) {
+        vdag_gpu_close(g);
+        return 1;
     }
     *out = g;
     return 0;
@@ -189,6 +184,10 @@ int vdag_gpu_open(vdag_gpu **out, vdag_gpu_target target, const voxdag *dag, uns
     *out = NULL;
     snprintf(err, err_size, "this vdag was built with x87 maths, without the GPU path (build it with SSE maths)");
     return 1;
+}
+int vdag_gpu_load(vdag_gpu *g, const voxdag *dag, char *err, size_t err_size) {
+    (void)g, (void)dag;
+    return snprintf(err, err_size, "no GPU path in this build"), 1;
 }
 void vdag_gpu_close(vdag_gpu *g) { (void)g; }
 const char *vdag_gpu_device(const vdag_gpu *g) { return (void)g, ""; }

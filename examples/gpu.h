@@ -35,12 +35,14 @@ typedef struct vdag_gpu_work {
 
 typedef struct vdag_gpu vdag_gpu;
 
-/* Prepares DAG's image (padded to whole words) for TARGET. Returns 0, or
-   nonzero with one line in ERR: no Vulkan, a tool built without it, or a
-   file the device cannot bind (above its storage-buffer limit, or 4 GiB
-   and more). THREADS: the emulation's threads (0: one). */
+/* Opens TARGET (THREADS: the emulation's threads, 0: one) for DAG's image,
+   padded to whole words. Returns 0, or nonzero with one line in ERR: no
+   Vulkan, a tool built without it, or a file the device cannot bind (above
+   its storage-buffer limit, or 4 GiB and more). */
 int vdag_gpu_open(vdag_gpu **out, vdag_gpu_target target, const voxdag *dag, unsigned threads, char *err,
                   size_t err_size);
+/* Replaces the file (the device and its compiled kernel stay). */
+int vdag_gpu_load(vdag_gpu *g, const voxdag *dag, char *err, size_t err_size);
 void vdag_gpu_close(vdag_gpu *g);
 
 /* The device's name, and whether it is a CPU (lavapipe or the emulation). */

@@ -159,6 +159,17 @@ struct vdag_vk {
     uint32_t timestamp_bits; /* the queue family's timestampValidBits; 0: no timestamps */
     VkPhysicalDeviceProperties props;
     VkPhysicalDeviceMemoryProperties memory;
+    /* The pipeline of the last run, kept for the next one with the same
+       shader and interface (creating one compiles the shader). */
+    const uint32_t *cached_spirv;
+    size_t cached_bytes;
+    char cached_entry[64];
+    unsigned cached_count;
+    uint32_t cached_push;
+    VkShaderModule module;
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline pipeline;
 };
 
 static const char *vk_result_name(VkResult r) {
@@ -377,8 +388,11 @@ fail:
     return 1;
 }
 
+static void vk_pipeline_free(vdag_vk *vk);
+
 void vdag_vk_close(vdag_vk *vk) {
     if (!vk) return;
+    if (vk->device) vk_pipeline_free(vk);
     if (vk->device && vk->vkDestroyDevice) vk->vkDestroyDevice(vk->device, NULL);
     if (vk->instance && vk->vkDestroyInstance) vk->vkDestroyInstance(vk->instance, NULL);
     if (vk->lib) vk_lib_close(vk->lib);
@@ -402,10 +416,6 @@ typedef struct vk_run_state {
     VkBuffer buffer[VDAG_VK_MAX_BUFFERS];
     VkDeviceMemory memory[VDAG_VK_MAX_BUFFERS];
     void *mapped[VDAG_VK_MAX_BUFFERS];
-    VkShaderModule module;
-    VkDescriptorSetLayout set_layout;
-    VkPipelineLayout layout;
-    VkPipeline pipeline;
     VkDescriptorPool pool;
     VkQueryPool queries;
     VkCommandPool commands;
@@ -422,16 +432,23 @@ static void vk_run_free(vdag_vk *vk, vk_run_state *s) {
     if (s->commands) vk->vkDestroyCommandPool(d, s->commands, NULL);
     if (s->queries) vk->vkDestroyQueryPool(d, s->queries, NULL);
     if (s->pool) vk->vkDestroyDescriptorPool(d, s->pool, NULL);
-    if (s->pipeline) vk->vkDestroyPipeline(d, s->pipeline, NULL);
-    if (s->layout) vk->vkDestroyPipelineLayout(d, s->layout, NULL);
-    if (s->set_layout) vk->vkDestroyDescriptorSetLayout(d, s->set_layout, NULL);
-    if (s->module) vk->vkDestroyShaderModule(d, s->module, NULL);
     for (i = 0; i < VDAG_VK_MAX_BUFFERS; i++) {
         if (s->mapped[i]) vk->vkUnmapMemory(d, s->memory[i]);
         if (s->buffer[i]) vk->vkDestroyBuffer(d, s->buffer[i], NULL);
         if (s->memory[i]) vk->vkFreeMemory(d, s->memory[i], NULL);
     }
     free(s->stamps);
+}
+
+static void vk_pipeline_free(vdag_vk *vk) {
+    VkDevice d = vk->device;
+    if (vk->pipeline) vk->vkDestroyPipeline(d, vk->pipeline, NULL);
+    if (vk->layout) vk->vkDestroyPipelineLayout(d, vk->layout, NULL);
+    if (vk->set_layout) vk->vkDestroyDescriptorSetLayout(d, vk->set_layout, NULL);
+    if (vk->module) vk->vkDestroyShaderModule(d, vk->module, NULL);
+    vk->pipeline = VK_NULL_HANDLE, vk->layout = VK_NULL_HANDLE;
+    vk->set_layout = VK_NULL_HANDLE, vk->module = VK_NULL_HANDLE;
+    vk->cached_spirv = NULL;
 }
 
 /* 1 when SPIRV declares a compute entry point named ENTRY. Checked here
@@ -585,44 +602,53 @@ int vdag_vk_run(vdag_vk *vk, const uint32_t *spirv, size_t spirv_bytes, const ch
         memcpy(s.mapped[i], buffers[i].data, (size_t)buffers[i].size);
     }
 
-    memset(&smci, 0, sizeof smci);
-    smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
-    smci.codeSize = spirv_bytes;
-    smci.pCode = spirv;
-    VK_CHECK(vk->vkCreateShaderModule(d, &smci, NULL, &s.module), "vkCreateShaderModule");
+    if (vk->cached_spirv != spirv || vk->cached_bytes != spirv_bytes || strcmp(vk->cached_entry, entry) ||
+        vk->cached_count != count || vk->cached_push != push_bytes) {
+        vk_pipeline_free(vk);
+        memset(&smci, 0, sizeof smci);
+        smci.sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO;
+        smci.codeSize = spirv_bytes;
+        smci.pCode = spirv;
+        VK_CHECK(vk->vkCreateShaderModule(d, &smci, NULL, &vk->module), "vkCreateShaderModule");
 
-    memset(bindings, 0, sizeof bindings);
-    for (i = 0; i < count; i++) {
-        bindings[i].binding = i;
-        bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        bindings[i].descriptorCount = 1;
-        bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        memset(bindings, 0, sizeof bindings);
+        for (i = 0; i < count; i++) {
+            bindings[i].binding = i;
+            bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+            bindings[i].descriptorCount = 1;
+            bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        }
+        memset(&dslci, 0, sizeof dslci);
+        dslci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
+        dslci.bindingCount = count;
+        dslci.pBindings = bindings;
+        VK_CHECK(vk->vkCreateDescriptorSetLayout(d, &dslci, NULL, &vk->set_layout), "vkCreateDescriptorSetLayout");
+
+        memset(&range, 0, sizeof range);
+        range.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        range.size = push_bytes;
+        memset(&plci, 0, sizeof plci);
+        plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
+        plci.setLayoutCount = 1;
+        plci.pSetLayouts = &vk->set_layout;
+        plci.pushConstantRangeCount = push_bytes ? 1 : 0;
+        plci.pPushConstantRanges = &range;
+        VK_CHECK(vk->vkCreatePipelineLayout(d, &plci, NULL, &vk->layout), "vkCreatePipelineLayout");
+
+        memset(&cpci, 0, sizeof cpci);
+        cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
+        cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
+        cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+        cpci.stage.module = vk->module;
+        cpci.stage.pName = entry;
+        cpci.layout = vk->layout;
+        VK_CHECK(vk->vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cpci, NULL, &vk->pipeline), "vkCreateComputePipelines");
+        if (strlen(entry) < sizeof vk->cached_entry) { /* else never reused */
+            vk->cached_spirv = spirv, vk->cached_bytes = spirv_bytes, vk->cached_count = count;
+            vk->cached_push = push_bytes;
+            memcpy(vk->cached_entry, entry, strlen(entry) + 1);
+        }
     }
-    memset(&dslci, 0, sizeof dslci);
-    dslci.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO;
-    dslci.bindingCount = count;
-    dslci.pBindings = bindings;
-    VK_CHECK(vk->vkCreateDescriptorSetLayout(d, &dslci, NULL, &s.set_layout), "vkCreateDescriptorSetLayout");
-
-    memset(&range, 0, sizeof range);
-    range.stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-    range.size = push_bytes;
-    memset(&plci, 0, sizeof plci);
-    plci.sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO;
-    plci.setLayoutCount = 1;
-    plci.pSetLayouts = &s.set_layout;
-    plci.pushConstantRangeCount = push_bytes ? 1 : 0;
-    plci.pPushConstantRanges = &range;
-    VK_CHECK(vk->vkCreatePipelineLayout(d, &plci, NULL, &s.layout), "vkCreatePipelineLayout");
-
-    memset(&cpci, 0, sizeof cpci);
-    cpci.sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO;
-    cpci.stage.sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO;
-    cpci.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    cpci.stage.module = s.module;
-    cpci.stage.pName = entry;
-    cpci.layout = s.layout;
-    VK_CHECK(vk->vkCreateComputePipelines(d, VK_NULL_HANDLE, 1, &cpci, NULL, &s.pipeline), "vkCreateComputePipelines");
 
     pool_size.type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     pool_size.descriptorCount = count;
@@ -636,7 +662,7 @@ int vdag_vk_run(vdag_vk *vk, const uint32_t *spirv, size_t spirv_bytes, const ch
     dsai.sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO;
     dsai.descriptorPool = s.pool;
     dsai.descriptorSetCount = 1;
-    dsai.pSetLayouts = &s.set_layout;
+    dsai.pSetLayouts = &vk->set_layout;
     VK_CHECK(vk->vkAllocateDescriptorSets(d, &dsai, &set), "vkAllocateDescriptorSets");
     memset(writes, 0, sizeof writes);
     for (i = 0; i < count; i++) {
@@ -680,9 +706,9 @@ int vdag_vk_run(vdag_vk *vk, const uint32_t *spirv, size_t spirv_bytes, const ch
     cbbi.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
     VK_CHECK(vk->vkBeginCommandBuffer(cb, &cbbi), "vkBeginCommandBuffer");
     if (timed) vk->vkCmdResetQueryPool(cb, s.queries, 0, 2 * repeat);
-    vk->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s.pipeline);
-    vk->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s.layout, 0, 1, &set, 0, NULL);
-    if (push_bytes) vk->vkCmdPushConstants(cb, s.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
+    vk->vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, vk->pipeline);
+    vk->vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, vk->layout, 0, 1, &set, 0, NULL);
+    if (push_bytes) vk->vkCmdPushConstants(cb, vk->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, push_bytes, push);
     memset(&barrier, 0, sizeof barrier);
     barrier.sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER;
     for (k = 0; k < repeat; k++) {

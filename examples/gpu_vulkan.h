@@ -52,7 +52,9 @@ uint64_t vdag_vk_max_storage_buffer(const vdag_vk *vk);
    after the previous one's writes; *SECONDS (when not NULL) receives the GPU
    time of one dispatch from timestamp queries, the median over the repeats
    (0 when the queue has no timestamps). Returns 0, or nonzero with one line
-   in ERR. Sizes are checked before anything is created or any data is read:
+   in ERR. The pipeline is kept for the next run with the same SPIRV pointer,
+   size, entry, buffer count and push size (so SPIRV must not change while
+   VK is open). Sizes are checked before anything is created or any data is read:
    a buffer larger than vdag_vk_max_storage_buffer is refused naming both
    sizes in MiB, so a DATA of NULL is never touched then. */
 int vdag_vk_run(vdag_vk *vk, const uint32_t *spirv, size_t spirv_bytes, const char *entry,

@@ -39,6 +39,7 @@ run unit "$build/test" $unit_args
 run voxcolor-ndebug "$build/test_voxcolor_ndebug"
 run voxdag-ndebug "$build/test_voxdag_ndebug"
 run vulkan "$build/test_vk"
+run gpu "$build/test_gpu_vk"
 run spirv sh tests/spirv_check.sh "$build"
 run cli sh tests/cli.sh "$build/vdag"
 run third-party sh tests/third_party.sh "$build"

@@ -13,6 +13,7 @@
 #include "voxdag_gpu.h"
 #include "rscene.h"
 #include "golden.h"
+#include "gpu_oracle.h"
 
 #include <math.h>
 
@@ -79,45 +80,6 @@ static voxdag_gpu_buf gpu_buffer(const voxdag *d) {
     return buf;
 }
 
-static voxdag_gpu_ray gpu_ray(const voxdag_ray *ray, double lod, int want_index) {
-    voxdag_gpu_ray g;
-    g.ox = (float)ray->origin[0], g.oy = (float)ray->origin[1], g.oz = (float)ray->origin[2];
-    g.dx = (float)ray->dir[0], g.dy = (float)ray->dir[1], g.dz = (float)ray->dir[2];
-    g.t_min = (float)ray->t_min, g.t_max = (float)ray->t_max, g.lod = (float)lod;
-    g.flags = want_index ? VOXDAG_GPU_WANT_INDEX : 0u;
-    return g;
-}
-
-/* Whether the exact answer to RAY is G's (voxel, level, normal, index). */
-static int same_answer(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g) {
-    voxdag_ray_opts o;
-    voxdag_hit h;
-    int r;
-    memset(&o, 0, sizeof o);
-    o.want_index = 1, o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0;
-    r = voxdag_raycast(d, ray, &o, &h);
-    if (r != (int)g->hit) return 0;
-    return !r || (h.xyz[0] == g->x && h.xyz[1] == g->y && h.xyz[2] == g->z && h.level == g->level &&
-                  h.normal[0] == g->nx && h.normal[1] == g->ny && h.normal[2] == g->nz &&
-                  h.index == ((uint64_t)g->index_hi << 32 | g->index_lo));
-}
-
-/* A near-tie: the exact answer of RAY moved by EPS grid units along an axis,
-   or with a limit moved by EPS, is G's. */
-static int near_tie(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g, double eps) {
-    double m = fmax(fabs(ray->dir[0]), fmax(fabs(ray->dir[1]), fabs(ray->dir[2])));
-    int a, s;
-    for (a = 0; a < 5; a++)
-        for (s = -1; s <= 1; s += 2) {
-            voxdag_ray p = *ray;
-            if (a < 3) p.origin[a] += s * eps;
-            else if (a == 3) p.t_min += s * eps / m;
-            else if (p.t_max != HUGE_VAL) p.t_max += s * eps / m;
-            if (same_answer(d, &p, lod, g)) return 1;
-        }
-    return 0;
-}
-
 /* One ray, with and without level of detail, and as a shadow query. */
 static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, const voxdag_ray *ray, double lod,
                       gpu_stats *st) {
@@ -125,7 +87,7 @@ static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, co
     voxdag_gpu_hit g = voxdag_gpu_raycast(buf, f, gpu_ray(ray, lod, 1));
     double m = fmax(fabs(ray->dir[0]), fmax(fabs(ray->dir[1]), fabs(ray->dir[2]))), eps;
     voxdag_get_info(d, &info);
-    eps = ldexp((double)(1u << info.levels) + fabs(ray->origin[0]) + fabs(ray->origin[1]) + fabs(ray->origin[2]), -20);
+    eps = near_tie_eps(info.levels, ray->origin);
     st->rays++;
     st->hits += g.hit;
     st->lod_hits += g.hit && g.level < info.levels;
@@ -152,16 +114,6 @@ static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, co
         CHECK(occ == g.hit);
         if (occ != (unsigned)voxdag_occluded(d, ray)) CHECK(near_tie(d, ray, 0, &g, eps));
     }
-}
-
-/* A ray from make_ray with every component rounded to float (the GPU's input). */
-static voxdag_ray float_ray(uint64_t *r, uint32_t n) {
-    voxdag_ray ray = make_ray(r, n);
-    int a;
-    for (a = 0; a < 3; a++) ray.origin[a] = (float)ray.origin[a], ray.dir[a] = (float)ray.dir[a];
-    ray.t_min = (float)ray.t_min;
-    if (ray.t_max != HUGE_VAL) ray.t_max = (float)ray.t_max;
-    return ray;
 }
 
 static void check_file(const voxdag *d, const rscene *s, uint64_t seed, uint32_t rays, gpu_stats *st) {
@@ -208,28 +160,6 @@ static void check_file(const voxdag *d, const rscene *s, uint64_t seed, uint32_t
         check_ray(d, buf, f, &ray, 0, st);
         if (info.levels > 2) check_ray(d, buf, f, &ray, (float)rand_in(&r, 0.01, 0.6), st);
     }
-}
-
-/* D with a voxcolor section of its colours (max error E, page shift S). */
-static voxdag *with_voxcolor(const voxdag *d, double e, unsigned s) {
-    voxdag_info info;
-    voxcolor_encode_opts eo;
-    voxdag *v = NULL;
-    uint8_t *rgb, *stream;
-    size_t cap, len, i;
-    voxdag_get_info(d, &info);
-    rgb = (uint8_t *)malloc(3 * (size_t)info.voxels + 3);
-    for (i = 0; i < info.voxels; i++) voxdag_color(d, i, rgb + 3 * i);
-    cap = voxcolor_encode_bound((size_t)info.voxels);
-    stream = (uint8_t *)malloc(cap);
-    memset(&eo, 0, sizeof eo);
-    eo.max_error = e, eo.page_shift = s;
-    len = voxcolor_encode(stream, cap, rgb, (size_t)info.voxels, &eo, NULL);
-    CHECK(len > 0);
-    CHECK(voxdag_with_colors(d, VOXDAG_COLORS_VOXCOLOR, stream, len, &v, NULL) == VOXDAG_OK);
-    free(rgb);
-    free(stream);
-    return v;
 }
 
 static void report(const char *what, const gpu_stats *st) {
