@@ -52,11 +52,11 @@
    float32 rounding at the grid's scale (2^-24 relative: at 65536^3 about
    0.004 voxel near the far side).
 
-   C mode needs float arithmetic without excess precision or contraction:
-   it sets #pragma STDC FP_CONTRACT OFF (clang) and refuses x87 maths
-   (FLT_EVAL_METHOD != 0: compile with -msse2 -mfpmath=sse); GCC contracts
-   only under -ffp-contract=fast on FMA targets, where the few products
-   that feed a sum are kept apart.
+   C mode rounds every float operation to float as a GPU does: it sets
+   #pragma STDC FP_CONTRACT OFF (clang), keeps products that feed a sum
+   apart (GCC contracts under -ffp-contract=fast on FMA targets), and where
+   floats are evaluated wider (FLT_EVAL_METHOD 1 or 2: s390x, x87) stores
+   every result; it stops with #error where FLT_EVAL_METHOD is negative.
 */
 #ifndef VOXDAG_GPU_H
 #define VOXDAG_GPU_H
@@ -104,8 +104,8 @@
 #include <float.h>
 #include <stdint.h>
 #include <string.h>
-#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD != 0
-#error "voxdag_gpu.h: float arithmetic must round to float (FLT_EVAL_METHOD 0): compile with SSE maths (-msse2 -mfpmath=sse)"
+#if !defined(FLT_EVAL_METHOD) || FLT_EVAL_METHOD < 0
+#error "voxdag_gpu.h: float arithmetic of unknown precision (FLT_EVAL_METHOD < 0): the traversal's bits could differ from a GPU's"
 #endif
 #if defined(__clang__)
 #pragma STDC FP_CONTRACT OFF
@@ -161,20 +161,43 @@ VOXDAG_GPU_FUNC uint32_t voxdag_gpui_word(voxdag_gpu_buf buf, uint32_t i) {
         if (at + k < buf.size) v |= (uint32_t)buf.bytes[at + k] << (8 * k);
     return v;
 }
-/* A product kept apart from the sum it feeds (no contraction into an FMA,
-   whatever the compiler's default). */
+/* Float arithmetic rounded to float after every operation, as on a GPU. A
+   product that feeds a sum is stored first (never contracted into an FMA,
+   whatever the compiler's default). Where float expressions are evaluated
+   wider (FLT_EVAL_METHOD 1, s390x; 2, x87) every result is stored: one
+   rounding of the wider result, which for a sum, difference or product of
+   two floats is the float result (the wider format has over 2 * 24 + 2
+   bits), and the traversal has no denormals or overflows. */
 VOXDAG_GPU_FUNC float voxdag_gpui_mul_apart(float a, float b) {
     volatile float r = a * b;
     return r;
 }
+#if FLT_EVAL_METHOD == 0
+#define voxdag_gpui_add(a, b) ((a) + (b))
+#define voxdag_gpui_sub(a, b) ((a) - (b))
+#define voxdag_gpui_mul(a, b) ((a) * (b))
+#else
+VOXDAG_GPU_FUNC float voxdag_gpui_add(float a, float b) {
+    volatile float r = a + b;
+    return r;
+}
+VOXDAG_GPU_FUNC float voxdag_gpui_sub(float a, float b) {
+    volatile float r = a - b;
+    return r;
+}
+#define voxdag_gpui_mul voxdag_gpui_mul_apart
+#endif
 typedef struct voxdag_gpu_file voxdag_gpu_file;
 typedef struct voxdag_gpu_ray voxdag_gpu_ray;
 typedef struct voxdag_gpu_hit voxdag_gpu_hit;
 typedef struct voxdag_gpu_lookup_result voxdag_gpu_lookup_result;
 #endif
 
-#ifndef VOXDAG_GPU_C
+#ifndef VOXDAG_GPU_C /* precise: no contraction, no reassociation */
 #define voxdag_gpui_mul_apart(a, b) ((a) * (b))
+#define voxdag_gpui_add(a, b) ((a) + (b))
+#define voxdag_gpui_sub(a, b) ((a) - (b))
+#define voxdag_gpui_mul(a, b) ((a) * (b))
 #endif
 
 // -- Public types
@@ -580,8 +603,8 @@ VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, v
 // world occupancy to return to, which also give the voxel index at the hit.
 
 #define VOXDAG_GPU_MAX_LEVELS 21
-#define VOXDAG_GPUI_FAR 1.329228e36f   /* 2^120: the t of a plane never met */
-#define VOXDAG_GPUI_LIMIT 1.2676506e30f /* 2^100: t limits are clamped to it */
+#define VOXDAG_GPUI_FAR VOXDAG_GPU_BITS_FLOAT(0x7B800000u)   /* 2^120: the t of a plane never met */
+#define VOXDAG_GPUI_LIMIT VOXDAG_GPU_BITS_FLOAT(0x71800000u) /* 2^100: t limits are clamped to it */
 
 /* The reciprocal of D (2^-64 <= |D| <= 2^32): a first guess from the bits,
    then four Newton steps (relative error 12 %, 1.4e-2, 2e-4, 4e-8, then
@@ -591,8 +614,8 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_recip(voxdag_gpu_f32 d) {
     VOXDAG_GPU_PRECISE voxdag_gpu_f32 a = VOXDAG_GPU_BITS_FLOAT(bits & 0x7FFFFFFFu);
     VOXDAG_GPU_PRECISE voxdag_gpu_f32 r = VOXDAG_GPU_BITS_FLOAT(0x7EF311C3u - (bits & 0x7FFFFFFFu));
     for (k = 0u; k < 4u; k++) {
-        VOXDAG_GPU_PRECISE voxdag_gpu_f32 e = 2.0f - voxdag_gpui_mul_apart(a, r);
-        r = r * e;
+        VOXDAG_GPU_PRECISE voxdag_gpu_f32 e = voxdag_gpui_sub(2.0f, voxdag_gpui_mul_apart(a, r));
+        r = voxdag_gpui_mul(r, e);
     }
     return VOXDAG_GPU_BITS_FLOAT(VOXDAG_GPU_FLOAT_BITS(r) | (bits & 0x80000000u));
 }
@@ -639,8 +662,8 @@ VOXDAG_GPU_FUNC voxdag_gpui_axis voxdag_gpui_axis_setup(voxdag_gpu_f32 o, voxdag
         VOXDAG_GPU_PRECISE voxdag_gpu_f32 t0, t1;
         x.sgn = d > 0.0f ? 1 : -1;
         x.ix = voxdag_gpui_recip(d);
-        t0 = ((d > 0.0f ? lo : hi) - x.o) * x.ix;
-        t1 = ((d > 0.0f ? hi : lo) - x.o) * x.ix;
+        t0 = voxdag_gpui_mul(voxdag_gpui_sub(d > 0.0f ? lo : hi, x.o), x.ix);
+        t1 = voxdag_gpui_mul(voxdag_gpui_sub(d > 0.0f ? hi : lo, x.o), x.ix);
         x.t0 = t0, x.t1 = t1;
     }
     return x;
@@ -649,7 +672,7 @@ VOXDAG_GPU_FUNC voxdag_gpui_axis voxdag_gpui_axis_setup(voxdag_gpu_f32 o, voxdag
 /* The t at which axis X meets the plane at integer coordinate PLANE (FAR
    when it does not move along it). */
 VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_plane_t(voxdag_gpui_axis x, voxdag_gpu_u32 plane) {
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 t = (VOXDAG_GPU_F32(plane) - x.o) * x.ix;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 t = voxdag_gpui_mul(voxdag_gpui_sub(VOXDAG_GPU_F32(plane), x.o), x.ix);
     return x.sgn == 0 ? VOXDAG_GPUI_FAR : t;
 }
 
@@ -657,7 +680,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_plane_t(voxdag_gpui_axis x, voxdag_gp
    (TE, AE): 1 when the ray is past the mid plane MID by then. */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_upper(voxdag_gpui_axis x, voxdag_gpu_u32 mid, voxdag_gpu_f32 te,
                                                  voxdag_gpu_u32 ae, voxdag_gpu_u32 b) {
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 tm = (VOXDAG_GPU_F32(mid) - x.o) * x.ix;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 tm = voxdag_gpui_mul(voxdag_gpui_sub(VOXDAG_GPU_F32(mid), x.o), x.ix);
     voxdag_gpu_bool crossed = tm < te || (tm == te && b <= ae); /* b = ae: the box entered there */
     if (x.sgn == 0) return x.o >= VOXDAG_GPU_F32(mid) ? 1u : 0u;
     return (x.sgn > 0) == crossed ? 1u : 0u;
@@ -759,7 +782,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
             }
         }
         /* Cell c of level q is full: a hit, or go down into it. */
-        if (q == nl || VOXDAG_GPU_F32(1u << (nl - q)) < lod * te) {
+        if (q == nl || VOXDAG_GPU_F32(1u << (nl - q)) < voxdag_gpui_mul(lod, te)) {
             h.hit = 1u;
             if (any_hit) return h;
             h.t = te;

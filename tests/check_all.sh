@@ -159,6 +159,14 @@ for cc in $CCS $CXXS; do
     f=$(lang_flags $cc)
     job "alone $cc voxdag.h" ok "$cc $f $VOXDAG_WARN -fsyntax-only -I. $L/header_voxdag.c"
     job "alone $cc voxcolor.h" ok "$cc $f $CONV -fsyntax-only -I. $L/header_voxcolor.c"
+    for o in -O0 -O2; do
+        job "alone $cc $o voxdag_gpu.h (C mode)" ok "$cc $f $CONV $o -c -o /dev/null -I. $L/header_voxdag_gpu.c"
+    done
+done
+# The GPU header's C mode on the foreign compilers: x87 and s390x evaluate
+# floats wider (FLT_EVAL_METHOD 2 and 1), where it stores every result.
+for c in $MINGW $I686 $S390X; do
+    job "alone $c voxdag_gpu.h (C mode)" ok "$c $C99 $CONV -O2 -c -o /dev/null -I. $L/header_voxdag_gpu.c"
 done
 
 # Implementations: every compiler, -O0/-O2, with and without NDEBUG, default
@@ -374,6 +382,20 @@ for spec in $DET_BUILDS; do
          $run$D/vdag-$t build $D/scene-$t.xyz $D/scene-$t-e0.1.vdag --threads 1 --color-error 0.1 >/dev/null"
 done
 
+# The GPU traversal's C build under FMA contraction (clang and gcc, -mfma
+# -ffp-contract=fast): the same float bits as the plain build.
+if grep -q -w fma /proc/cpuinfo 2>/dev/null; then
+    for cc in $CCS; do
+        job "gpu header: $cc -O2 -mfma -ffp-contract=fast answers equal the plain build's" ok \
+            "$cc -std=gnu99 -O2 -I. -o $D/answers-plain-$cc tests/platform_answers.c -pthread -lm
+             $cc -std=gnu99 -O2 -mfma -ffp-contract=fast -I. -o $D/answers-fma-$cc tests/platform_answers.c -pthread -lm
+             $D/answers-plain-$cc | grep 'gpu ray' >$D/answers-plain-$cc.txt
+             $D/answers-fma-$cc | grep 'gpu ray' >$D/answers-fma-$cc.txt
+             test \$(wc -l <$D/answers-plain-$cc.txt) -gt 10000
+             cmp $D/answers-plain-$cc.txt $D/answers-fma-$cc.txt"
+    done
+fi
+
 # -- Portability matrix: the portable unit tests and the platform answers on
 # each foreign target. On Wine every portable test but the two slowest; under
 # qemu (20-30 times slower) the format, query, codec and ray conventions
@@ -382,14 +404,15 @@ done
 # tests/platform_answers.c.
 M=$out/matrix
 mkdir -p "$M"
-PORTABLE_SRC="tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_format.c tests/test_raytrace.c tests/test_voxelize.c tests/test_no_voxcolor.c"
+PORTABLE_SRC="tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_format.c tests/test_raytrace.c tests/test_gpu.c tests/test_voxelize.c tests/test_no_voxcolor.c"
 PORTABLE="$C99 -O2 -DTEST_PORTABLE -I. -o"
 SEL_QEMU="format/golden format/offsets format/header format/limits format/hostile format/version3 format/save
           format/build_allocation voxcolor/golden voxcolor/lossless voxcolor/handmade voxcolor/rejects
           voxcolor/wide voxcolor/empty voxcolor/morton2d voxcolor/error_offsets voxcolor/deterministic
           voxcolor/invalid voxcolor/cielab raytrace_conventions core/streaming core/color_sink
-          core/bad_arguments core/build_limits voxelize/face_plane voxelize/bad_meshes"
-SEL_WINE="format/ voxcolor/ raytrace voxelize/ core/mirrored core/determinism core/thread_pool core/streaming
+          core/bad_arguments core/build_limits voxelize/face_plane voxelize/bad_meshes gpu/transforms gpu/golden
+          gpu/domain"
+SEL_WINE="format/ voxcolor/ raytrace gpu/ voxelize/ core/mirrored core/determinism core/thread_pool core/streaming
           core/color_sink core/load_roundtrip core/bad_arguments core/allocation core/build_limits"
 SEL_QEMU=$(echo $SEL_QEMU) # one line each in the job scripts
 SEL_WINE=$(echo $SEL_WINE)

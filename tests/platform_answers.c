@@ -11,7 +11,9 @@
    - rays (full-precision random origins and directions, axis-aligned rays
      through faces, edges and corners, level of detail, tiny and huge
      coordinates): hit or miss, t as a hexadecimal float, voxel, normal,
-     level, index, and the shadow query. Every t is printed bit for bit.
+     level, index, and the shadow query. Every t is printed bit for bit;
+   - the same rays rounded to float through voxdag_gpu.h's C build (the GPU
+     traversal), its t as the float's bits.
    Usage: platform_answers [DATA_DIR] (default tests/data). */
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,6 +23,7 @@
 #include "voxdag.h"
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
+#include "voxdag_gpu.h"
 
 static const char *const goldens[] = {"brick_root_l2", "empty_l2", "empty_l5", "mirrored_blob_l5", "one_voxel",
                                       "svdag_l5"};
@@ -133,6 +136,25 @@ static void print_ray(const char *name, unsigned i, const voxdag *d, const voxda
                (unsigned long long)hit.index, occ);
     else
         printf("%s ray %u: miss occluded %d\n", name, i, occ);
+    {
+        size_t size;
+        voxdag_gpu_buf buf;
+        voxdag_gpu_file f;
+        voxdag_gpu_ray g;
+        voxdag_gpu_hit h;
+        uint32_t t;
+        buf.bytes = (const unsigned char *)voxdag_image(d, &size), buf.size = size;
+        f = voxdag_gpu_open(buf, 0);
+        g.ox = (float)r->origin[0], g.oy = (float)r->origin[1], g.oz = (float)r->origin[2];
+        g.dx = (float)r->dir[0], g.dy = (float)r->dir[1], g.dz = (float)r->dir[2];
+        g.t_min = (float)r->t_min, g.t_max = (float)r->t_max;
+        g.lod = o ? (float)(o->lod_factor * o->lod_pixels) : 0, g.flags = VOXDAG_GPU_WANT_INDEX;
+        h = voxdag_gpu_raycast(buf, f, g);
+        memcpy(&t, &h.t, 4);
+        printf("%s gpu ray %u: hit %u t %08lx voxel %u %u %u normal %d %d %d level %u index %llu occluded %u\n", name,
+               i, h.hit, (unsigned long)t, h.x, h.y, h.z, (int)h.nx, (int)h.ny, (int)h.nz, h.level,
+               (unsigned long long)((uint64_t)h.index_hi << 32 | h.index_lo), voxdag_gpu_occluded(buf, f, g));
+    }
 }
 
 /* COUNT random rays into DAG, then axis-aligned rays from integer and

@@ -53,37 +53,41 @@ VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_rgb(voxdag_gpu_buf buf, voxdag_gpu_fi
 
 /* Channel C of RGB times FACTOR, rounded and clamped. */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_shade(voxdag_gpu_u32 rgb, voxdag_gpu_u32 c, voxdag_gpu_f32 factor) {
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 v = voxdag_gpui_mul_apart(VOXDAG_GPU_F32(rgb >> (8u * c) & 0xFFu), factor) + 0.5f;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 v = voxdag_gpui_add(voxdag_gpui_mul_apart(VOXDAG_GPU_F32(rgb >> (8u * c) & 0xFFu), factor), 0.5f);
     return v >= 255.0f ? 255u : VOXDAG_GPU_U32(v);
 }
 
 VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_pixel(voxdag_gpu_buf buf, voxdag_gpu_file f, vdag_kernel_params p,
                                                  voxdag_gpu_u32 x, voxdag_gpu_u32 y) {
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 sx = voxdag_gpui_mul_apart(VOXDAG_GPU_F32(2u * x + 1u), p.inv_w) - 1.0f;
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 sy = 1.0f - voxdag_gpui_mul_apart(VOXDAG_GPU_F32(2u * y + 1u), p.inv_h);
-    VOXDAG_GPU_PRECISE voxdag_gpu_f32 factor = 1.0f, lit = 0.0f;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 sx = voxdag_gpui_sub(voxdag_gpui_mul_apart(VOXDAG_GPU_F32(2u * x + 1u), p.inv_w), 1.0f);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 sy = voxdag_gpui_sub(1.0f, voxdag_gpui_mul_apart(VOXDAG_GPU_F32(2u * y + 1u), p.inv_h));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 dx = voxdag_gpui_add(voxdag_gpui_add(p.f_x, voxdag_gpui_mul_apart(sx, p.r_x)), voxdag_gpui_mul_apart(sy, p.u_x));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 dy = voxdag_gpui_add(voxdag_gpui_add(p.f_y, voxdag_gpui_mul_apart(sx, p.r_y)), voxdag_gpui_mul_apart(sy, p.u_y));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 dz = voxdag_gpui_add(voxdag_gpui_add(p.f_z, voxdag_gpui_mul_apart(sx, p.r_z)), voxdag_gpui_mul_apart(sy, p.u_z));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 factor = 1.0f, lit = 0.0f, sox, soy, soz;
     voxdag_gpu_ray ray;
     voxdag_gpu_hit h;
     voxdag_gpu_u32 rgb;
     ray.ox = p.eye_x, ray.oy = p.eye_y, ray.oz = p.eye_z;
-    ray.dx = p.f_x + voxdag_gpui_mul_apart(sx, p.r_x) + voxdag_gpui_mul_apart(sy, p.u_x);
-    ray.dy = p.f_y + voxdag_gpui_mul_apart(sx, p.r_y) + voxdag_gpui_mul_apart(sy, p.u_y);
-    ray.dz = p.f_z + voxdag_gpui_mul_apart(sx, p.r_z) + voxdag_gpui_mul_apart(sy, p.u_z);
+    ray.dx = dx, ray.dy = dy, ray.dz = dz;
     ray.t_min = 0.0f, ray.t_max = 0.0f, ray.lod = p.lod, ray.flags = VOXDAG_GPU_WANT_INDEX;
     h = voxdag_gpu_raycast(buf, f, ray);
     if (h.hit == 0u) return VDAG_KERNEL_BACKGROUND;
     rgb = vdag_kernel_rgb(buf, f, h.index_lo, h.index_hi);
     if (h.nx != 0 || h.ny != 0 || h.nz != 0) {
         lit = h.nx != 0 ? VOXDAG_GPU_F32(h.nx) * p.l_x : h.ny != 0 ? VOXDAG_GPU_F32(h.ny) * p.l_y : VOXDAG_GPU_F32(h.nz) * p.l_z;
-        factor = lit > 0.0f ? p.ambient + voxdag_gpui_mul_apart(1.0f - p.ambient, lit) : p.ambient;
+        factor = lit > 0.0f ? voxdag_gpui_add(p.ambient, voxdag_gpui_mul_apart(voxdag_gpui_sub(1.0f, p.ambient), lit)) : p.ambient;
         if ((p.flags & VDAG_KERNEL_SHADOWS) != 0u && lit > 0.0f) {
             /* from the hit point, exactly on the face plane (then it starts in
                the neighbouring voxel), towards the light */
             voxdag_gpu_ray s;
             voxdag_gpu_u32 side = 1u << (f.levels - h.level);
-            s.ox = h.nx != 0 ? VOXDAG_GPU_F32(h.x + (h.nx > 0 ? side : 0u)) : ray.ox + voxdag_gpui_mul_apart(h.t, ray.dx);
-            s.oy = h.ny != 0 ? VOXDAG_GPU_F32(h.y + (h.ny > 0 ? side : 0u)) : ray.oy + voxdag_gpui_mul_apart(h.t, ray.dy);
-            s.oz = h.nz != 0 ? VOXDAG_GPU_F32(h.z + (h.nz > 0 ? side : 0u)) : ray.oz + voxdag_gpui_mul_apart(h.t, ray.dz);
+            sox = voxdag_gpui_add(ray.ox, voxdag_gpui_mul_apart(h.t, dx));
+            soy = voxdag_gpui_add(ray.oy, voxdag_gpui_mul_apart(h.t, dy));
+            soz = voxdag_gpui_add(ray.oz, voxdag_gpui_mul_apart(h.t, dz));
+            s.ox = h.nx != 0 ? VOXDAG_GPU_F32(h.x + (h.nx > 0 ? side : 0u)) : sox;
+            s.oy = h.ny != 0 ? VOXDAG_GPU_F32(h.y + (h.ny > 0 ? side : 0u)) : soy;
+            s.oz = h.nz != 0 ? VOXDAG_GPU_F32(h.z + (h.nz > 0 ? side : 0u)) : soz;
             s.dx = p.l_x, s.dy = p.l_y, s.dz = p.l_z;
             s.t_min = 0.0f, s.t_max = 0.0f, s.lod = 0.0f, s.flags = 0u;
             if (voxdag_gpu_occluded(buf, f, s) != 0u) factor = p.ambient;
