@@ -75,6 +75,28 @@ $$(BUILD)/shaders/%_hlsl.h $$(BUILD)/shaders/%_hlsl.spv: $(1)/%.hlsl $$(SHADER_D
 	$$(GLSLANG) -D -e main -S comp --vn $$*_hlsl -o $$(BUILD)/shaders/$$*_hlsl.h $$<
 	$$(GLSLANG) -D -e main -S comp -o $$(BUILD)/shaders/$$*_hlsl.spv $$< >/dev/null
 endef
+# README.md's shader code (the ```glsl and ```hlsl blocks of "Rendering on
+# the GPU") compiled as fragment shaders, checked by tests/spirv_check.sh.
+$(BUILD)/shaders/readme_glsl_frag.spv: README.md voxdag_gpu.h
+	@mkdir -p $(@D)
+	@awk '/^```glsl$$/ { c = 1; next } /^```/ { c = 0 } c' README.md >$(BUILD)/shaders/readme.frag
+	@test -s $(BUILD)/shaders/readme.frag
+	@printf '%s\n' 'layout(location = 0) out vec4 colour;' \
+	    'void main() { colour = vec4(shade(vec3(gl_FragCoord.xy, -9.0), vec3(0.1, 0.2, 1.0)), 1.0); }' >>$(BUILD)/shaders/readme.frag
+	$(GLSLANG) -S frag -o $@ $(BUILD)/shaders/readme.frag >/dev/null
+$(BUILD)/shaders/readme_hlsl_frag.spv: README.md voxdag_gpu.h
+	@mkdir -p $(@D)
+	@awk '/^```hlsl$$/ { c = 1; next } /^```/ { c = 0 } c' README.md >$(BUILD)/shaders/readme_frag.hlsl
+	@test -s $(BUILD)/shaders/readme_frag.hlsl
+	@printf '%s\n' 'float4 main(float4 pos : SV_Position) : SV_Target {' \
+	    '    voxdag_gpu_file f = voxdag_gpu_open(0u, 0u);' \
+	    '    voxdag_gpu_ray r; r.ox = pos.x; r.oy = pos.y; r.oz = -9.0; r.dx = 0.1; r.dy = 0.2; r.dz = 1.0;' \
+	    '    r.t_min = 0.0; r.t_max = 0.0; r.lod = 0.0; r.flags = VOXDAG_GPU_WANT_INDEX;' \
+	    '    voxdag_gpu_hit h = voxdag_gpu_raycast(0u, f, r);' \
+	    '    uint rgb = h.hit != 0u ? voxdag_gpu_color(0u, f, h.index_lo, h.index_hi) : 0u;' \
+	    '    return float4(rgb & 255u, rgb >> 8 & 255u, rgb >> 16 & 255u, 255.0) / 255.0;' '}' >>$(BUILD)/shaders/readme_frag.hlsl
+	$(GLSLANG) -D -e main -S frag -o $@ $(BUILD)/shaders/readme_frag.hlsl >/dev/null
+README_SHADERS := $(BUILD)/shaders/readme_glsl_frag.spv $(BUILD)/shaders/readme_hlsl_frag.spv
 $(eval $(call shader_rules,examples/shaders))
 $(eval $(call shader_rules,tests/shaders))
 
@@ -202,7 +224,7 @@ $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scen
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
 
 TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
-                 $(if $(VULKAN),$(VK_SMOKE:.h=.spv))
+                 $(if $(VULKAN),$(VK_SMOKE:.h=.spv) $(VDAG_KERNEL:.h=.spv) $(README_SHADERS))
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)
 
