@@ -157,6 +157,10 @@ VOXDAG_GPU_FUNC uint32_t voxdag_gpui_msb(uint32_t x) { /* X > 0 */
 VOXDAG_GPU_FUNC uint32_t voxdag_gpui_word(voxdag_gpu_buf buf, uint32_t i) {
     uint64_t at = (uint64_t)i * 4;
     uint32_t v = 0, k;
+    if (at + 4 <= buf.size) {
+        const unsigned char *b = buf.bytes + at;
+        return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+    }
     for (k = 0; k < 4; k++)
         if (at + k < buf.size) v |= (uint32_t)buf.bytes[at + k] << (8 * k);
     return v;
@@ -425,6 +429,14 @@ VOXDAG_GPU_FUNC voxdag_gpui_level voxdag_gpui_level_at(voxdag_gpu_buf buf, voxda
     return lv;
 }
 
+/* Where level L's records start, and its count bits C: one word each. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_level_data(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l) {
+    return f.nodes + voxdag_gpui_word(buf, (f.level_table + 80u * l) >> 2);
+}
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_level_count_bits(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l) {
+    return voxdag_gpui_word(buf, ((f.level_table + 80u * l) >> 2) + 5u) & 0xFFu;
+}
+
 /* The bit where the pointer of stored octant S starts in a record with
    HEADER (S = 8: the record's size in bits): count, base, then the lower
    octants' pointers. */
@@ -507,27 +519,77 @@ VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_stored_count(voxdag_gpu_buf buf, vo
         voxdag_gpui_mask m = voxdag_gpui_brick(buf, f, at);
         c.lo = voxdag_gpui_popcount(m.lo) + voxdag_gpui_popcount(m.hi), c.hi = 0u;
     } else {
-        voxdag_gpui_level lv = voxdag_gpui_level_at(buf, f, l);
-        voxdag_gpu_u32 n = lv.count_bits;
-        c.lo = voxdag_gpui_bits(buf, lv.data + at, 16u, n < 32u ? n : 32u);
-        c.hi = n > 32u ? voxdag_gpui_bits(buf, lv.data + at, 48u, n - 32u) : 0u;
+        voxdag_gpu_u32 n = voxdag_gpui_level_count_bits(buf, f, l), rec = voxdag_gpui_level_data(buf, f, l) + at;
+        c.lo = voxdag_gpui_bits(buf, rec, 16u, n < 32u ? n : 32u);
+        c.hi = n > 32u ? voxdag_gpui_bits(buf, rec, 48u, n - 32u) : 0u;
     }
     return c;
 }
 
+/* A pass over a record's children in stored octant order: each pointer
+   starts where the previous one ends, each private child after the
+   previous one, so every child costs one step. */
+struct voxdag_gpui_walk {
+    voxdag_gpu_u32 bit, priv, privs, child; /* child: the last step's offset (or brick index) */
+};
+#ifdef VOXDAG_GPU_C
+typedef struct voxdag_gpui_walk voxdag_gpui_walk;
+#endif
+
+VOXDAG_GPU_FUNC voxdag_gpui_walk voxdag_gpui_walk_start(voxdag_gpu_buf buf, voxdag_gpui_level lv, voxdag_gpu_u32 rec,
+                                                        voxdag_gpu_u32 header) {
+    voxdag_gpui_walk w;
+    w.bit = 16u + lv.count_bits, w.priv = 0u, w.privs = 0u, w.child = 0u;
+    if ((header & header >> 1 & 0x5555u) != 0u && lv.private_children != 0u) {
+        w.priv = voxdag_gpui_bits(buf, rec, w.bit, lv.base_bits < 32u ? lv.base_bits : 32u);
+        w.bit += lv.base_bits;
+    }
+    return w;
+}
+
+/* The child of present stored octant S, after the walk's lower octants. */
+VOXDAG_GPU_FUNC voxdag_gpui_walk voxdag_gpui_walk_step(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
+                                                       voxdag_gpui_level lv, voxdag_gpu_u32 rec, voxdag_gpu_u32 header,
+                                                       voxdag_gpu_u32 s, voxdag_gpui_walk w) {
+    voxdag_gpu_u32 tag = header >> (2u * s) & 3u;
+    if (tag == 3u && lv.private_children != 0u) {
+        if (w.privs > 0u) {
+            if (l + 3u < f.levels) {
+                voxdag_gpui_level next = voxdag_gpui_level_at(buf, f, l + 1u);
+                w.priv += (voxdag_gpui_child_bit(next, voxdag_gpui_u16(buf, next.data + w.priv), 8u) + 7u) >> 3;
+            } else {
+                w.priv++;
+            }
+        }
+        w.privs++;
+        w.child = w.priv;
+    } else {
+        voxdag_gpu_u32 k = tag == 1u ? lv.k1 : tag == 2u ? lv.k2 : lv.k3;
+        voxdag_gpu_u32 width = tag == 1u ? lv.w1 : tag == 2u ? lv.w2 : lv.w3;
+        w.child = voxdag_gpui_bits(buf, rec, w.bit + k, width - k < 32u ? width - k : 32u);
+        w.bit += width;
+    }
+    return w;
+}
+
 /* Voxels below the node at byte AT of level L (or brick AT): stored, or the
-   sum of its children's (C = 0). */
+   sum of its children's (C = 0), which their level stores. */
 VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_count(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
                                                    voxdag_gpu_u32 at) {
     voxdag_gpui_mask sum;
-    voxdag_gpu_u32 header, set, s;
-    if (l + 2u == f.levels || voxdag_gpui_level_at(buf, f, l).count_bits != 0u) return voxdag_gpui_stored_count(buf, f, l, at);
-    header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at);
-    set = voxdag_gpui_presence(header);
+    voxdag_gpui_level lv;
+    voxdag_gpui_walk w;
+    voxdag_gpu_u32 header, s;
+    if (l + 2u == f.levels || voxdag_gpui_level_count_bits(buf, f, l) != 0u) return voxdag_gpui_stored_count(buf, f, l, at);
+    lv = voxdag_gpui_level_at(buf, f, l);
+    header = voxdag_gpui_u16(buf, lv.data + at);
+    w = voxdag_gpui_walk_start(buf, lv, lv.data + at, header);
     sum.lo = 0u, sum.hi = 0u;
     for (s = 0u; s < 8u; s++)
-        if ((set >> s & 1u) != 0u) {
-            voxdag_gpui_mask c = voxdag_gpui_stored_count(buf, f, l + 1u, voxdag_gpui_child(buf, f, l, at, header, s).at);
+        if ((header >> (2u * s) & 3u) != 0u) {
+            voxdag_gpui_mask c;
+            w = voxdag_gpui_walk_step(buf, f, l, lv, lv.data + at, header, s, w);
+            c = voxdag_gpui_stored_count(buf, f, l + 1u, w.child);
             sum = voxdag_gpui_add64(sum, c.lo, c.hi);
         }
     return sum;
@@ -538,16 +600,21 @@ VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_count(voxdag_gpu_buf buf, voxdag_gp
 VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_preceding(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 l,
                                                        voxdag_gpu_u32 at, voxdag_gpu_u32 header, voxdag_gpu_u32 mi,
                                                        voxdag_gpu_u32 w) {
+    voxdag_gpui_level lv = voxdag_gpui_level_at(buf, f, l);
+    voxdag_gpui_walk walk = voxdag_gpui_walk_start(buf, lv, lv.data + at, header);
     voxdag_gpui_mask sum;
-    voxdag_gpu_u32 present = voxdag_gpui_presence(header), j;
+    voxdag_gpu_u32 set = 0u, j, s;
+    for (j = 0u; j < w; j++) set |= 1u << voxdag_gpui_act(mi, j); /* the stored octants before W */
+    set &= voxdag_gpui_presence(header);
     sum.lo = 0u, sum.hi = 0u;
-    for (j = 0u; j < w; j++) {
-        voxdag_gpu_u32 s = voxdag_gpui_act(mi, j);
-        if ((present >> s & 1u) != 0u) {
-            voxdag_gpui_mask c = voxdag_gpui_count(buf, f, l + 1u, voxdag_gpui_child(buf, f, l, at, header, s).at);
-            sum = voxdag_gpui_add64(sum, c.lo, c.hi);
+    for (s = 0u; (set >> s) != 0u; s++)
+        if ((header >> (2u * s) & 3u) != 0u) {
+            walk = voxdag_gpui_walk_step(buf, f, l, lv, lv.data + at, header, s, walk);
+            if ((set >> s & 1u) != 0u) {
+                voxdag_gpui_mask c = voxdag_gpui_count(buf, f, l + 1u, walk.child);
+                sum = voxdag_gpui_add64(sum, c.lo, c.hi);
+            }
         }
-    }
     return sum;
 }
 
@@ -574,7 +641,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, v
     if (f.levels == 0u || (f.voxels_lo | f.voxels_hi) == 0u || ((x | y | z) >> f.levels) != 0u) return r;
     for (l = 0u; l + 2u < f.levels; l++) {
         voxdag_gpu_u32 sh = f.levels - 1u - l, w = (x >> sh & 1u) | (y >> sh & 1u) << 1 | (z >> sh & 1u) << 2;
-        voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at), s = voxdag_gpui_act(mi, w);
+        voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_data(buf, f, l) + at), s = voxdag_gpui_act(mi, w);
         voxdag_gpui_ref ref;
         if ((header >> (2u * s) & 3u) == 0u) return r;
         m = voxdag_gpui_preceding(buf, f, l, at, header, mi, w);
@@ -731,7 +798,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
         /* Enter node l, cell c of level q = l: its occupancy in world order. */
         voxdag_gpu_u32 sh = nl - q - 1u;
         if (l < bl) {
-            header = voxdag_gpui_u16(buf, voxdag_gpui_level_at(buf, f, l).data + at);
+            header = voxdag_gpui_u16(buf, voxdag_gpui_level_data(buf, f, l) + at);
             occ = voxdag_gpui_bytes_to_world(voxdag_gpui_presence(header), mi) & 0xFFu;
             fr_at[l] = at;
             fr_info[l] = header | mi << 16 | occ << 24;
