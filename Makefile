@@ -114,7 +114,7 @@ $(STB_IMAGE):
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/gpu_oracle.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/gpu_oracle.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h examples/shaders/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
 $(BUILD)/opt/examples/image_stb.o $(BUILD)/san/examples/image_stb.o: $(STB_IMAGE)

@@ -195,6 +195,7 @@ typedef struct voxdag_gpu_file voxdag_gpu_file;
 typedef struct voxdag_gpu_ray voxdag_gpu_ray;
 typedef struct voxdag_gpu_hit voxdag_gpu_hit;
 typedef struct voxdag_gpu_lookup_result voxdag_gpu_lookup_result;
+typedef struct voxdag_gpu_frustum voxdag_gpu_frustum;
 #endif
 
 #ifndef VOXDAG_GPU_C /* precise: no contraction, no reassociation */
@@ -889,6 +890,134 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpu_raycast(voxdag_gpu_buf buf, voxdag_gpu
 /* Whether any full voxel lies along RAY (level of detail ignored): 1 or 0. */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_occluded(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray) {
     return voxdag_gpui_trace(buf, f, ray, VOXDAG_GPUI_TRUE).hit;
+}
+
+// -- Frustum depth (beams)
+//
+// A lower bound of the depth at which any ray of a frustum (a block of
+// pixels) meets a full voxel: a depth-first walk, nearest octant first, of
+// the cells that the frustum's four side planes do not exclude, pruned by
+// the best depth so far. A full cell becomes a candidate at its nearest
+// corner once it is no wider than the frustum (WIDTH times its far depth) or
+// than a level-of-detail cell there, and bricks are tested voxel by voxel,
+// so the bound never passes a voxel (or level-of-detail cell) that a ray of
+// the frustum would hit. Rays started there (t_min) give the same answers.
+// The bound is conservative, not bit-exact: its arithmetic is not marked
+// precise (glslang's precise analysis of this walk takes minutes and
+// gigabytes), and its margins cover any contraction.
+
+#define VOXDAG_GPUI_STACK (7u * VOXDAG_GPU_MAX_LEVELS + 1u)
+
+/* Apex o, unit view axis f (depth is f . (p - o)), and inward normals of
+   the four side planes through o; width: the frustum's side per unit of
+   depth; lod as voxdag_gpu_ray's. */
+struct voxdag_gpu_frustum {
+    voxdag_gpu_f32 ox, oy, oz, fx, fy, fz, lod, width;
+    voxdag_gpu_f32 n0x, n0y, n0z, n1x, n1y, n1z, n2x, n2y, n2z, n3x, n3y, n3z;
+};
+
+/* A . B for (AX, AY, AZ) and a box corner chosen per axis. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_dot(voxdag_gpu_f32 ax, voxdag_gpu_f32 ay, voxdag_gpu_f32 az, voxdag_gpu_f32 bx,
+                                               voxdag_gpu_f32 by, voxdag_gpu_f32 bz) {
+    voxdag_gpu_f32 d =
+        voxdag_gpui_add(voxdag_gpui_add(voxdag_gpui_mul_apart(ax, bx), voxdag_gpui_mul_apart(ay, by)), voxdag_gpui_mul_apart(az, bz));
+    return d;
+}
+
+/* The largest N . (p - o) over the box [LO, LO + S)^3 (relative to o: X, Y, Z). */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_box_max(voxdag_gpu_f32 nx, voxdag_gpu_f32 ny, voxdag_gpu_f32 nz, voxdag_gpu_f32 x,
+                                                   voxdag_gpu_f32 y, voxdag_gpu_f32 z, voxdag_gpu_f32 s) {
+    return voxdag_gpui_dot(nx, ny, nz, nx > 0.0f ? voxdag_gpui_add(x, s) : x, ny > 0.0f ? voxdag_gpui_add(y, s) : y,
+                           nz > 0.0f ? voxdag_gpui_add(z, s) : z);
+}
+
+/* Whether box (X, Y, Z) + [0, S)^3 relative to the apex may meet the
+   frustum: on the inner side of every plane within MARGIN, not behind. */
+VOXDAG_GPU_FUNC voxdag_gpu_bool voxdag_gpui_box_in(voxdag_gpu_frustum fr, voxdag_gpu_f32 x, voxdag_gpu_f32 y,
+                                                   voxdag_gpu_f32 z, voxdag_gpu_f32 s, voxdag_gpu_f32 margin) {
+    return voxdag_gpui_box_max(fr.n0x, fr.n0y, fr.n0z, x, y, z, s) >= -margin &&
+           voxdag_gpui_box_max(fr.n1x, fr.n1y, fr.n1z, x, y, z, s) >= -margin &&
+           voxdag_gpui_box_max(fr.n2x, fr.n2y, fr.n2z, x, y, z, s) >= -margin &&
+           voxdag_gpui_box_max(fr.n3x, fr.n3y, fr.n3z, x, y, z, s) >= -margin &&
+           voxdag_gpui_box_max(fr.fx, fr.fy, fr.fz, x, y, z, s) >= -margin;
+}
+
+/* The nearest depth of box (X, Y, Z) + [0, S)^3 relative to the apex. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_box_near(voxdag_gpu_frustum fr, voxdag_gpu_f32 x, voxdag_gpu_f32 y,
+                                                    voxdag_gpu_f32 z, voxdag_gpu_f32 s) {
+    return -voxdag_gpui_box_max(-fr.fx, -fr.fy, -fr.fz, x, y, z, s);
+}
+
+/* A depth below which no ray of FR meets a full voxel of F (0 when one may
+   at once, 2^100 when none does); rays t = depth / (f . d) started a little
+   before it (see the kernel) give the answers they would from 0. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpu_frustum_depth(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_frustum fr) {
+    voxdag_gpu_u32 st_at[VOXDAG_GPUI_STACK], st_info[VOXDAG_GPUI_STACK], st_x[VOXDAG_GPUI_STACK],
+        st_y[VOXDAG_GPUI_STACK], st_z[VOXDAG_GPUI_STACK];
+    voxdag_gpu_u32 sp = 1u, nl = f.levels, near = 0u;
+    voxdag_gpu_f32 best = VOXDAG_GPUI_LIMIT, margin;
+    if (nl == 0u || (f.voxels_lo | f.voxels_hi) == 0u) return best;
+    margin = VOXDAG_GPU_F32(1u << nl) * 0.00024414062f; /* 2^-12 of the grid: float rounding of the tests */
+    near |= fr.fx < 0.0f ? 1u : 0u, near |= fr.fy < 0.0f ? 2u : 0u, near |= fr.fz < 0.0f ? 4u : 0u;
+    st_at[0] = 0u, st_info[0] = f.root_inverse << 8, st_x[0] = 0u, st_y[0] = 0u, st_z[0] = 0u;
+    while (sp > 0u) {
+        voxdag_gpu_u32 at, q, mi, cx, cy, cz, k;
+        voxdag_gpu_f32 s, x, y, z, d_near, d_far;
+        sp--;
+        at = st_at[sp], q = st_info[sp] & 31u, mi = st_info[sp] >> 8, cx = st_x[sp], cy = st_y[sp], cz = st_z[sp];
+        s = VOXDAG_GPU_F32(1u << (nl - q));
+        x = voxdag_gpui_sub(voxdag_gpui_mul(VOXDAG_GPU_F32(cx), s), fr.ox);
+        y = voxdag_gpui_sub(voxdag_gpui_mul(VOXDAG_GPU_F32(cy), s), fr.oy);
+        z = voxdag_gpui_sub(voxdag_gpui_mul(VOXDAG_GPU_F32(cz), s), fr.oz);
+        if (!voxdag_gpui_box_in(fr, x, y, z, s, margin)) continue;
+        d_near = voxdag_gpui_box_near(fr, x, y, z, s);
+        if (d_near >= best) continue;
+        d_far = voxdag_gpui_box_max(fr.fx, fr.fy, fr.fz, x, y, z, s);
+        /* a cell no wider than the frustum, or than a level-of-detail cell, there */
+        if (s <= voxdag_gpui_mul(fr.width, d_far) || s < voxdag_gpui_mul(fr.lod, d_far)) {
+            best = d_near;
+            continue;
+        }
+        if (q + 2u == nl) { /* a brick: its 2^3 cells, then their voxels, the same way */
+            voxdag_gpui_mask m = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
+            for (k = 0u; k < 8u; k++) {
+                voxdag_gpu_u32 byte = (k < 4u ? m.lo : m.hi) >> (8u * (k & 3u)) & 0xFFu, v;
+                voxdag_gpu_f32 ex = voxdag_gpui_add(x, VOXDAG_GPU_F32(2u * (k & 1u)));
+                voxdag_gpu_f32 ey = voxdag_gpui_add(y, VOXDAG_GPU_F32(k & 2u));
+                voxdag_gpu_f32 ez = voxdag_gpui_add(z, VOXDAG_GPU_F32(k >> 1 & 2u));
+                if (byte == 0u || !voxdag_gpui_box_in(fr, ex, ey, ez, 2.0f, margin)) continue;
+                d_near = voxdag_gpui_box_near(fr, ex, ey, ez, 2.0f);
+                d_far = voxdag_gpui_box_max(fr.fx, fr.fy, fr.fz, ex, ey, ez, 2.0f);
+                if (2.0f <= voxdag_gpui_mul(fr.width, d_far) || 2.0f < voxdag_gpui_mul(fr.lod, d_far)) {
+                    if (d_near < best) best = d_near;
+                    continue;
+                }
+                for (v = 0u; v < 8u; v++) {
+                    voxdag_gpu_f32 vx = voxdag_gpui_add(ex, VOXDAG_GPU_F32(v & 1u));
+                    voxdag_gpu_f32 vy = voxdag_gpui_add(ey, VOXDAG_GPU_F32(v >> 1 & 1u));
+                    voxdag_gpu_f32 vz = voxdag_gpui_add(ez, VOXDAG_GPU_F32(v >> 2));
+                    if ((byte >> v & 1u) != 0u && voxdag_gpui_box_in(fr, vx, vy, vz, 1.0f, margin)) {
+                        voxdag_gpu_f32 d = voxdag_gpui_box_near(fr, vx, vy, vz, 1.0f);
+                        if (d < best) best = d;
+                    }
+                }
+            }
+            continue;
+        }
+        {
+            voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_data(buf, f, q) + at), j;
+            for (j = 8u; j > 0u; j--) { /* the nearest octant popped first */
+                voxdag_gpu_u32 w = near ^ (j - 1u), sw = voxdag_gpui_act(mi, w);
+                if ((header >> (2u * sw) & 3u) != 0u) {
+                    voxdag_gpui_ref ref = voxdag_gpui_child(buf, f, q, at, header, sw);
+                    st_at[sp] = ref.at, st_info[sp] = (q + 1u) | voxdag_gpui_compose(ref.inverse, mi) << 8;
+                    st_x[sp] = 2u * cx + (w & 1u), st_y[sp] = 2u * cy + (w >> 1 & 1u), st_z[sp] = 2u * cz + (w >> 2);
+                    sp++;
+                }
+            }
+        }
+    }
+    return best < 0.0f ? 0.0f : best;
 }
 
 // -- Colours (FORMAT.md, Colour section)

@@ -133,7 +133,7 @@ static vdag_kernel_params kernel_params(const vdag_gpu_work *w) {
     vdag_kernel_params p;
     memset(&p, 0, sizeof p);
     p.mode = (uint32_t)w->mode, p.count = w->count, p.width = w->width, p.height = w->height;
-    p.flags = w->shadows ? VDAG_KERNEL_SHADOWS : 0u;
+    p.flags = (w->shadows ? VDAG_KERNEL_SHADOWS : 0u) | (w->beam_start ? VDAG_KERNEL_BEAM_START : 0u);
     p.eye_x = w->eye[0], p.eye_y = w->eye[1], p.eye_z = w->eye[2], p.lod = w->lod;
     p.f_x = w->f[0], p.f_y = w->f[1], p.f_z = w->f[2], p.inv_w = w->inv_w;
     p.r_x = w->r[0], p.r_y = w->r[1], p.r_z = w->r[2], p.inv_h = w->inv_h;

@@ -21,7 +21,8 @@ typedef enum vdag_gpu_mode {
     VDAG_GPU_RAYS,     /* in 10 words a ray, out 12 a hit */
     VDAG_GPU_OCCLUDED, /* in 10 words a ray, out 1 */
     VDAG_GPU_LOOKUPS,  /* in 3 words a voxel, out 4 */
-    VDAG_GPU_RENDER    /* out one 0x00BBGGRR word a pixel */
+    VDAG_GPU_RENDER,   /* out one 0x00BBGGRR word a pixel (in: BEAM's depths with beam_start) */
+    VDAG_GPU_BEAM      /* out one depth (float bits) per 8x8 block of pixels */
 } vdag_gpu_mode;
 
 typedef struct vdag_gpu_work {
@@ -29,6 +30,7 @@ typedef struct vdag_gpu_work {
     uint32_t count;          /* items (RENDER: width * height) */
     uint32_t width, height;  /* RENDER */
     int shadows;
+    int beam_start;          /* RENDER: rays start at their block's BEAM depth */
     float eye[3], f[3], r[3], u[3], light[3]; /* RENDER: as vdag_kernel_params */
     float lod, ambient, inv_w, inv_h;
 } vdag_gpu_work;

@@ -366,12 +366,12 @@ static int parse_size(const char *s, uint32_t *w, uint32_t *h) {
 
 /* vdag render --gpu: the kernel's picture model (vdag_kernel.h) on the same
    camera, in one run. */
-static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels, unsigned threads, int quiet) {
+static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels, unsigned threads, int beam, int quiet) {
     const camera *c = &job->cam;
     vdag_gpu_work w;
     vdag_gpu *g;
-    uint32_t *out, i;
-    double secs = 0, aspect = (double)c->w / c->h;
+    uint32_t *out, *depths = NULL, i, blocks = ((c->w + 7) / 8) * ((c->h + 7) / 8);
+    double secs = 0, beam_secs = 0, aspect = (double)c->w / c->h;
     char err[256];
     int k, rc = 0;
     memset(&w, 0, sizeof w);
@@ -383,30 +383,43 @@ static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels
     w.lod = (float)(job->opts.lod_factor * lod_pixels), w.ambient = (float)AMBIENT;
     w.inv_w = 1.0f / (float)c->w, w.inv_h = 1.0f / (float)c->h;
     out = (uint32_t *)malloc(sizeof *out * w.count);
-    if (!out) return vdag_fail("render: out of memory");
+    if (beam) depths = (uint32_t *)malloc(sizeof *depths * blocks);
+    if (!out || (beam && !depths)) {
+        free(out), free(depths);
+        return vdag_fail("render: out of memory");
+    }
     if (vdag_gpu_open(&g, target, job->file->dag, threads, err, sizeof err)) {
-        free(out);
+        free(out), free(depths);
         return vdag_fail("render --gpu: %s", err);
     }
-    if (vdag_gpu_run(g, &w, NULL, 0, out, w.count, 1, &secs, err, sizeof err)) rc = vdag_fail("render --gpu: %s", err);
+    if (beam) { /* the beam pass: a safe start depth per 8x8 block */
+        vdag_gpu_work bw = w;
+        bw.mode = VDAG_GPU_BEAM, bw.count = blocks;
+        if (vdag_gpu_run(g, &bw, NULL, 0, depths, blocks, 1, &beam_secs, err, sizeof err)) rc = vdag_fail("render --gpu: %s", err);
+        w.beam_start = 1;
+    }
+    if (!rc && vdag_gpu_run(g, &w, depths, beam ? blocks : 0, out, w.count, 1, &secs, err, sizeof err))
+        rc = vdag_fail("render --gpu: %s", err);
+    secs += beam_secs;
     for (i = 0; !rc && i < w.count; i++)
         for (k = 0; k < 3; k++) job->rgb[3 * (size_t)i + k] = (uint8_t)(out[i] >> (8 * k));
     if (!rc && !quiet)
-        fprintf(stderr, "render: %ux%u on %s in %.3f s%s, %.2f Mrays/s\n", c->w, c->h, vdag_gpu_device(g), secs,
-                target == VDAG_GPU_EMULATE ? "" : " (GPU time)", (double)w.count / (secs > 0 ? secs : 1e-9) * 1e-6);
+        fprintf(stderr, "render: %ux%u on %s in %.3f s%s%s, %.2f Mrays/s\n", c->w, c->h, vdag_gpu_device(g), secs,
+                target == VDAG_GPU_EMULATE ? "" : " (GPU time)", beam ? " with the beam pass" : "",
+                (double)w.count / (secs > 0 ? secs : 1e-9) * 1e-6);
     vdag_gpu_close(g);
-    free(out);
+    free(out), free(depths);
     return rc;
 }
 
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet] [--gpu | --gpu-emulate]";
+                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet] [--gpu | --gpu-emulate [--beam]]";
     render_job job;
     vdag_file f;
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, cpu0, secs, cpu;
-    int have_eye = 0, have_target = 0, quiet = 0, gpu = -1, i, k;
+    int have_eye = 0, have_target = 0, quiet = 0, gpu = -1, beam = 0, i, k;
     uint32_t box[6];
     unsigned threads, t;
     pthread_t tid[64];
@@ -441,11 +454,14 @@ int vdag_cmd_render(int argc, char **argv) {
             gpu = VDAG_GPU_GLSL;
         } else if (!strcmp(a, "--gpu-emulate")) {
             gpu = VDAG_GPU_EMULATE;
+        } else if (!strcmp(a, "--beam")) {
+            beam = 1;
         } else {
             return vdag_fail("render: unknown option '%s' (%s)", a, usage);
         }
     }
     if (gpu == VDAG_GPU_GLSL && threads_d > 0) return vdag_fail("render: --threads is for the CPU; --gpu takes none");
+    if (beam && gpu < 0) return vdag_fail("render: --beam is a pass of the GPU kernel: add --gpu or --gpu-emulate");
     {   /* the picture is a PNG: an OUT named otherwise would hold PNG bytes under another name */
         const char *slash = strrchr(argv[2], '/'), *dot = strrchr(slash ? slash : argv[2], '.');
         if (!dot || strlen(dot) != 4 || (dot[1] | 0x20) != 'p' || (dot[2] | 0x20) != 'n' || (dot[3] | 0x20) != 'g')
@@ -493,7 +509,8 @@ int vdag_cmd_render(int argc, char **argv) {
         return vdag_fail("render: out of memory");
     }
     if (gpu >= 0) {
-        int rc = render_gpu(&job, (vdag_gpu_target)gpu, lod, threads_d > 0 ? (unsigned)threads_d : vdag_cpu_count(), quiet);
+        int rc = render_gpu(&job, (vdag_gpu_target)gpu, lod, threads_d > 0 ? (unsigned)threads_d : vdag_cpu_count(), beam,
+                            quiet);
         if (!rc && !write_png(argv[2], job.rgb, job.cam.w, job.cam.h))
             rc = vdag_fail("render: cannot write %s (%s)", argv[2], errno ? strerror(errno) : "write error");
         free(job.rgb);

@@ -224,7 +224,10 @@ static const struct {
                "  --quiet           no progress or timing on stderr\n"
                "  --gpu             render on the GPU through Vulkan (voxdag_gpu.h, float32; every option\n"
                "                    but --threads; level of detail by depth along the view axis)\n"
-               "  --gpu-emulate     the GPU picture computed on the CPU (the same pixels as --gpu)\n"},
+               "  --gpu-emulate     the GPU picture computed on the CPU (the same pixels as --gpu)\n"
+               "  --beam            with --gpu or --gpu-emulate: a first pass finds, per 8x8 block of\n"
+               "                    pixels, a depth before which none of its rays meets a voxel, where\n"
+               "                    the rays then start (the same picture)\n"},
     {"export-voxels", "usage: vdag export-voxels FILE\n"
                       "Prints every voxel as \"x y z r g b\" (grid units), in voxel-index order.\n"},
     {"gen", "usage: vdag gen demo OUT.xyz [--levels L]\n"

@@ -842,6 +842,10 @@ EOF"
     check "render --gpu: the same pixels as --gpu-emulate (shadows, level of detail)" sh -c "
         '$VDAG' render '$T/r.vdag' '$T/g.png' --size 64x40 --shadows --lod 2 --gpu --quiet &&
         '$VDAG' render '$T/r.vdag' '$T/e.png' --size 64x40 --shadows --lod 2 --gpu-emulate --quiet && cmp '$T/g.png' '$T/e.png'"
+    check "render --gpu --beam and --gpu-emulate --beam: the same pixels as without the beam pass" sh -c "
+        '$VDAG' render '$T/r.vdag' '$T/gb.png' --size 64x40 --shadows --lod 2 --gpu --beam --quiet && cmp '$T/g.png' '$T/gb.png' &&
+        '$VDAG' render '$T/r.vdag' '$T/eb.png' --size 64x40 --shadows --lod 2 --gpu-emulate --beam --quiet && cmp '$T/g.png' '$T/eb.png' &&
+        ! '$VDAG' render '$T/r.vdag' '$T/cb.png' --beam 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] && [ ! -e '$T/cb.png' ]"
     check "render --gpu: --threads is refused in one line" sh -c "
         ! '$VDAG' render '$T/r.vdag' '$T/t.png' --gpu --threads 2 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] && [ ! -e '$T/t.png' ]"
     check "--gpu without a Vulkan driver: one line, exit 1, no picture" sh -c "

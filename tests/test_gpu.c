@@ -14,6 +14,7 @@
 #include "rscene.h"
 #include "golden.h"
 #include "gpu_oracle.h"
+#include "examples/shaders/vdag_kernel.h"
 
 #include <math.h>
 
@@ -335,11 +336,81 @@ static void test_gpu_domain(void) {
     voxdag_free(d);
 }
 
+/* The beam pass: for random cameras (inside and outside the grid, with and
+   without level of detail), every ray of an 8x8 block of a 240x160
+   picture started at the block's frustum depth gives the same answer as
+   from 0; the depth is often above 0 and often close to the first hit (so
+   that a bound too far would show). */
+static void test_gpu_beam(void) {
+    uint64_t r = 0xBEA4, rays = 0, later = 0, blocks = 0, tight = 0;
+    uint32_t levels;
+    int kind;
+    for (levels = 3; levels <= 7; levels++)
+        for (kind = RS_SPARSE; kind < RS_COUNT; kind += 2) {
+            rscene s;
+            voxdag *d = rscene_make(&s, kind, levels, (int)(levels % 3), 0xBE0 + levels);
+            voxdag_gpu_buf buf;
+            voxdag_gpu_file f;
+            int cam;
+            if (!d) continue;
+            buf = gpu_buffer(d), f = voxdag_gpu_open(buf, 0);
+            for (cam = 0; cam < 6; cam++) {
+                vdag_kernel_params p;
+                double n = (double)(1u << levels), fd[3], rd[3], ud[3], len;
+                uint32_t x, y, a, k;
+                memset(&p, 0, sizeof p);
+                p.width = 240, p.height = 160, p.inv_w = 1.0f / 240, p.inv_h = 1.0f / 160;
+                p.lod = cam % 3 == 2 ? (float)rand_in(&r, 0.01, 0.2) : 0.0f;
+                p.eye_x = (float)rand_in(&r, cam & 1 ? -n : 0, cam & 1 ? 2 * n : n);
+                p.eye_y = (float)rand_in(&r, cam & 1 ? -n : 0, cam & 1 ? 2 * n : n);
+                p.eye_z = (float)rand_in(&r, cam & 1 ? -n : 0, cam & 1 ? 2 * n : n);
+                fd[0] = n / 2 - p.eye_x + rand_in(&r, -n / 4, n / 4), fd[1] = n / 2 - p.eye_y, fd[2] = n / 2 - p.eye_z + 0.3;
+                len = sqrt(fd[0] * fd[0] + fd[1] * fd[1] + fd[2] * fd[2]);
+                for (a = 0; a < 3; a++) fd[a] /= len;
+                rd[0] = fd[1], rd[1] = -fd[0], rd[2] = 0, len = sqrt(rd[0] * rd[0] + rd[1] * rd[1]);
+                for (a = 0; a < 3; a++) rd[a] /= len;
+                ud[0] = rd[1] * fd[2] - rd[2] * fd[1], ud[1] = rd[2] * fd[0] - rd[0] * fd[2], ud[2] = rd[0] * fd[1] - rd[1] * fd[0];
+                p.f_x = (float)fd[0], p.f_y = (float)fd[1], p.f_z = (float)fd[2];
+                p.r_x = (float)(rd[0] * 0.7), p.r_y = (float)(rd[1] * 0.7), p.r_z = (float)(rd[2] * 0.7);
+                p.u_x = (float)(ud[0] * 0.47), p.u_y = (float)(ud[1] * 0.47), p.u_z = (float)(ud[2] * 0.47);
+                for (k = 0; k < 12; k++) { /* blocks of the middle, where the scene is */
+                    uint32_t b = (7 + test_rand_below(&r, 6)) * 30 + 12 + test_rand_below(&r, 6);
+                    float depth = voxdag_gpu_frustum_depth(buf, f, vdag_kernel_frustum(p, b)), t0 = vdag_kernel_start(f, depth);
+                    blocks++, later += t0 > 0;
+                    for (y = 8 * (b / 30); y < 8 * (b / 30) + 8; y++)
+                        for (x = 8 * (b % 30); x < 8 * (b % 30) + 8; x++) {
+                            voxdag_gpu_ray ray;
+                            voxdag_gpu_hit h0, h1;
+                            float sx = vdag_kernel_sx(p, x), sy = vdag_kernel_sy(p, y);
+                            ray.ox = p.eye_x, ray.oy = p.eye_y, ray.oz = p.eye_z;
+                            ray.dx = p.f_x + sx * p.r_x + sy * p.u_x, ray.dy = p.f_y + sx * p.r_y + sy * p.u_y;
+                            ray.dz = p.f_z + sx * p.r_z + sy * p.u_z;
+                            ray.t_min = 0, ray.t_max = 0, ray.lod = p.lod, ray.flags = VOXDAG_GPU_WANT_INDEX;
+                            h0 = voxdag_gpu_raycast(buf, f, ray);
+                            ray.t_min = t0;
+                            h1 = voxdag_gpu_raycast(buf, f, ray);
+                            rays++;
+                            tight += h0.hit && h0.t < t0 * 1.05f;
+                            CHECK_MSG(!memcmp(&h0, &h1, sizeof h0), "L=%u kind %d camera %d block %u pixel (%u %u): hit %u t %g "
+                                      "from 0, hit %u t %g from the beam's %g", levels, kind, cam, b, x, y, h0.hit, (double)h0.t,
+                                      h1.hit, (double)h1.t, (double)t0);
+                        }
+                }
+            }
+            voxdag_free(d);
+            rscene_free(&s);
+        }
+    fprintf(stderr, "  %llu rays in %llu blocks, %llu blocks starting after 0, %llu hits within 5 %% of their start\n",
+            (unsigned long long)rays, (unsigned long long)blocks, (unsigned long long)later, (unsigned long long)tight);
+    CHECK(later * 4 > blocks && tight > 100);
+}
+
 const test_case test_gpu_cases[] = {
     {"gpu/transforms: the 48 symmetries as FORMAT.md defines them", test_gpu_transforms},
     {"gpu/scenes: lookups, colours and rays against brute force and the library", test_gpu_scenes},
     {"gpu/golden: the golden files, at offset 0 and inside a larger buffer", test_gpu_golden},
     {"gpu/large: voxelized scenes at L = 9 and 11", test_gpu_large},
     {"gpu/domain: non-finite and tiny inputs", test_gpu_domain},
+    {"gpu/beam: rays started at their block's frustum depth answer as from 0", test_gpu_beam},
     {NULL, NULL},
 };

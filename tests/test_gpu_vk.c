@@ -20,7 +20,7 @@ int test_current_failed, test_full;
 const char *test_data_dir(void) { return "tests/data"; }
 
 typedef struct vk_stats {
-    uint64_t rays, hits, lod_hits, near_ties, occluded, lookups, pixels, runs;
+    uint64_t rays, hits, lod_hits, near_ties, occluded, lookups, pixels, runs, beam_blocks;
 } vk_stats;
 
 /* Runs W on the device and on the emulation; 1 when both ran and gave the
@@ -144,14 +144,31 @@ static void check_file(vdag_gpu *gpu, vdag_gpu *emu, const voxdag *d, const rsce
     memset(&w, 0, sizeof w);
     w.mode = VDAG_GPU_RENDER, w.width = 48, w.height = 32, w.count = 48 * 32, w.shadows = 1;
     w.eye[0] = -0.7f * (float)(1u << info.levels), w.eye[1] = 1.9f * (float)(1u << info.levels), w.eye[2] = 1.3f * (float)(1u << info.levels);
-    w.f[0] = 0.6f, w.f[1] = -0.64f, w.f[2] = -0.48f; /* about towards the middle */
-    w.r[0] = 0.55f, w.r[1] = 0.52f, w.r[2] = 0, w.u[0] = -0.15f, w.u[1] = 0.16f, w.u[2] = 0.4f;
+    /* looking about at the middle; r and u perpendicular to f and to each other, as the tool's camera */
+    w.f[0] = 0.60000000f, w.f[1] = -0.64000000f, w.f[2] = -0.48000000f;
+    w.r[0] = -0.51067604f, w.r[1] = -0.47875879f, w.r[2] = -0.00000000f;
+    w.u[0] = 0.15429712f, w.u[1] = -0.16458359f, w.u[2] = 0.41231619f;
     w.light[0] = 0.48f, w.light[1] = 0.29f, w.light[2] = 0.77f;
     w.lod = info.levels > 4 ? 0.004f : 0, w.ambient = 0.3f, w.inv_w = 1.0f / 48, w.inv_h = 1.0f / 32;
     free(out);
     out = (uint32_t *)malloc(sizeof *out * w.count);
     st->runs++, st->pixels += w.count;
     CHECK_MSG(run_both(gpu, emu, &w, NULL, 0, out, w.count, "render"), "render: device and C differ");
+    { /* the beam pass: rays started at their block's depth give the same picture, on both */
+        uint32_t depths[24], beamed[48 * 32];
+        vdag_gpu_work bw = w;
+        int k;
+        bw.mode = VDAG_GPU_BEAM, bw.count = 24;
+        for (k = 0; k < 2; k++) {
+            vdag_gpu *g = k ? emu : gpu;
+            vdag_gpu_work rw = w;
+            rw.beam_start = 1;
+            CHECK(vdag_gpu_run(g, &bw, NULL, 0, depths, 24, 1, NULL, err, sizeof err) == 0);
+            CHECK(vdag_gpu_run(g, &rw, depths, 24, beamed, w.count, 1, NULL, err, sizeof err) == 0);
+            CHECK_MSG(!memcmp(beamed, out, sizeof beamed), "%s: the beam pass changed the picture", k ? "C" : "device");
+            for (i = 0; i < 24; i++) st->beam_blocks += depths[i] != 0u; /* a depth above 0 */
+        }
+    }
     free(in), free(out), free(rays), free(lods);
 }
 
@@ -194,10 +211,11 @@ static void run_target(vdag_gpu_target target, const char *name) {
         rscene_free(&s);
     }
     fprintf(stderr, "  %s: %llu runs; %llu rays (%llu hits, %llu LOD hits), %llu shadow rays, %llu near-ties; "
-            "%llu lookups; %llu pixels\n", name, (unsigned long long)st.runs, (unsigned long long)st.rays,
+            "%llu lookups; %llu pixels; %llu beam blocks starting later\n", name, (unsigned long long)st.runs, (unsigned long long)st.rays,
             (unsigned long long)st.hits, (unsigned long long)st.lod_hits, (unsigned long long)st.occluded,
-            (unsigned long long)st.near_ties, (unsigned long long)st.lookups, (unsigned long long)st.pixels);
-    CHECK(st.hits > 1000 && st.lod_hits > 100 && st.near_ties * 200 <= st.rays);
+            (unsigned long long)st.near_ties, (unsigned long long)st.lookups, (unsigned long long)st.pixels,
+            (unsigned long long)st.beam_blocks);
+    CHECK(st.hits > 1000 && st.lod_hits > 100 && st.near_ties * 200 <= st.rays && st.beam_blocks > 100);
     vdag_gpu_close(gpu);
     vdag_gpu_close(emu);
     voxdag_free(first);
