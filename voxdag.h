@@ -1031,25 +1031,55 @@ static uint64_t voxdagi_mix64(uint64_t z) { /* a strong 64-bit finalizer */
 
 /* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing by 16:
    sixteen bytes per step through sixteen 256-entry tables, T[k][b] being the
-   CRC register after byte b followed by k zero bytes. The tables (16 KiB)
-   are built per call in about 4,000 steps (the CRC is linear, so T[0] is XORs
-   of its 8 power-of-two entries), only for inputs of 4 KiB or more (sections);
-   the header and the section table go byte by byte through T[0]. The data is
-   read byte by byte, so the result does not depend on alignment or byte
-   order. */
+   CRC register after byte b followed by k zero bytes. T[0] is a constant
+   (the tests compute it bit by bit); the other fifteen (15 KiB) are built
+   from it per call in about 4,000 steps, only for inputs of 4 KiB or more
+   (sections), so that small inputs (the header, the section table, the
+   sections of a small file) go byte by byte through T[0] with nothing to
+   build. The data is read byte by byte, so the result does not depend on
+   alignment or byte order. */
+static const uint32_t voxdagi_crc_t0[256] = {
+    0x00000000u, 0xF26B8303u, 0xE13B70F7u, 0x1350F3F4u, 0xC79A971Fu, 0x35F1141Cu, 0x26A1E7E8u, 0xD4CA64EBu,
+    0x8AD958CFu, 0x78B2DBCCu, 0x6BE22838u, 0x9989AB3Bu, 0x4D43CFD0u, 0xBF284CD3u, 0xAC78BF27u, 0x5E133C24u,
+    0x105EC76Fu, 0xE235446Cu, 0xF165B798u, 0x030E349Bu, 0xD7C45070u, 0x25AFD373u, 0x36FF2087u, 0xC494A384u,
+    0x9A879FA0u, 0x68EC1CA3u, 0x7BBCEF57u, 0x89D76C54u, 0x5D1D08BFu, 0xAF768BBCu, 0xBC267848u, 0x4E4DFB4Bu,
+    0x20BD8EDEu, 0xD2D60DDDu, 0xC186FE29u, 0x33ED7D2Au, 0xE72719C1u, 0x154C9AC2u, 0x061C6936u, 0xF477EA35u,
+    0xAA64D611u, 0x580F5512u, 0x4B5FA6E6u, 0xB93425E5u, 0x6DFE410Eu, 0x9F95C20Du, 0x8CC531F9u, 0x7EAEB2FAu,
+    0x30E349B1u, 0xC288CAB2u, 0xD1D83946u, 0x23B3BA45u, 0xF779DEAEu, 0x05125DADu, 0x1642AE59u, 0xE4292D5Au,
+    0xBA3A117Eu, 0x4851927Du, 0x5B016189u, 0xA96AE28Au, 0x7DA08661u, 0x8FCB0562u, 0x9C9BF696u, 0x6EF07595u,
+    0x417B1DBCu, 0xB3109EBFu, 0xA0406D4Bu, 0x522BEE48u, 0x86E18AA3u, 0x748A09A0u, 0x67DAFA54u, 0x95B17957u,
+    0xCBA24573u, 0x39C9C670u, 0x2A993584u, 0xD8F2B687u, 0x0C38D26Cu, 0xFE53516Fu, 0xED03A29Bu, 0x1F682198u,
+    0x5125DAD3u, 0xA34E59D0u, 0xB01EAA24u, 0x42752927u, 0x96BF4DCCu, 0x64D4CECFu, 0x77843D3Bu, 0x85EFBE38u,
+    0xDBFC821Cu, 0x2997011Fu, 0x3AC7F2EBu, 0xC8AC71E8u, 0x1C661503u, 0xEE0D9600u, 0xFD5D65F4u, 0x0F36E6F7u,
+    0x61C69362u, 0x93AD1061u, 0x80FDE395u, 0x72966096u, 0xA65C047Du, 0x5437877Eu, 0x4767748Au, 0xB50CF789u,
+    0xEB1FCBADu, 0x197448AEu, 0x0A24BB5Au, 0xF84F3859u, 0x2C855CB2u, 0xDEEEDFB1u, 0xCDBE2C45u, 0x3FD5AF46u,
+    0x7198540Du, 0x83F3D70Eu, 0x90A324FAu, 0x62C8A7F9u, 0xB602C312u, 0x44694011u, 0x5739B3E5u, 0xA55230E6u,
+    0xFB410CC2u, 0x092A8FC1u, 0x1A7A7C35u, 0xE811FF36u, 0x3CDB9BDDu, 0xCEB018DEu, 0xDDE0EB2Au, 0x2F8B6829u,
+    0x82F63B78u, 0x709DB87Bu, 0x63CD4B8Fu, 0x91A6C88Cu, 0x456CAC67u, 0xB7072F64u, 0xA457DC90u, 0x563C5F93u,
+    0x082F63B7u, 0xFA44E0B4u, 0xE9141340u, 0x1B7F9043u, 0xCFB5F4A8u, 0x3DDE77ABu, 0x2E8E845Fu, 0xDCE5075Cu,
+    0x92A8FC17u, 0x60C37F14u, 0x73938CE0u, 0x81F80FE3u, 0x55326B08u, 0xA759E80Bu, 0xB4091BFFu, 0x466298FCu,
+    0x1871A4D8u, 0xEA1A27DBu, 0xF94AD42Fu, 0x0B21572Cu, 0xDFEB33C7u, 0x2D80B0C4u, 0x3ED04330u, 0xCCBBC033u,
+    0xA24BB5A6u, 0x502036A5u, 0x4370C551u, 0xB11B4652u, 0x65D122B9u, 0x97BAA1BAu, 0x84EA524Eu, 0x7681D14Du,
+    0x2892ED69u, 0xDAF96E6Au, 0xC9A99D9Eu, 0x3BC21E9Du, 0xEF087A76u, 0x1D63F975u, 0x0E330A81u, 0xFC588982u,
+    0xB21572C9u, 0x407EF1CAu, 0x532E023Eu, 0xA145813Du, 0x758FE5D6u, 0x87E466D5u, 0x94B49521u, 0x66DF1622u,
+    0x38CC2A06u, 0xCAA7A905u, 0xD9F75AF1u, 0x2B9CD9F2u, 0xFF56BD19u, 0x0D3D3E1Au, 0x1E6DCDEEu, 0xEC064EEDu,
+    0xC38D26C4u, 0x31E6A5C7u, 0x22B65633u, 0xD0DDD530u, 0x0417B1DBu, 0xF67C32D8u, 0xE52CC12Cu, 0x1747422Fu,
+    0x49547E0Bu, 0xBB3FFD08u, 0xA86F0EFCu, 0x5A048DFFu, 0x8ECEE914u, 0x7CA56A17u, 0x6FF599E3u, 0x9D9E1AE0u,
+    0xD3D3E1ABu, 0x21B862A8u, 0x32E8915Cu, 0xC083125Fu, 0x144976B4u, 0xE622F5B7u, 0xF5720643u, 0x07198540u,
+    0x590AB964u, 0xAB613A67u, 0xB831C993u, 0x4A5A4A90u, 0x9E902E7Bu, 0x6CFBAD78u, 0x7FAB5E8Cu, 0x8DC0DD8Fu,
+    0xE330A81Au, 0x115B2B19u, 0x020BD8EDu, 0xF0605BEEu, 0x24AA3F05u, 0xD6C1BC06u, 0xC5914FF2u, 0x37FACCF1u,
+    0x69E9F0D5u, 0x9B8273D6u, 0x88D28022u, 0x7AB90321u, 0xAE7367CAu, 0x5C18E4C9u, 0x4F48173Du, 0xBD23943Eu,
+    0xF36E6F75u, 0x0105EC76u, 0x12551F82u, 0xE03E9C81u, 0x34F4F86Au, 0xC69F7B69u, 0xD5CF889Du, 0x27A40B9Eu,
+    0x79B737BAu, 0x8BDCB4B9u, 0x988C474Du, 0x6AE7C44Eu, 0xBE2DA0A5u, 0x4C4623A6u, 0x5F16D052u, 0xAD7D5351u};
+
 typedef struct voxdagi_crc_tables {
     uint32_t t[16][256];
 } voxdagi_crc_tables;
 
-static void voxdagi_crc_tables_init(voxdagi_crc_tables *c, int all) {
+static void voxdagi_crc_tables_init(voxdagi_crc_tables *c) {
     uint32_t i, k;
-    c->t[0][0] = 0;
-    for (i = 1; i < 256; i <<= 1) {
-        uint32_t x = i;
-        for (k = 0; k < 8; k++) x = (x >> 1) ^ (0x82F63B78u & (0u - (x & 1)));
-        for (k = 0; k < i; k++) c->t[0][i + k] = x ^ c->t[0][k];
-    }
-    for (k = 1; all && k < 16; k++)
+    memcpy(c->t[0], voxdagi_crc_t0, sizeof voxdagi_crc_t0);
+    for (k = 1; k < 16; k++)
         for (i = 0; i < 256; i++) c->t[k][i] = (c->t[k - 1][i] >> 8) ^ c->t[0][c->t[k - 1][i] & 0xFF];
 }
 
@@ -1096,7 +1126,7 @@ static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
     voxdagi_crc_tables c;
     uint32_t crc = 0xFFFFFFFFu;
     int sliced = n >= 4096;
-    voxdagi_crc_tables_init(&c, sliced);
+    if (sliced) voxdagi_crc_tables_init(&c);
     if (n >= 65536) {
         uint64_t part = n / 48 * 16, i; /* a third, in whole steps */
         uint32_t c1 = 0xFFFFFFFFu, c2 = 0xFFFFFFFFu;
@@ -1109,7 +1139,7 @@ static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
         p += 3 * part, n -= 3 * part;
     }
     for (; sliced && n >= 16; n -= 16, p += 16) crc = voxdagi_crc_step(&c, crc, p);
-    while (n--) crc = c.t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+    while (n--) crc = voxdagi_crc_t0[(crc ^ *p++) & 0xFF] ^ (crc >> 8);
     return ~crc;
 }
 
@@ -3873,12 +3903,11 @@ VOXDAGI_INLINE unsigned voxdagi_has_private(unsigned header) { return (header & 
 /* Fills LV->ptr_bits from its pointer widths: for each header byte, the sum
    of the widths of its four tags. */
 static void voxdagi_ptr_bits_init(voxdagi_level *lv) {
-    unsigned b, i;
-    for (b = 0; b < 256; b++) {
-        unsigned n = 0;
-        for (i = 0; i < 4; i++) n += lv->width[b >> (2 * i) & 3];
-        lv->ptr_bits[b] = (uint8_t)n; /* 4 x 57 < 256 */
-    }
+    uint8_t two[16]; /* two tags */
+    unsigned h, l;
+    for (l = 0; l < 16; l++) two[l] = (uint8_t)(lv->width[l & 3] + lv->width[l >> 2]);
+    for (h = 0; h < 16; h++)
+        for (l = 0; l < 16; l++) lv->ptr_bits[16 * h + l] = (uint8_t)(two[h] + two[l]); /* 4 x 57 < 256 */
 }
 
 /* Bit offset of child octant S's pointer inside a record with HEADER: the
@@ -4177,12 +4206,12 @@ static const char *voxdagi_validate_level(const voxdag *d, uint32_t l, voxdagi_v
    8; the pointer loop then takes one tag after the other, with no search for
    the next present octant on its critical path. */
 static void voxdagi_tag_seq_init(uint16_t tag_seq[256]) {
-    unsigned b, k;
-    for (b = 0; b < 256; b++) {
-        unsigned seq = 0, n = 0;
-        for (k = 0; k < 4; k++)
-            if (b >> (2 * k) & 3) seq |= (b >> (2 * k) & 3) << (2 * n++);
-        tag_seq[b] = (uint16_t)(seq | n << 9);
+    unsigned b;
+    for (b = 0; b < 16; b++) /* two tags: the upper one moves down when the lower is 0 */
+        tag_seq[b] = (uint16_t)((b & 3 ? b : b >> 2) | ((unsigned)((b & 3) != 0) + (unsigned)(b > 3)) << 9);
+    for (b = 16; b < 256; b++) { /* the upper two tags after the lower two */
+        unsigned lo = tag_seq[b & 15], hi = tag_seq[b >> 4];
+        tag_seq[b] = (uint16_t)(((lo & 0xFF) | (hi & 0xFF) << (lo >> 8)) | ((lo >> 9) + (hi >> 9)) << 9);
     }
 }
 
@@ -4344,14 +4373,11 @@ static void voxdagi_ref_set_free(voxdagi_mem *m, voxdagi_ref_set *s) {
 static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned high, uint32_t *out) {
     uint32_t brick_level = d->levels - 2, l, at = high ? 1u << d->levels : 0, best = high ? 0 : 4;
     voxdagi_ref_set cur, next;
-    uint8_t wanted[2][VOXDAGI_TRANSFORMS]; /* [half][MI]: the stored octants of the world half */
+    const unsigned lower = a == 0 ? 0x55 : a == 1 ? 0x33 : 0x0F; /* the world octants with bit A clear */
     size_t i;
-    unsigned w, mi;
+    unsigned mi;
     memset(&cur, 0, sizeof cur);
     memset(&next, 0, sizeof next);
-    memset(wanted, 0, sizeof wanted);
-    for (mi = 0; mi < VOXDAGI_TRANSFORMS; mi++)
-        for (w = 0; w < 8; w++) wanted[w >> a & 1][mi] = (uint8_t)(wanted[w >> a & 1][mi] | 1u << voxdagi_cube_tables.act[mi][w]);
     if (!voxdagi_ref_set_add(m, &cur, voxdagi_cube_tables.inv[d->root_transform])) return 0;
     for (l = 0; l < brick_level; l++) {
         unsigned side; /* the half of each cell on the wanted side, then the other */
@@ -4369,7 +4395,8 @@ static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned
                 mi = (unsigned)(key & 63);
                 rec = d->level[l].data + off;
                 header = voxdagi_le16(rec);
-                set = voxdagi_presence(header) & wanted[half][mi];
+                /* the stored octants MI(w) of the world half: world and stored swap under MI^-1 */
+                set = voxdagi_presence(header) & voxdagi_occupancy[voxdagi_cube_tables.inv[mi]][half ? 0xFF ^ lower : lower];
                 if (!set) continue;
                 voxdagi_child_refs(d, l, rec, header, set, ref);
                 for (; set; set &= set - 1) {
