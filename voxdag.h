@@ -223,7 +223,13 @@ typedef struct voxdag_build_opts {
                                     threads, started once per builder) or on
                                     thread_pool; 0 or 1: the calling thread only.
                                     At most 64 are used. The file is the same
-                                    bytes whatever T. */
+                                    bytes whatever T. Voxel input (builder_add):
+                                    the threads check and encode an add call of
+                                    2^18 voxels or more, sort a flush of 2^16 or
+                                    more voxels that are not in Morton order, and
+                                    reduce a flush spanning enough subtrees;
+                                    dropping repeats, colours and the final
+                                    encoding run on the calling thread. */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit; more
                                     is VOXDAG_ERR_LIMIT */
@@ -1830,9 +1836,12 @@ static void voxdagi_reducer_finish(voxdagi_reducer *r) {
 
 /* Sorts CODE (and RGB, packed 0xRRGGBB, when non-NULL) by the low BITS bits
    of the codes, stably. TMP_CODE/TMP_RGB hold N elements each. */
+#define VOXDAGI_RADIX_BITS 11
+#define VOXDAGI_RADIX_BUCKETS (1u << VOXDAGI_RADIX_BITS)
+
 static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code,
                                uint32_t *tmp_rgb, size_t n, unsigned bits) {
-    enum { radix_bits = 11, radix_buckets = 1 << radix_bits };
+    enum { radix_bits = VOXDAGI_RADIX_BITS, radix_buckets = VOXDAGI_RADIX_BUCKETS };
     size_t count[radix_buckets];
     unsigned shift;
     for (shift = 0; shift < bits; shift += radix_bits) {
@@ -2142,6 +2151,83 @@ static void voxdagi_batch_wait(voxdag_builder *b) {
 static void voxdagi_run_parallel(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
     voxdagi_batch_start(b, fn, jobs, size, count);
     voxdagi_batch_wait(b);
+}
+
+/* One job of a parallel radix sort pass: counts the digits of elements
+   [begin, end) (COUNT: radix_buckets entries), or, once COUNT holds each
+   digit's first destination for this slice, moves them there. */
+typedef struct voxdagi_sort_job {
+    const uint64_t *code;
+    const uint32_t *rgb;
+    uint64_t *to_code;
+    uint32_t *to_rgb;
+    size_t begin, end, *count;
+    unsigned shift;
+    int scatter;
+} voxdagi_sort_job;
+
+static void *voxdagi_sort_run(void *arg) {
+    voxdagi_sort_job *j = (voxdagi_sort_job *)arg;
+    const uint64_t mask = VOXDAGI_RADIX_BUCKETS - 1;
+    size_t i;
+    if (!j->scatter) {
+        memset(j->count, 0, VOXDAGI_RADIX_BUCKETS * sizeof *j->count);
+        for (i = j->begin; i < j->end; i++) j->count[(j->code[i] >> j->shift) & mask]++;
+        return NULL;
+    }
+    for (i = j->begin; i < j->end; i++) {
+        size_t d = j->count[(j->code[i] >> j->shift) & mask]++;
+        j->to_code[d] = j->code[i];
+        if (j->rgb) j->to_rgb[d] = j->rgb[i];
+    }
+    return NULL;
+}
+
+/* voxdagi_radix_sort on the builder's threads: each pass counts, then moves,
+   one slice of the elements per job, every slice's elements of a digit
+   placed after those of the slices before it, so the order is the serial
+   sort's (a stable sort has one result) whatever the thread count. Serial
+   with one thread, for small inputs, or when the counts cannot be
+   allocated. */
+static void voxdagi_sort(voxdag_builder *b, uint64_t *code, uint32_t *rgb, uint64_t *tmp_code, uint32_t *tmp_rgb,
+                         size_t n, unsigned bits) {
+    voxdagi_sort_job job[VOXDAGI_MAX_THREADS];
+    unsigned jobs = b->threads, t, shift;
+    size_t *count = NULL, d, sum;
+    if (jobs > 1 && n >= (1u << 16)) /* below, the batches would cost more than they save */
+        count = (size_t *)voxdagi_alloc(&b->mem, jobs * VOXDAGI_RADIX_BUCKETS * sizeof *count);
+    if (!count) {
+        voxdagi_radix_sort(code, rgb, tmp_code, tmp_rgb, n, bits);
+        return;
+    }
+    for (shift = 0; shift < bits; shift += VOXDAGI_RADIX_BITS) {
+        uint64_t *c;
+        uint32_t *r;
+        for (t = 0; t < jobs; t++) {
+            job[t].code = code, job[t].rgb = rgb, job[t].to_code = tmp_code, job[t].to_rgb = tmp_rgb;
+            job[t].begin = n / jobs * t;
+            job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
+            job[t].count = count + (size_t)t * VOXDAGI_RADIX_BUCKETS;
+            job[t].shift = shift;
+            job[t].scatter = 0;
+        }
+        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        for (d = 0, sum = 0; d < VOXDAGI_RADIX_BUCKETS; d++) /* digit by digit, slices in order */
+            for (t = 0; t < jobs; t++) {
+                size_t k = job[t].count[d];
+                job[t].count[d] = sum;
+                sum += k;
+            }
+        for (t = 0; t < jobs; t++) job[t].scatter = 1;
+        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        c = code; code = tmp_code; tmp_code = c;
+        r = rgb; rgb = tmp_rgb; tmp_rgb = r;
+    }
+    if (((bits + VOXDAGI_RADIX_BITS - 1) / VOXDAGI_RADIX_BITS) & 1) { /* odd pass count: the result is in tmp */
+        memcpy(tmp_code, code, n * sizeof *code);
+        if (rgb) memcpy(tmp_rgb, rgb, n * sizeof *rgb);
+    }
+    voxdagi_free(&b->mem, count, jobs * VOXDAGI_RADIX_BUCKETS * sizeof *count);
 }
 
 /* Morton encoding and checks of voxels [begin, end) of an add call. */
@@ -2521,7 +2607,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
             voxdagi_free(&b->mem, tr, rgb_size);
             return VOXDAG_ERR_OUT_OF_MEMORY;
         }
-        voxdagi_radix_sort(code, rgb, tc, tr, n, 3 * b->levels);
+        voxdagi_sort(b, code, rgb, tc, tr, n, 3 * b->levels);
         voxdagi_free(&b->mem, tc, n * sizeof *tc);
         voxdagi_free(&b->mem, tr, rgb_size);
     }
