@@ -223,7 +223,13 @@ typedef struct voxdag_build_opts {
                                     threads, started once per builder) or on
                                     thread_pool; 0 or 1: the calling thread only.
                                     At most 64 are used. The file is the same
-                                    bytes whatever T. */
+                                    bytes whatever T. Voxel input (builder_add):
+                                    the threads check and encode an add call of
+                                    2^18 voxels or more, sort a flush of 2^16 or
+                                    more voxels that are not in Morton order, and
+                                    reduce a flush spanning enough subtrees;
+                                    dropping repeats, colours and the final
+                                    encoding run on the calling thread. */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit; more
                                     is VOXDAG_ERR_LIMIT */
@@ -392,7 +398,9 @@ typedef struct voxdag_load_opts {
 /* Validates a .vdag image in memory completely (structure, every pointer,
    every count, checksums unless opts->skip_checksums) and returns a DAG that
    queries it in place. Unless opts->copy is set, DATA must stay valid and
-   unchanged until voxdag_free. */
+   unchanged until voxdag_free. The DAG holds a few hundred bytes plus about
+   half a KB per inner level (L - 2 of them) besides a copy; the symmetry
+   tables are constants that every DAG shares. */
 VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
                                             const voxdag_load_opts *opts,
                                             voxdag **out, voxdag_error *err);
@@ -1029,25 +1037,55 @@ static uint64_t voxdagi_mix64(uint64_t z) { /* a strong 64-bit finalizer */
 
 /* CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), slicing by 16:
    sixteen bytes per step through sixteen 256-entry tables, T[k][b] being the
-   CRC register after byte b followed by k zero bytes. The tables (16 KiB)
-   are built per call in about 4,000 steps (the CRC is linear, so T[0] is XORs
-   of its 8 power-of-two entries), only for inputs of 4 KiB or more (sections);
-   the header and the section table go byte by byte through T[0]. The data is
-   read byte by byte, so the result does not depend on alignment or byte
-   order. */
+   CRC register after byte b followed by k zero bytes. T[0] is a constant
+   (the tests compute it bit by bit); the other fifteen (15 KiB) are built
+   from it per call in about 4,000 steps, only for inputs of 4 KiB or more
+   (sections), so that small inputs (the header, the section table, the
+   sections of a small file) go byte by byte through T[0] with nothing to
+   build. The data is read byte by byte, so the result does not depend on
+   alignment or byte order. */
+static const uint32_t voxdagi_crc_t0[256] = {
+    0x00000000u, 0xF26B8303u, 0xE13B70F7u, 0x1350F3F4u, 0xC79A971Fu, 0x35F1141Cu, 0x26A1E7E8u, 0xD4CA64EBu,
+    0x8AD958CFu, 0x78B2DBCCu, 0x6BE22838u, 0x9989AB3Bu, 0x4D43CFD0u, 0xBF284CD3u, 0xAC78BF27u, 0x5E133C24u,
+    0x105EC76Fu, 0xE235446Cu, 0xF165B798u, 0x030E349Bu, 0xD7C45070u, 0x25AFD373u, 0x36FF2087u, 0xC494A384u,
+    0x9A879FA0u, 0x68EC1CA3u, 0x7BBCEF57u, 0x89D76C54u, 0x5D1D08BFu, 0xAF768BBCu, 0xBC267848u, 0x4E4DFB4Bu,
+    0x20BD8EDEu, 0xD2D60DDDu, 0xC186FE29u, 0x33ED7D2Au, 0xE72719C1u, 0x154C9AC2u, 0x061C6936u, 0xF477EA35u,
+    0xAA64D611u, 0x580F5512u, 0x4B5FA6E6u, 0xB93425E5u, 0x6DFE410Eu, 0x9F95C20Du, 0x8CC531F9u, 0x7EAEB2FAu,
+    0x30E349B1u, 0xC288CAB2u, 0xD1D83946u, 0x23B3BA45u, 0xF779DEAEu, 0x05125DADu, 0x1642AE59u, 0xE4292D5Au,
+    0xBA3A117Eu, 0x4851927Du, 0x5B016189u, 0xA96AE28Au, 0x7DA08661u, 0x8FCB0562u, 0x9C9BF696u, 0x6EF07595u,
+    0x417B1DBCu, 0xB3109EBFu, 0xA0406D4Bu, 0x522BEE48u, 0x86E18AA3u, 0x748A09A0u, 0x67DAFA54u, 0x95B17957u,
+    0xCBA24573u, 0x39C9C670u, 0x2A993584u, 0xD8F2B687u, 0x0C38D26Cu, 0xFE53516Fu, 0xED03A29Bu, 0x1F682198u,
+    0x5125DAD3u, 0xA34E59D0u, 0xB01EAA24u, 0x42752927u, 0x96BF4DCCu, 0x64D4CECFu, 0x77843D3Bu, 0x85EFBE38u,
+    0xDBFC821Cu, 0x2997011Fu, 0x3AC7F2EBu, 0xC8AC71E8u, 0x1C661503u, 0xEE0D9600u, 0xFD5D65F4u, 0x0F36E6F7u,
+    0x61C69362u, 0x93AD1061u, 0x80FDE395u, 0x72966096u, 0xA65C047Du, 0x5437877Eu, 0x4767748Au, 0xB50CF789u,
+    0xEB1FCBADu, 0x197448AEu, 0x0A24BB5Au, 0xF84F3859u, 0x2C855CB2u, 0xDEEEDFB1u, 0xCDBE2C45u, 0x3FD5AF46u,
+    0x7198540Du, 0x83F3D70Eu, 0x90A324FAu, 0x62C8A7F9u, 0xB602C312u, 0x44694011u, 0x5739B3E5u, 0xA55230E6u,
+    0xFB410CC2u, 0x092A8FC1u, 0x1A7A7C35u, 0xE811FF36u, 0x3CDB9BDDu, 0xCEB018DEu, 0xDDE0EB2Au, 0x2F8B6829u,
+    0x82F63B78u, 0x709DB87Bu, 0x63CD4B8Fu, 0x91A6C88Cu, 0x456CAC67u, 0xB7072F64u, 0xA457DC90u, 0x563C5F93u,
+    0x082F63B7u, 0xFA44E0B4u, 0xE9141340u, 0x1B7F9043u, 0xCFB5F4A8u, 0x3DDE77ABu, 0x2E8E845Fu, 0xDCE5075Cu,
+    0x92A8FC17u, 0x60C37F14u, 0x73938CE0u, 0x81F80FE3u, 0x55326B08u, 0xA759E80Bu, 0xB4091BFFu, 0x466298FCu,
+    0x1871A4D8u, 0xEA1A27DBu, 0xF94AD42Fu, 0x0B21572Cu, 0xDFEB33C7u, 0x2D80B0C4u, 0x3ED04330u, 0xCCBBC033u,
+    0xA24BB5A6u, 0x502036A5u, 0x4370C551u, 0xB11B4652u, 0x65D122B9u, 0x97BAA1BAu, 0x84EA524Eu, 0x7681D14Du,
+    0x2892ED69u, 0xDAF96E6Au, 0xC9A99D9Eu, 0x3BC21E9Du, 0xEF087A76u, 0x1D63F975u, 0x0E330A81u, 0xFC588982u,
+    0xB21572C9u, 0x407EF1CAu, 0x532E023Eu, 0xA145813Du, 0x758FE5D6u, 0x87E466D5u, 0x94B49521u, 0x66DF1622u,
+    0x38CC2A06u, 0xCAA7A905u, 0xD9F75AF1u, 0x2B9CD9F2u, 0xFF56BD19u, 0x0D3D3E1Au, 0x1E6DCDEEu, 0xEC064EEDu,
+    0xC38D26C4u, 0x31E6A5C7u, 0x22B65633u, 0xD0DDD530u, 0x0417B1DBu, 0xF67C32D8u, 0xE52CC12Cu, 0x1747422Fu,
+    0x49547E0Bu, 0xBB3FFD08u, 0xA86F0EFCu, 0x5A048DFFu, 0x8ECEE914u, 0x7CA56A17u, 0x6FF599E3u, 0x9D9E1AE0u,
+    0xD3D3E1ABu, 0x21B862A8u, 0x32E8915Cu, 0xC083125Fu, 0x144976B4u, 0xE622F5B7u, 0xF5720643u, 0x07198540u,
+    0x590AB964u, 0xAB613A67u, 0xB831C993u, 0x4A5A4A90u, 0x9E902E7Bu, 0x6CFBAD78u, 0x7FAB5E8Cu, 0x8DC0DD8Fu,
+    0xE330A81Au, 0x115B2B19u, 0x020BD8EDu, 0xF0605BEEu, 0x24AA3F05u, 0xD6C1BC06u, 0xC5914FF2u, 0x37FACCF1u,
+    0x69E9F0D5u, 0x9B8273D6u, 0x88D28022u, 0x7AB90321u, 0xAE7367CAu, 0x5C18E4C9u, 0x4F48173Du, 0xBD23943Eu,
+    0xF36E6F75u, 0x0105EC76u, 0x12551F82u, 0xE03E9C81u, 0x34F4F86Au, 0xC69F7B69u, 0xD5CF889Du, 0x27A40B9Eu,
+    0x79B737BAu, 0x8BDCB4B9u, 0x988C474Du, 0x6AE7C44Eu, 0xBE2DA0A5u, 0x4C4623A6u, 0x5F16D052u, 0xAD7D5351u};
+
 typedef struct voxdagi_crc_tables {
     uint32_t t[16][256];
 } voxdagi_crc_tables;
 
-static void voxdagi_crc_tables_init(voxdagi_crc_tables *c, int all) {
+static void voxdagi_crc_tables_init(voxdagi_crc_tables *c) {
     uint32_t i, k;
-    c->t[0][0] = 0;
-    for (i = 1; i < 256; i <<= 1) {
-        uint32_t x = i;
-        for (k = 0; k < 8; k++) x = (x >> 1) ^ (0x82F63B78u & (0u - (x & 1)));
-        for (k = 0; k < i; k++) c->t[0][i + k] = x ^ c->t[0][k];
-    }
-    for (k = 1; all && k < 16; k++)
+    memcpy(c->t[0], voxdagi_crc_t0, sizeof voxdagi_crc_t0);
+    for (k = 1; k < 16; k++)
         for (i = 0; i < 256; i++) c->t[k][i] = (c->t[k - 1][i] >> 8) ^ c->t[0][c->t[k - 1][i] & 0xFF];
 }
 
@@ -1094,7 +1132,7 @@ static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
     voxdagi_crc_tables c;
     uint32_t crc = 0xFFFFFFFFu;
     int sliced = n >= 4096;
-    voxdagi_crc_tables_init(&c, sliced);
+    if (sliced) voxdagi_crc_tables_init(&c);
     if (n >= 65536) {
         uint64_t part = n / 48 * 16, i; /* a third, in whole steps */
         uint32_t c1 = 0xFFFFFFFFu, c2 = 0xFFFFFFFFu;
@@ -1107,7 +1145,7 @@ static uint32_t voxdagi_crc32c(const uint8_t *p, uint64_t n) {
         p += 3 * part, n -= 3 * part;
     }
     for (; sliced && n >= 16; n -= 16, p += 16) crc = voxdagi_crc_step(&c, crc, p);
-    while (n--) crc = c.t[0][(crc ^ *p++) & 0xFF] ^ (crc >> 8);
+    while (n--) crc = voxdagi_crc_t0[(crc ^ *p++) & 0xFF] ^ (crc >> 8);
     return ~crc;
 }
 
@@ -1127,8 +1165,9 @@ static unsigned voxdagi_bytes_for(uint64_t v) { /* bytes to hold v, >= 1 */
 // and 0..7 are the eight reflections (a group of their own). T acts the same
 // way on a child octant (bit a: the upper half along axis a) and on each of
 // the two coordinate-bit triples of a Morton position inside a 4^3 brick.
-// Every table below is derived from this definition when it is built, and
-// the tests check them against transforming points.
+// The tables below depend on nothing else, so every DAG and every build
+// shares these constant copies; they were printed from this definition, and
+// the tests derive each entry again from it (test_format.c, "cube tables").
 
 #define VOXDAGI_TRANSFORMS 48
 
@@ -1138,36 +1177,200 @@ typedef struct voxdagi_cube {
     uint8_t inv[VOXDAGI_TRANSFORMS];
 } voxdagi_cube;
 
-/* The permutation numbered P: axis a goes to axis perm[a]. */
-static void voxdagi_perm(unsigned p, unsigned perm[3]) {
-    unsigned n = 0, a, b, c;
-    for (a = 0; a < 3; a++)
-        for (b = 0; b < 3; b++)
-            for (c = 0; c < 3; c++)
-                if (a != b && b != c && a != c && n++ == p) {
-                    perm[0] = a, perm[1] = b, perm[2] = c;
-                    return;
-                }
-}
+static const voxdagi_cube voxdagi_cube_tables = {
+    {/* act */
+     {0, 1, 2, 3, 4, 5, 6, 7}, {1, 0, 3, 2, 5, 4, 7, 6}, {2, 3, 0, 1, 6, 7, 4, 5}, {3, 2, 1, 0, 7, 6, 5, 4},
+     {4, 5, 6, 7, 0, 1, 2, 3}, {5, 4, 7, 6, 1, 0, 3, 2}, {6, 7, 4, 5, 2, 3, 0, 1}, {7, 6, 5, 4, 3, 2, 1, 0},
+     {0, 1, 4, 5, 2, 3, 6, 7}, {1, 0, 5, 4, 3, 2, 7, 6}, {2, 3, 6, 7, 0, 1, 4, 5}, {3, 2, 7, 6, 1, 0, 5, 4},
+     {4, 5, 0, 1, 6, 7, 2, 3}, {5, 4, 1, 0, 7, 6, 3, 2}, {6, 7, 2, 3, 4, 5, 0, 1}, {7, 6, 3, 2, 5, 4, 1, 0},
+     {0, 2, 1, 3, 4, 6, 5, 7}, {1, 3, 0, 2, 5, 7, 4, 6}, {2, 0, 3, 1, 6, 4, 7, 5}, {3, 1, 2, 0, 7, 5, 6, 4},
+     {4, 6, 5, 7, 0, 2, 1, 3}, {5, 7, 4, 6, 1, 3, 0, 2}, {6, 4, 7, 5, 2, 0, 3, 1}, {7, 5, 6, 4, 3, 1, 2, 0},
+     {0, 2, 4, 6, 1, 3, 5, 7}, {1, 3, 5, 7, 0, 2, 4, 6}, {2, 0, 6, 4, 3, 1, 7, 5}, {3, 1, 7, 5, 2, 0, 6, 4},
+     {4, 6, 0, 2, 5, 7, 1, 3}, {5, 7, 1, 3, 4, 6, 0, 2}, {6, 4, 2, 0, 7, 5, 3, 1}, {7, 5, 3, 1, 6, 4, 2, 0},
+     {0, 4, 1, 5, 2, 6, 3, 7}, {1, 5, 0, 4, 3, 7, 2, 6}, {2, 6, 3, 7, 0, 4, 1, 5}, {3, 7, 2, 6, 1, 5, 0, 4},
+     {4, 0, 5, 1, 6, 2, 7, 3}, {5, 1, 4, 0, 7, 3, 6, 2}, {6, 2, 7, 3, 4, 0, 5, 1}, {7, 3, 6, 2, 5, 1, 4, 0},
+     {0, 4, 2, 6, 1, 5, 3, 7}, {1, 5, 3, 7, 0, 4, 2, 6}, {2, 6, 0, 4, 3, 7, 1, 5}, {3, 7, 1, 5, 2, 6, 0, 4},
+     {4, 0, 6, 2, 5, 1, 7, 3}, {5, 1, 7, 3, 4, 0, 6, 2}, {6, 2, 4, 0, 7, 3, 5, 1}, {7, 3, 5, 1, 6, 2, 4, 0}},
+    {/* comp */
+     {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 21, 22, 23,
+      24, 25, 26, 27, 28, 29, 30, 31, 32, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 44, 45, 46, 47},
+     {1, 0, 3, 2, 5, 4, 7, 6, 9, 8, 11, 10, 13, 12, 15, 14, 17, 16, 19, 18, 21, 20, 23, 22,
+      25, 24, 27, 26, 29, 28, 31, 30, 33, 32, 35, 34, 37, 36, 39, 38, 41, 40, 43, 42, 45, 44, 47, 46},
+     {2, 3, 0, 1, 6, 7, 4, 5, 10, 11, 8, 9, 14, 15, 12, 13, 18, 19, 16, 17, 22, 23, 20, 21,
+      26, 27, 24, 25, 30, 31, 28, 29, 34, 35, 32, 33, 38, 39, 36, 37, 42, 43, 40, 41, 46, 47, 44, 45},
+     {3, 2, 1, 0, 7, 6, 5, 4, 11, 10, 9, 8, 15, 14, 13, 12, 19, 18, 17, 16, 23, 22, 21, 20,
+      27, 26, 25, 24, 31, 30, 29, 28, 35, 34, 33, 32, 39, 38, 37, 36, 43, 42, 41, 40, 47, 46, 45, 44},
+     {4, 5, 6, 7, 0, 1, 2, 3, 12, 13, 14, 15, 8, 9, 10, 11, 20, 21, 22, 23, 16, 17, 18, 19,
+      28, 29, 30, 31, 24, 25, 26, 27, 36, 37, 38, 39, 32, 33, 34, 35, 44, 45, 46, 47, 40, 41, 42, 43},
+     {5, 4, 7, 6, 1, 0, 3, 2, 13, 12, 15, 14, 9, 8, 11, 10, 21, 20, 23, 22, 17, 16, 19, 18,
+      29, 28, 31, 30, 25, 24, 27, 26, 37, 36, 39, 38, 33, 32, 35, 34, 45, 44, 47, 46, 41, 40, 43, 42},
+     {6, 7, 4, 5, 2, 3, 0, 1, 14, 15, 12, 13, 10, 11, 8, 9, 22, 23, 20, 21, 18, 19, 16, 17,
+      30, 31, 28, 29, 26, 27, 24, 25, 38, 39, 36, 37, 34, 35, 32, 33, 46, 47, 44, 45, 42, 43, 40, 41},
+     {7, 6, 5, 4, 3, 2, 1, 0, 15, 14, 13, 12, 11, 10, 9, 8, 23, 22, 21, 20, 19, 18, 17, 16,
+      31, 30, 29, 28, 27, 26, 25, 24, 39, 38, 37, 36, 35, 34, 33, 32, 47, 46, 45, 44, 43, 42, 41, 40},
+     {8, 9, 12, 13, 10, 11, 14, 15, 0, 1, 4, 5, 2, 3, 6, 7, 32, 33, 36, 37, 34, 35, 38, 39,
+      40, 41, 44, 45, 42, 43, 46, 47, 16, 17, 20, 21, 18, 19, 22, 23, 24, 25, 28, 29, 26, 27, 30, 31},
+     {9, 8, 13, 12, 11, 10, 15, 14, 1, 0, 5, 4, 3, 2, 7, 6, 33, 32, 37, 36, 35, 34, 39, 38,
+      41, 40, 45, 44, 43, 42, 47, 46, 17, 16, 21, 20, 19, 18, 23, 22, 25, 24, 29, 28, 27, 26, 31, 30},
+     {10, 11, 14, 15, 8, 9, 12, 13, 2, 3, 6, 7, 0, 1, 4, 5, 34, 35, 38, 39, 32, 33, 36, 37,
+      42, 43, 46, 47, 40, 41, 44, 45, 18, 19, 22, 23, 16, 17, 20, 21, 26, 27, 30, 31, 24, 25, 28, 29},
+     {11, 10, 15, 14, 9, 8, 13, 12, 3, 2, 7, 6, 1, 0, 5, 4, 35, 34, 39, 38, 33, 32, 37, 36,
+      43, 42, 47, 46, 41, 40, 45, 44, 19, 18, 23, 22, 17, 16, 21, 20, 27, 26, 31, 30, 25, 24, 29, 28},
+     {12, 13, 8, 9, 14, 15, 10, 11, 4, 5, 0, 1, 6, 7, 2, 3, 36, 37, 32, 33, 38, 39, 34, 35,
+      44, 45, 40, 41, 46, 47, 42, 43, 20, 21, 16, 17, 22, 23, 18, 19, 28, 29, 24, 25, 30, 31, 26, 27},
+     {13, 12, 9, 8, 15, 14, 11, 10, 5, 4, 1, 0, 7, 6, 3, 2, 37, 36, 33, 32, 39, 38, 35, 34,
+      45, 44, 41, 40, 47, 46, 43, 42, 21, 20, 17, 16, 23, 22, 19, 18, 29, 28, 25, 24, 31, 30, 27, 26},
+     {14, 15, 10, 11, 12, 13, 8, 9, 6, 7, 2, 3, 4, 5, 0, 1, 38, 39, 34, 35, 36, 37, 32, 33,
+      46, 47, 42, 43, 44, 45, 40, 41, 22, 23, 18, 19, 20, 21, 16, 17, 30, 31, 26, 27, 28, 29, 24, 25},
+     {15, 14, 11, 10, 13, 12, 9, 8, 7, 6, 3, 2, 5, 4, 1, 0, 39, 38, 35, 34, 37, 36, 33, 32,
+      47, 46, 43, 42, 45, 44, 41, 40, 23, 22, 19, 18, 21, 20, 17, 16, 31, 30, 27, 26, 29, 28, 25, 24},
+     {16, 18, 17, 19, 20, 22, 21, 23, 24, 26, 25, 27, 28, 30, 29, 31, 0, 2, 1, 3, 4, 6, 5, 7,
+      8, 10, 9, 11, 12, 14, 13, 15, 40, 42, 41, 43, 44, 46, 45, 47, 32, 34, 33, 35, 36, 38, 37, 39},
+     {17, 19, 16, 18, 21, 23, 20, 22, 25, 27, 24, 26, 29, 31, 28, 30, 1, 3, 0, 2, 5, 7, 4, 6,
+      9, 11, 8, 10, 13, 15, 12, 14, 41, 43, 40, 42, 45, 47, 44, 46, 33, 35, 32, 34, 37, 39, 36, 38},
+     {18, 16, 19, 17, 22, 20, 23, 21, 26, 24, 27, 25, 30, 28, 31, 29, 2, 0, 3, 1, 6, 4, 7, 5,
+      10, 8, 11, 9, 14, 12, 15, 13, 42, 40, 43, 41, 46, 44, 47, 45, 34, 32, 35, 33, 38, 36, 39, 37},
+     {19, 17, 18, 16, 23, 21, 22, 20, 27, 25, 26, 24, 31, 29, 30, 28, 3, 1, 2, 0, 7, 5, 6, 4,
+      11, 9, 10, 8, 15, 13, 14, 12, 43, 41, 42, 40, 47, 45, 46, 44, 35, 33, 34, 32, 39, 37, 38, 36},
+     {20, 22, 21, 23, 16, 18, 17, 19, 28, 30, 29, 31, 24, 26, 25, 27, 4, 6, 5, 7, 0, 2, 1, 3,
+      12, 14, 13, 15, 8, 10, 9, 11, 44, 46, 45, 47, 40, 42, 41, 43, 36, 38, 37, 39, 32, 34, 33, 35},
+     {21, 23, 20, 22, 17, 19, 16, 18, 29, 31, 28, 30, 25, 27, 24, 26, 5, 7, 4, 6, 1, 3, 0, 2,
+      13, 15, 12, 14, 9, 11, 8, 10, 45, 47, 44, 46, 41, 43, 40, 42, 37, 39, 36, 38, 33, 35, 32, 34},
+     {22, 20, 23, 21, 18, 16, 19, 17, 30, 28, 31, 29, 26, 24, 27, 25, 6, 4, 7, 5, 2, 0, 3, 1,
+      14, 12, 15, 13, 10, 8, 11, 9, 46, 44, 47, 45, 42, 40, 43, 41, 38, 36, 39, 37, 34, 32, 35, 33},
+     {23, 21, 22, 20, 19, 17, 18, 16, 31, 29, 30, 28, 27, 25, 26, 24, 7, 5, 6, 4, 3, 1, 2, 0,
+      15, 13, 14, 12, 11, 9, 10, 8, 47, 45, 46, 44, 43, 41, 42, 40, 39, 37, 38, 36, 35, 33, 34, 32},
+     {24, 26, 28, 30, 25, 27, 29, 31, 16, 18, 20, 22, 17, 19, 21, 23, 40, 42, 44, 46, 41, 43, 45, 47,
+      32, 34, 36, 38, 33, 35, 37, 39, 0, 2, 4, 6, 1, 3, 5, 7, 8, 10, 12, 14, 9, 11, 13, 15},
+     {25, 27, 29, 31, 24, 26, 28, 30, 17, 19, 21, 23, 16, 18, 20, 22, 41, 43, 45, 47, 40, 42, 44, 46,
+      33, 35, 37, 39, 32, 34, 36, 38, 1, 3, 5, 7, 0, 2, 4, 6, 9, 11, 13, 15, 8, 10, 12, 14},
+     {26, 24, 30, 28, 27, 25, 31, 29, 18, 16, 22, 20, 19, 17, 23, 21, 42, 40, 46, 44, 43, 41, 47, 45,
+      34, 32, 38, 36, 35, 33, 39, 37, 2, 0, 6, 4, 3, 1, 7, 5, 10, 8, 14, 12, 11, 9, 15, 13},
+     {27, 25, 31, 29, 26, 24, 30, 28, 19, 17, 23, 21, 18, 16, 22, 20, 43, 41, 47, 45, 42, 40, 46, 44,
+      35, 33, 39, 37, 34, 32, 38, 36, 3, 1, 7, 5, 2, 0, 6, 4, 11, 9, 15, 13, 10, 8, 14, 12},
+     {28, 30, 24, 26, 29, 31, 25, 27, 20, 22, 16, 18, 21, 23, 17, 19, 44, 46, 40, 42, 45, 47, 41, 43,
+      36, 38, 32, 34, 37, 39, 33, 35, 4, 6, 0, 2, 5, 7, 1, 3, 12, 14, 8, 10, 13, 15, 9, 11},
+     {29, 31, 25, 27, 28, 30, 24, 26, 21, 23, 17, 19, 20, 22, 16, 18, 45, 47, 41, 43, 44, 46, 40, 42,
+      37, 39, 33, 35, 36, 38, 32, 34, 5, 7, 1, 3, 4, 6, 0, 2, 13, 15, 9, 11, 12, 14, 8, 10},
+     {30, 28, 26, 24, 31, 29, 27, 25, 22, 20, 18, 16, 23, 21, 19, 17, 46, 44, 42, 40, 47, 45, 43, 41,
+      38, 36, 34, 32, 39, 37, 35, 33, 6, 4, 2, 0, 7, 5, 3, 1, 14, 12, 10, 8, 15, 13, 11, 9},
+     {31, 29, 27, 25, 30, 28, 26, 24, 23, 21, 19, 17, 22, 20, 18, 16, 47, 45, 43, 41, 46, 44, 42, 40,
+      39, 37, 35, 33, 38, 36, 34, 32, 7, 5, 3, 1, 6, 4, 2, 0, 15, 13, 11, 9, 14, 12, 10, 8},
+     {32, 36, 33, 37, 34, 38, 35, 39, 40, 44, 41, 45, 42, 46, 43, 47, 8, 12, 9, 13, 10, 14, 11, 15,
+      0, 4, 1, 5, 2, 6, 3, 7, 24, 28, 25, 29, 26, 30, 27, 31, 16, 20, 17, 21, 18, 22, 19, 23},
+     {33, 37, 32, 36, 35, 39, 34, 38, 41, 45, 40, 44, 43, 47, 42, 46, 9, 13, 8, 12, 11, 15, 10, 14,
+      1, 5, 0, 4, 3, 7, 2, 6, 25, 29, 24, 28, 27, 31, 26, 30, 17, 21, 16, 20, 19, 23, 18, 22},
+     {34, 38, 35, 39, 32, 36, 33, 37, 42, 46, 43, 47, 40, 44, 41, 45, 10, 14, 11, 15, 8, 12, 9, 13,
+      2, 6, 3, 7, 0, 4, 1, 5, 26, 30, 27, 31, 24, 28, 25, 29, 18, 22, 19, 23, 16, 20, 17, 21},
+     {35, 39, 34, 38, 33, 37, 32, 36, 43, 47, 42, 46, 41, 45, 40, 44, 11, 15, 10, 14, 9, 13, 8, 12,
+      3, 7, 2, 6, 1, 5, 0, 4, 27, 31, 26, 30, 25, 29, 24, 28, 19, 23, 18, 22, 17, 21, 16, 20},
+     {36, 32, 37, 33, 38, 34, 39, 35, 44, 40, 45, 41, 46, 42, 47, 43, 12, 8, 13, 9, 14, 10, 15, 11,
+      4, 0, 5, 1, 6, 2, 7, 3, 28, 24, 29, 25, 30, 26, 31, 27, 20, 16, 21, 17, 22, 18, 23, 19},
+     {37, 33, 36, 32, 39, 35, 38, 34, 45, 41, 44, 40, 47, 43, 46, 42, 13, 9, 12, 8, 15, 11, 14, 10,
+      5, 1, 4, 0, 7, 3, 6, 2, 29, 25, 28, 24, 31, 27, 30, 26, 21, 17, 20, 16, 23, 19, 22, 18},
+     {38, 34, 39, 35, 36, 32, 37, 33, 46, 42, 47, 43, 44, 40, 45, 41, 14, 10, 15, 11, 12, 8, 13, 9,
+      6, 2, 7, 3, 4, 0, 5, 1, 30, 26, 31, 27, 28, 24, 29, 25, 22, 18, 23, 19, 20, 16, 21, 17},
+     {39, 35, 38, 34, 37, 33, 36, 32, 47, 43, 46, 42, 45, 41, 44, 40, 15, 11, 14, 10, 13, 9, 12, 8,
+      7, 3, 6, 2, 5, 1, 4, 0, 31, 27, 30, 26, 29, 25, 28, 24, 23, 19, 22, 18, 21, 17, 20, 16},
+     {40, 44, 42, 46, 41, 45, 43, 47, 32, 36, 34, 38, 33, 37, 35, 39, 24, 28, 26, 30, 25, 29, 27, 31,
+      16, 20, 18, 22, 17, 21, 19, 23, 8, 12, 10, 14, 9, 13, 11, 15, 0, 4, 2, 6, 1, 5, 3, 7},
+     {41, 45, 43, 47, 40, 44, 42, 46, 33, 37, 35, 39, 32, 36, 34, 38, 25, 29, 27, 31, 24, 28, 26, 30,
+      17, 21, 19, 23, 16, 20, 18, 22, 9, 13, 11, 15, 8, 12, 10, 14, 1, 5, 3, 7, 0, 4, 2, 6},
+     {42, 46, 40, 44, 43, 47, 41, 45, 34, 38, 32, 36, 35, 39, 33, 37, 26, 30, 24, 28, 27, 31, 25, 29,
+      18, 22, 16, 20, 19, 23, 17, 21, 10, 14, 8, 12, 11, 15, 9, 13, 2, 6, 0, 4, 3, 7, 1, 5},
+     {43, 47, 41, 45, 42, 46, 40, 44, 35, 39, 33, 37, 34, 38, 32, 36, 27, 31, 25, 29, 26, 30, 24, 28,
+      19, 23, 17, 21, 18, 22, 16, 20, 11, 15, 9, 13, 10, 14, 8, 12, 3, 7, 1, 5, 2, 6, 0, 4},
+     {44, 40, 46, 42, 45, 41, 47, 43, 36, 32, 38, 34, 37, 33, 39, 35, 28, 24, 30, 26, 29, 25, 31, 27,
+      20, 16, 22, 18, 21, 17, 23, 19, 12, 8, 14, 10, 13, 9, 15, 11, 4, 0, 6, 2, 5, 1, 7, 3},
+     {45, 41, 47, 43, 44, 40, 46, 42, 37, 33, 39, 35, 36, 32, 38, 34, 29, 25, 31, 27, 28, 24, 30, 26,
+      21, 17, 23, 19, 20, 16, 22, 18, 13, 9, 15, 11, 12, 8, 14, 10, 5, 1, 7, 3, 4, 0, 6, 2},
+     {46, 42, 44, 40, 47, 43, 45, 41, 38, 34, 36, 32, 39, 35, 37, 33, 30, 26, 28, 24, 31, 27, 29, 25,
+      22, 18, 20, 16, 23, 19, 21, 17, 14, 10, 12, 8, 15, 11, 13, 9, 6, 2, 4, 0, 7, 3, 5, 1},
+     {47, 43, 45, 41, 46, 42, 44, 40, 39, 35, 37, 33, 38, 34, 36, 32, 31, 27, 29, 25, 30, 26, 28, 24,
+      23, 19, 21, 17, 22, 18, 20, 16, 15, 11, 13, 9, 14, 10, 12, 8, 7, 3, 5, 1, 6, 2, 4, 0}},
+    {/* inv */
+     0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15, 16, 18, 17, 19, 20, 22, 21, 23,
+     32, 36, 33, 37, 34, 38, 35, 39, 24, 26, 28, 30, 25, 27, 29, 31, 40, 44, 42, 46, 41, 45, 43, 47}};
 
-static unsigned voxdagi_permute_bits(unsigned x, const unsigned perm[3]) {
-    return (x & 1) << perm[0] | (x >> 1 & 1) << perm[1] | (x >> 2 & 1) << perm[2];
-}
-
-static void voxdagi_cube_init(voxdagi_cube *c) {
-    unsigned perm[6][3], tf, ta, tb, i, k;
-    for (ta = 0; ta < 6; ta++) voxdagi_perm(ta, perm[ta]);
-    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++)
-        for (i = 0; i < 8; i++) c->act[tf][i] = (uint8_t)(voxdagi_permute_bits(i, perm[tf >> 3]) ^ (tf & 7));
-    for (ta = 0; ta < VOXDAGI_TRANSFORMS; ta++)
-        for (tb = 0; tb < VOXDAGI_TRANSFORMS; tb++) {
-            unsigned pc[3], p;
-            for (k = 0; k < 3; k++) pc[k] = perm[ta >> 3][perm[tb >> 3][k]];
-            for (p = 0; memcmp(perm[p], pc, sizeof pc); p++) {}
-            c->comp[ta][tb] = (uint8_t)(p << 3 | (voxdagi_permute_bits(tb & 7, perm[ta >> 3]) ^ (ta & 7)));
-            if (c->comp[ta][tb] == 0) c->inv[ta] = (uint8_t)tb;
-        }
-}
+/* voxdagi_occupancy[MI][p]: the world octants w holding a child, for stored
+   presence P seen through world-to-stored transform MI (w is full when MI(w)
+   is: bit w of the entry is bit MI(w) of P). Each row is given by its
+   entries for P below 16 and for P = 16 h, and an entry is the OR of the
+   entries of P's two nibbles (a bit permutation is linear). */
+#define VOXDAGI_OCCUPANCY_ROWS(X) \
+    X(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15,  0, 16, 32, 48, 64, 80, 96, 112, 128, 144, 160, 176, 192, 208, 224, 240) \
+    X(0, 2, 1, 3, 8, 10, 9, 11, 4, 6, 5, 7, 12, 14, 13, 15,  0, 32, 16, 48, 128, 160, 144, 176, 64, 96, 80, 112, 192, 224, 208, 240) \
+    X(0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15,  0, 64, 128, 192, 16, 80, 144, 208, 32, 96, 160, 224, 48, 112, 176, 240) \
+    X(0, 8, 4, 12, 2, 10, 6, 14, 1, 9, 5, 13, 3, 11, 7, 15,  0, 128, 64, 192, 32, 160, 96, 224, 16, 144, 80, 208, 48, 176, 112, 240) \
+    X(0, 16, 32, 48, 64, 80, 96, 112, 128, 144, 160, 176, 192, 208, 224, 240,  0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15) \
+    X(0, 32, 16, 48, 128, 160, 144, 176, 64, 96, 80, 112, 192, 224, 208, 240,  0, 2, 1, 3, 8, 10, 9, 11, 4, 6, 5, 7, 12, 14, 13, 15) \
+    X(0, 64, 128, 192, 16, 80, 144, 208, 32, 96, 160, 224, 48, 112, 176, 240,  0, 4, 8, 12, 1, 5, 9, 13, 2, 6, 10, 14, 3, 7, 11, 15) \
+    X(0, 128, 64, 192, 32, 160, 96, 224, 16, 144, 80, 208, 48, 176, 112, 240,  0, 8, 4, 12, 2, 10, 6, 14, 1, 9, 5, 13, 3, 11, 7, 15) \
+    X(0, 1, 2, 3, 16, 17, 18, 19, 32, 33, 34, 35, 48, 49, 50, 51,  0, 4, 8, 12, 64, 68, 72, 76, 128, 132, 136, 140, 192, 196, 200, 204) \
+    X(0, 2, 1, 3, 32, 34, 33, 35, 16, 18, 17, 19, 48, 50, 49, 51,  0, 8, 4, 12, 128, 136, 132, 140, 64, 72, 68, 76, 192, 200, 196, 204) \
+    X(0, 16, 32, 48, 1, 17, 33, 49, 2, 18, 34, 50, 3, 19, 35, 51,  0, 64, 128, 192, 4, 68, 132, 196, 8, 72, 136, 200, 12, 76, 140, 204) \
+    X(0, 32, 16, 48, 2, 34, 18, 50, 1, 33, 17, 49, 3, 35, 19, 51,  0, 128, 64, 192, 8, 136, 72, 200, 4, 132, 68, 196, 12, 140, 76, 204) \
+    X(0, 4, 8, 12, 64, 68, 72, 76, 128, 132, 136, 140, 192, 196, 200, 204,  0, 1, 2, 3, 16, 17, 18, 19, 32, 33, 34, 35, 48, 49, 50, 51) \
+    X(0, 8, 4, 12, 128, 136, 132, 140, 64, 72, 68, 76, 192, 200, 196, 204,  0, 2, 1, 3, 32, 34, 33, 35, 16, 18, 17, 19, 48, 50, 49, 51) \
+    X(0, 64, 128, 192, 4, 68, 132, 196, 8, 72, 136, 200, 12, 76, 140, 204,  0, 16, 32, 48, 1, 17, 33, 49, 2, 18, 34, 50, 3, 19, 35, 51) \
+    X(0, 128, 64, 192, 8, 136, 72, 200, 4, 132, 68, 196, 12, 140, 76, 204,  0, 32, 16, 48, 2, 34, 18, 50, 1, 33, 17, 49, 3, 35, 19, 51) \
+    X(0, 1, 4, 5, 2, 3, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15,  0, 16, 64, 80, 32, 48, 96, 112, 128, 144, 192, 208, 160, 176, 224, 240) \
+    X(0, 4, 1, 5, 8, 12, 9, 13, 2, 6, 3, 7, 10, 14, 11, 15,  0, 64, 16, 80, 128, 192, 144, 208, 32, 96, 48, 112, 160, 224, 176, 240) \
+    X(0, 2, 8, 10, 1, 3, 9, 11, 4, 6, 12, 14, 5, 7, 13, 15,  0, 32, 128, 160, 16, 48, 144, 176, 64, 96, 192, 224, 80, 112, 208, 240) \
+    X(0, 8, 2, 10, 4, 12, 6, 14, 1, 9, 3, 11, 5, 13, 7, 15,  0, 128, 32, 160, 64, 192, 96, 224, 16, 144, 48, 176, 80, 208, 112, 240) \
+    X(0, 16, 64, 80, 32, 48, 96, 112, 128, 144, 192, 208, 160, 176, 224, 240,  0, 1, 4, 5, 2, 3, 6, 7, 8, 9, 12, 13, 10, 11, 14, 15) \
+    X(0, 64, 16, 80, 128, 192, 144, 208, 32, 96, 48, 112, 160, 224, 176, 240,  0, 4, 1, 5, 8, 12, 9, 13, 2, 6, 3, 7, 10, 14, 11, 15) \
+    X(0, 32, 128, 160, 16, 48, 144, 176, 64, 96, 192, 224, 80, 112, 208, 240,  0, 2, 8, 10, 1, 3, 9, 11, 4, 6, 12, 14, 5, 7, 13, 15) \
+    X(0, 128, 32, 160, 64, 192, 96, 224, 16, 144, 48, 176, 80, 208, 112, 240,  0, 8, 2, 10, 4, 12, 6, 14, 1, 9, 3, 11, 5, 13, 7, 15) \
+    X(0, 1, 16, 17, 2, 3, 18, 19, 32, 33, 48, 49, 34, 35, 50, 51,  0, 4, 64, 68, 8, 12, 72, 76, 128, 132, 192, 196, 136, 140, 200, 204) \
+    X(0, 16, 1, 17, 32, 48, 33, 49, 2, 18, 3, 19, 34, 50, 35, 51,  0, 64, 4, 68, 128, 192, 132, 196, 8, 72, 12, 76, 136, 200, 140, 204) \
+    X(0, 2, 32, 34, 1, 3, 33, 35, 16, 18, 48, 50, 17, 19, 49, 51,  0, 8, 128, 136, 4, 12, 132, 140, 64, 72, 192, 200, 68, 76, 196, 204) \
+    X(0, 32, 2, 34, 16, 48, 18, 50, 1, 33, 3, 35, 17, 49, 19, 51,  0, 128, 8, 136, 64, 192, 72, 200, 4, 132, 12, 140, 68, 196, 76, 204) \
+    X(0, 4, 64, 68, 8, 12, 72, 76, 128, 132, 192, 196, 136, 140, 200, 204,  0, 1, 16, 17, 2, 3, 18, 19, 32, 33, 48, 49, 34, 35, 50, 51) \
+    X(0, 64, 4, 68, 128, 192, 132, 196, 8, 72, 12, 76, 136, 200, 140, 204,  0, 16, 1, 17, 32, 48, 33, 49, 2, 18, 3, 19, 34, 50, 35, 51) \
+    X(0, 8, 128, 136, 4, 12, 132, 140, 64, 72, 192, 200, 68, 76, 196, 204,  0, 2, 32, 34, 1, 3, 33, 35, 16, 18, 48, 50, 17, 19, 49, 51) \
+    X(0, 128, 8, 136, 64, 192, 72, 200, 4, 132, 12, 140, 68, 196, 76, 204,  0, 32, 2, 34, 16, 48, 18, 50, 1, 33, 3, 35, 17, 49, 19, 51) \
+    X(0, 1, 4, 5, 16, 17, 20, 21, 64, 65, 68, 69, 80, 81, 84, 85,  0, 2, 8, 10, 32, 34, 40, 42, 128, 130, 136, 138, 160, 162, 168, 170) \
+    X(0, 4, 1, 5, 64, 68, 65, 69, 16, 20, 17, 21, 80, 84, 81, 85,  0, 8, 2, 10, 128, 136, 130, 138, 32, 40, 34, 42, 160, 168, 162, 170) \
+    X(0, 16, 64, 80, 1, 17, 65, 81, 4, 20, 68, 84, 5, 21, 69, 85,  0, 32, 128, 160, 2, 34, 130, 162, 8, 40, 136, 168, 10, 42, 138, 170) \
+    X(0, 64, 16, 80, 4, 68, 20, 84, 1, 65, 17, 81, 5, 69, 21, 85,  0, 128, 32, 160, 8, 136, 40, 168, 2, 130, 34, 162, 10, 138, 42, 170) \
+    X(0, 2, 8, 10, 32, 34, 40, 42, 128, 130, 136, 138, 160, 162, 168, 170,  0, 1, 4, 5, 16, 17, 20, 21, 64, 65, 68, 69, 80, 81, 84, 85) \
+    X(0, 8, 2, 10, 128, 136, 130, 138, 32, 40, 34, 42, 160, 168, 162, 170,  0, 4, 1, 5, 64, 68, 65, 69, 16, 20, 17, 21, 80, 84, 81, 85) \
+    X(0, 32, 128, 160, 2, 34, 130, 162, 8, 40, 136, 168, 10, 42, 138, 170,  0, 16, 64, 80, 1, 17, 65, 81, 4, 20, 68, 84, 5, 21, 69, 85) \
+    X(0, 128, 32, 160, 8, 136, 40, 168, 2, 130, 34, 162, 10, 138, 42, 170,  0, 64, 16, 80, 4, 68, 20, 84, 1, 65, 17, 81, 5, 69, 21, 85) \
+    X(0, 1, 16, 17, 4, 5, 20, 21, 64, 65, 80, 81, 68, 69, 84, 85,  0, 2, 32, 34, 8, 10, 40, 42, 128, 130, 160, 162, 136, 138, 168, 170) \
+    X(0, 16, 1, 17, 64, 80, 65, 81, 4, 20, 5, 21, 68, 84, 69, 85,  0, 32, 2, 34, 128, 160, 130, 162, 8, 40, 10, 42, 136, 168, 138, 170) \
+    X(0, 4, 64, 68, 1, 5, 65, 69, 16, 20, 80, 84, 17, 21, 81, 85,  0, 8, 128, 136, 2, 10, 130, 138, 32, 40, 160, 168, 34, 42, 162, 170) \
+    X(0, 64, 4, 68, 16, 80, 20, 84, 1, 65, 5, 69, 17, 81, 21, 85,  0, 128, 8, 136, 32, 160, 40, 168, 2, 130, 10, 138, 34, 162, 42, 170) \
+    X(0, 2, 32, 34, 8, 10, 40, 42, 128, 130, 160, 162, 136, 138, 168, 170,  0, 1, 16, 17, 4, 5, 20, 21, 64, 65, 80, 81, 68, 69, 84, 85) \
+    X(0, 32, 2, 34, 128, 160, 130, 162, 8, 40, 10, 42, 136, 168, 138, 170,  0, 16, 1, 17, 64, 80, 65, 81, 4, 20, 5, 21, 68, 84, 69, 85) \
+    X(0, 8, 128, 136, 2, 10, 130, 138, 32, 40, 160, 168, 34, 42, 162, 170,  0, 4, 64, 68, 1, 5, 65, 69, 16, 20, 80, 84, 17, 21, 81, 85) \
+    X(0, 128, 8, 136, 32, 160, 40, 168, 2, 130, 10, 138, 34, 162, 42, 170,  0, 64, 4, 68, 16, 80, 20, 84, 1, 65, 5, 69, 17, 81, 21, 85)
+#define VOXDAGI_OCC16(h, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15) \
+    h | l0, h | l1, h | l2, h | l3, h | l4, h | l5, h | l6, h | l7, h | l8, h | l9, h | l10, h | l11, h | l12, \
+        h | l13, h | l14, h | l15
+#define VOXDAGI_OCC_ROW(l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15, h0, h1, h2, h3, h4, \
+                        h5, h6, h7, h8, h9, h10, h11, h12, h13, h14, h15) \
+    {VOXDAGI_OCC16(h0, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h1, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h2, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h3, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h4, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h5, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h6, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h7, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h8, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h9, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h10, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h11, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h12, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h13, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h14, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15), \
+     VOXDAGI_OCC16(h15, l0, l1, l2, l3, l4, l5, l6, l7, l8, l9, l10, l11, l12, l13, l14, l15)},
+static const uint8_t voxdagi_occupancy[VOXDAGI_TRANSFORMS][256] = {VOXDAGI_OCCUPANCY_ROWS(VOXDAGI_OCC_ROW)};
+#undef VOXDAGI_OCC_ROW
+#undef VOXDAGI_OCC16
+#undef VOXDAGI_OCCUPANCY_ROWS
 
 #ifndef VOXDAG_NO_BUILD /* the builder, the voxelizer (up to the file image assembly) */
 
@@ -1294,7 +1497,6 @@ static uint32_t voxdagi_store_intern(voxdagi_mem *m, voxdagi_store *s, int inner
 /* The transforms a build shares nodes under (0..count-1: 1 for none, the 8
    reflections, or all 48), and the tables canonicalization uses. */
 typedef struct voxdagi_group {
-    voxdagi_cube cube;
     uint8_t src[VOXDAGI_TRANSFORMS][8];      /* octant whose child lands in slot i: T^-1(i) */
     uint8_t mask8[VOXDAGI_TRANSFORMS][256];  /* a child-presence mask seen through T */
     uint8_t least[256];                      /* per presence mask: its smallest image in the group */
@@ -1304,12 +1506,11 @@ typedef struct voxdagi_group {
 
 static void voxdagi_group_init(voxdagi_group *g, voxdag_symmetry symmetry) {
     unsigned tf, x, i;
-    voxdagi_cube_init(&g->cube);
     for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
-        for (i = 0; i < 8; i++) g->src[tf][i] = g->cube.act[g->cube.inv[tf]][i];
+        for (i = 0; i < 8; i++) g->src[tf][i] = voxdagi_cube_tables.act[voxdagi_cube_tables.inv[tf]][i];
         for (x = 0; x < 256; x++) {
             unsigned y = 0;
-            for (i = 0; i < 8; i++) y |= (x >> i & 1) << g->cube.act[tf][i];
+            for (i = 0; i < 8; i++) y |= (x >> i & 1) << voxdagi_cube_tables.act[tf][i];
             g->mask8[tf][x] = (uint8_t)y;
         }
     }
@@ -1378,9 +1579,9 @@ static voxdagi_canon voxdagi_canon_brick(const voxdagi_group *g, uint64_t mask) 
     }
     best = voxdagi_lowest_bit(cand);
     c.key = voxdagi_transform_brick(g, mask, best);
-    c.tag = g->cube.inv[best];
+    c.tag = voxdagi_cube_tables.inv[best];
     c.stab = 0;
-    for (; cand; cand &= cand - 1) c.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(cand)][c.tag];
+    for (; cand; cand &= cand - 1) c.stab |= 1ull << voxdagi_cube_tables.comp[voxdagi_lowest_bit(cand)][c.tag];
     return c;
 }
 
@@ -1405,8 +1606,8 @@ static int voxdagi_compare_transforms(const voxdagi_group *g, const voxdagi_chil
         unsigned ja = g->src[a][i], jb = g->src[b][i], ta, tb;
         if (!(present >> i & 1)) continue;
         if (c->fp[ja] != c->fp[jb]) return c->fp[ja] < c->fp[jb] ? -1 : 1;
-        ta = voxdagi_normalize(&g->cube, g->cube.comp[a][c->tag[ja]], c->stab[ja]);
-        tb = voxdagi_normalize(&g->cube, g->cube.comp[b][c->tag[jb]], c->stab[jb]);
+        ta = voxdagi_normalize(&voxdagi_cube_tables, voxdagi_cube_tables.comp[a][c->tag[ja]], c->stab[ja]);
+        tb = voxdagi_normalize(&voxdagi_cube_tables, voxdagi_cube_tables.comp[b][c->tag[jb]], c->stab[jb]);
         if (ta != tb) return ta < tb ? -1 : 1;
         if (c->id[ja] != c->id[jb]) return c->id[ja] < c->id[jb] ? -1 : 1;
     }
@@ -1428,14 +1629,14 @@ static voxdagi_canon voxdagi_canon_node(const voxdagi_group *g, const voxdagi_ch
         if (order < 0) best = tf, tie = 0;
         if (order <= 0) tie |= 1ull << tf;
     }
-    r.tag = g->cube.inv[best];
+    r.tag = voxdagi_cube_tables.inv[best];
     r.stab = 0;
-    for (; tie; tie &= tie - 1) r.stab |= 1ull << g->cube.comp[voxdagi_lowest_bit(tie)][r.tag];
+    for (; tie; tie &= tie - 1) r.stab |= 1ull << voxdagi_cube_tables.comp[voxdagi_lowest_bit(tie)][r.tag];
     for (i = 0; i < 8; i++) {
         unsigned j = g->src[best][i], t;
         uint64_t v = 0;
         if (best_present >> i & 1) {
-            t = voxdagi_normalize(&g->cube, g->cube.comp[best][c->tag[j]], c->stab[j]);
+            t = voxdagi_normalize(&voxdagi_cube_tables, voxdagi_cube_tables.comp[best][c->tag[j]], c->stab[j]);
             slots[i] = c->id[j] << 6 | t;
             v = c->fp[j] + (uint64_t)(t + 1) * 0xD6E8FEB86659FD93ull;
         } else {
@@ -1635,9 +1836,12 @@ static void voxdagi_reducer_finish(voxdagi_reducer *r) {
 
 /* Sorts CODE (and RGB, packed 0xRRGGBB, when non-NULL) by the low BITS bits
    of the codes, stably. TMP_CODE/TMP_RGB hold N elements each. */
+#define VOXDAGI_RADIX_BITS 11
+#define VOXDAGI_RADIX_BUCKETS (1u << VOXDAGI_RADIX_BITS)
+
 static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code,
                                uint32_t *tmp_rgb, size_t n, unsigned bits) {
-    enum { radix_bits = 11, radix_buckets = 1 << radix_bits };
+    enum { radix_bits = VOXDAGI_RADIX_BITS, radix_buckets = VOXDAGI_RADIX_BUCKETS };
     size_t count[radix_buckets];
     unsigned shift;
     for (shift = 0; shift < bits; shift += radix_bits) {
@@ -1949,6 +2153,83 @@ static void voxdagi_run_parallel(voxdag_builder *b, void *(*fn)(void *), void *j
     voxdagi_batch_wait(b);
 }
 
+/* One job of a parallel radix sort pass: counts the digits of elements
+   [begin, end) (COUNT: radix_buckets entries), or, once COUNT holds each
+   digit's first destination for this slice, moves them there. */
+typedef struct voxdagi_sort_job {
+    const uint64_t *code;
+    const uint32_t *rgb;
+    uint64_t *to_code;
+    uint32_t *to_rgb;
+    size_t begin, end, *count;
+    unsigned shift;
+    int scatter;
+} voxdagi_sort_job;
+
+static void *voxdagi_sort_run(void *arg) {
+    voxdagi_sort_job *j = (voxdagi_sort_job *)arg;
+    const uint64_t mask = VOXDAGI_RADIX_BUCKETS - 1;
+    size_t i;
+    if (!j->scatter) {
+        memset(j->count, 0, VOXDAGI_RADIX_BUCKETS * sizeof *j->count);
+        for (i = j->begin; i < j->end; i++) j->count[(j->code[i] >> j->shift) & mask]++;
+        return NULL;
+    }
+    for (i = j->begin; i < j->end; i++) {
+        size_t d = j->count[(j->code[i] >> j->shift) & mask]++;
+        j->to_code[d] = j->code[i];
+        if (j->rgb) j->to_rgb[d] = j->rgb[i];
+    }
+    return NULL;
+}
+
+/* voxdagi_radix_sort on the builder's threads: each pass counts, then moves,
+   one slice of the elements per job, every slice's elements of a digit
+   placed after those of the slices before it, so the order is the serial
+   sort's (a stable sort has one result) whatever the thread count. Serial
+   with one thread, for small inputs, or when the counts cannot be
+   allocated. */
+static void voxdagi_sort(voxdag_builder *b, uint64_t *code, uint32_t *rgb, uint64_t *tmp_code, uint32_t *tmp_rgb,
+                         size_t n, unsigned bits) {
+    voxdagi_sort_job job[VOXDAGI_MAX_THREADS];
+    unsigned jobs = b->threads, t, shift;
+    size_t *count = NULL, d, sum;
+    if (jobs > 1 && n >= (1u << 16)) /* below, the batches would cost more than they save */
+        count = (size_t *)voxdagi_alloc(&b->mem, jobs * VOXDAGI_RADIX_BUCKETS * sizeof *count);
+    if (!count) {
+        voxdagi_radix_sort(code, rgb, tmp_code, tmp_rgb, n, bits);
+        return;
+    }
+    for (shift = 0; shift < bits; shift += VOXDAGI_RADIX_BITS) {
+        uint64_t *c;
+        uint32_t *r;
+        for (t = 0; t < jobs; t++) {
+            job[t].code = code, job[t].rgb = rgb, job[t].to_code = tmp_code, job[t].to_rgb = tmp_rgb;
+            job[t].begin = n / jobs * t;
+            job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
+            job[t].count = count + (size_t)t * VOXDAGI_RADIX_BUCKETS;
+            job[t].shift = shift;
+            job[t].scatter = 0;
+        }
+        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        for (d = 0, sum = 0; d < VOXDAGI_RADIX_BUCKETS; d++) /* digit by digit, slices in order */
+            for (t = 0; t < jobs; t++) {
+                size_t k = job[t].count[d];
+                job[t].count[d] = sum;
+                sum += k;
+            }
+        for (t = 0; t < jobs; t++) job[t].scatter = 1;
+        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        c = code; code = tmp_code; tmp_code = c;
+        r = rgb; rgb = tmp_rgb; tmp_rgb = r;
+    }
+    if (((bits + VOXDAGI_RADIX_BITS - 1) / VOXDAGI_RADIX_BITS) & 1) { /* odd pass count: the result is in tmp */
+        memcpy(tmp_code, code, n * sizeof *code);
+        if (rgb) memcpy(tmp_rgb, rgb, n * sizeof *rgb);
+    }
+    voxdagi_free(&b->mem, count, jobs * VOXDAGI_RADIX_BUCKETS * sizeof *count);
+}
+
 /* Morton encoding and checks of voxels [begin, end) of an add call. */
 typedef struct voxdagi_encode_job {
     const voxdag_builder *b;
@@ -2127,8 +2408,8 @@ static void *voxdagi_worker_run(void *arg) {
 }
 
 /* The reference "T applied to reference REF": the same node, tag T o t. */
-static uint32_t voxdagi_ref_compose(const voxdagi_group *g, unsigned tf, uint32_t ref) {
-    return (ref & ~63u) | g->cube.comp[tf][ref & 63];
+static uint32_t voxdagi_ref_compose(unsigned tf, uint32_t ref) {
+    return (ref & ~63u) | voxdagi_cube_tables.comp[tf][ref & 63];
 }
 
 /* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
@@ -2152,7 +2433,7 @@ static int voxdagi_merge(voxdagi_reducer *r, voxdagi_reducer *w, uint32_t **map,
                         c[j] = x;
                         continue;
                     }
-                    c[j] = voxdagi_ref_compose(r->group, x & 63, map[l + 1][x >> 6]);
+                    c[j] = voxdagi_ref_compose(x & 63, map[l + 1][x >> 6]);
                     same |= map[l + 1][x >> 6] & 63;
                 }
             if (!same) {
@@ -2246,7 +2527,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
                 st = VOXDAG_ERR_OUT_OF_MEMORY;
             for (p = 0; p < worker[t].piece_count && st == VOXDAG_OK; p++) {
                 uint32_t x = worker[t].piece[p].root[k];
-                worker[t].piece[p].root[k] = voxdagi_ref_compose(b->red[k].group, x & 63, map[split][x >> 6]);
+                worker[t].piece[p].root[k] = voxdagi_ref_compose(x & 63, map[split][x >> 6]);
             }
             for (i = 0; i < VOXDAG_MAX_LEVELS; i++) voxdagi_free(&b->mem, map[i], map_size[i]);
         }
@@ -2326,7 +2607,7 @@ static voxdag_status voxdagi_builder_reduce(voxdag_builder *b, int final) {
             voxdagi_free(&b->mem, tr, rgb_size);
             return VOXDAG_ERR_OUT_OF_MEMORY;
         }
-        voxdagi_radix_sort(code, rgb, tc, tr, n, 3 * b->levels);
+        voxdagi_sort(b, code, rgb, tc, tr, n, 3 * b->levels);
         voxdagi_free(&b->mem, tc, n * sizeof *tc);
         voxdagi_free(&b->mem, tr, rgb_size);
     }
@@ -3207,7 +3488,7 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
    to child reference X (id << 6 | t) of level L + 1: RP o t o s o RC^-1 for
    s in the child's stabilizer, the smallest of them. */
 static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigned rp, uint32_t x) {
-    const voxdagi_cube *c = &e->group->cube;
+    const voxdagi_cube *c = &voxdagi_cube_tables;
     unsigned u = c->comp[rp][x & 63], rc_inv = c->inv[e->orient[l + 1][x >> 6]];
     unsigned best = c->comp[u][rc_inv];
     uint64_t stabs = e->r->store[l + 1].node[x >> 6].stab & ~1ull;
@@ -3225,7 +3506,7 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
    RP o t o S(n). The references into a level are gathered per node first. */
 static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
-    const voxdagi_cube *c = &e->group->cube;
+    const voxdagi_cube *c = &voxdagi_cube_tables;
     uint32_t brick_level = e->levels - 2, l;
     uint64_t votes[VOXDAGI_TRANSFORMS];
     for (l = 0; l <= brick_level; l++) {
@@ -3319,7 +3600,7 @@ static int voxdagi_is_private(const voxdagi_encoder *e, uint32_t l, uint32_t x) 
 static void voxdagi_stored_children(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint32_t child[8],
                                     unsigned tag[8]) {
     const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
-    const uint8_t *act = e->group->cube.act[e->orient[l][id]];
+    const uint8_t *act = voxdagi_cube_tables.act[e->orient[l][id]];
     unsigned j;
     for (j = 0; j < 8; j++) child[j] = VOXDAGI_NONE, tag[j] = 0;
     for (j = 0; j < 8; j++)
@@ -3344,7 +3625,7 @@ static uint64_t voxdagi_private_base(const voxdagi_encoder *e, uint32_t l, uint3
 static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id, uint8_t *p) {
     const voxdagi_classes *cls = &e->cls[l];
     const uint32_t *ch = e->r->store[l].child + 8 * (size_t)id;
-    const uint8_t *act = e->group->cube.act[e->orient[l][id]], *tags = e->tag[l] + 8 * (size_t)id;
+    const uint8_t *act = voxdagi_cube_tables.act[e->orient[l][id]], *tags = e->tag[l] + 8 * (size_t)id;
     uint64_t target[8], bits = 16 + e->count_bits[l], base = voxdagi_private_base(e, l, id);
     unsigned code[8], present = 0, private_children = 0, header = 0, j, s;
     for (j = 0; j < 8; j++) { /* canonical child j sits in stored octant R(j) */
@@ -3559,7 +3840,7 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
         ok = voxdagi_orient(e);
     }
     if (ok) { /* the root's transform: world = root tag o R^-1 (stored root) */
-        const voxdagi_cube *c = &e->group->cube;
+        const voxdagi_cube *c = &voxdagi_cube_tables;
         uint32_t x = r->root;
         unsigned best = c->comp[x & 63][c->inv[e->orient[0][x >> 6]]];
         uint64_t stabs = r->store[0].node[x >> 6].stab;
@@ -3645,7 +3926,8 @@ struct voxdag {
     voxdag_symmetry symmetry;
     uint64_t voxels;
     uint32_t voxel_box[6];
-    voxdagi_level level[VOXDAG_MAX_LEVELS]; /* inner levels 0..L-3 */
+    voxdagi_level *level;         /* inner levels 0..L-3: L - 2 of them, sized by the file */
+    uint32_t level_count;         /* entries allocated in LEVEL */
     uint64_t node_bytes;
     const uint8_t *bricks;
     uint64_t brick_count;
@@ -3654,8 +3936,6 @@ struct voxdag {
     uint64_t color_size;
     int has_bounds;
     double bounds[6];
-    voxdagi_cube cube;
-    uint8_t occupancy[VOXDAGI_TRANSFORMS][256]; /* [MI][stored presence]: world presence */
 #ifdef VOXDAGI_VOXCOLOR
     voxcolor_view color_view; /* the voxcolor colour section, validated */
 #endif
@@ -3672,6 +3952,7 @@ VOXDAG_API void voxdag_free(voxdag *dag) {
     if (!dag) return;
     a = dag->alloc;
     voxdagi_release(&a, dag->owned, dag->owned_size);
+    voxdagi_release(&a, dag->level, dag->level_count * sizeof *dag->level);
     voxdagi_release(&a, dag, sizeof *dag);
 }
 
@@ -3693,25 +3974,12 @@ static unsigned voxdagi_presence(unsigned header) {
 /* A stored brick mask seen through world-to-stored transform MI, in world
    order: byte w of the result (the 2^3 cell w) is stored byte MI(w) with its
    bits mapped the same way; branch-free, one table lookup a byte. */
-VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(const voxdag *d, uint64_t mask, unsigned mi) {
-    const uint8_t *to_stored = d->cube.act[mi], *occ = d->occupancy[mi];
+VOXDAGI_INLINE uint64_t voxdagi_brick_to_world(uint64_t mask, unsigned mi) {
+    const uint8_t *to_stored = voxdagi_cube_tables.act[mi], *occ = voxdagi_occupancy[mi];
     uint64_t w = 0;
     unsigned k;
     for (k = 0; k < 8; k++) w |= (uint64_t)occ[(mask >> 8 * to_stored[k]) & 0xFF] << 8 * k;
     return w;
-}
-
-/* occupancy[MI][p]: the world octants w holding a child, for stored presence
-   P seen through world-to-stored transform MI (w is full when MI(w) is). */
-static void voxdagi_occupancy_init(voxdag *d) {
-    unsigned tf, i, k;
-    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
-        uint8_t *occ = d->occupancy[tf], world[8]; /* world[i]: the world octant of stored octant i, as a bit */
-        for (i = 0; i < 8; i++) world[d->cube.act[tf][i]] = (uint8_t)(1u << i);
-        occ[0] = 0;
-        for (i = 0; i < 8; i++) /* the presences below 2^(i+1) from those below 2^i */
-            for (k = 0; k < 1u << i; k++) occ[(1u << i) + k] = (uint8_t)(occ[k] | world[i]);
-    }
 }
 
 /* Whether a record with HEADER has private children (then its base field
@@ -3721,12 +3989,11 @@ VOXDAGI_INLINE unsigned voxdagi_has_private(unsigned header) { return (header & 
 /* Fills LV->ptr_bits from its pointer widths: for each header byte, the sum
    of the widths of its four tags. */
 static void voxdagi_ptr_bits_init(voxdagi_level *lv) {
-    unsigned b, i;
-    for (b = 0; b < 256; b++) {
-        unsigned n = 0;
-        for (i = 0; i < 4; i++) n += lv->width[b >> (2 * i) & 3];
-        lv->ptr_bits[b] = (uint8_t)n; /* 4 x 57 < 256 */
-    }
+    uint8_t two[16]; /* two tags */
+    unsigned h, l;
+    for (l = 0; l < 16; l++) two[l] = (uint8_t)(lv->width[l & 3] + lv->width[l >> 2]);
+    for (h = 0; h < 16; h++)
+        for (l = 0; l < 16; l++) lv->ptr_bits[16 * h + l] = (uint8_t)(two[h] + two[l]); /* 4 x 57 < 256 */
 }
 
 /* Bit offset of child octant S's pointer inside a record with HEADER: the
@@ -4025,12 +4292,12 @@ static const char *voxdagi_validate_level(const voxdag *d, uint32_t l, voxdagi_v
    8; the pointer loop then takes one tag after the other, with no search for
    the next present octant on its critical path. */
 static void voxdagi_tag_seq_init(uint16_t tag_seq[256]) {
-    unsigned b, k;
-    for (b = 0; b < 256; b++) {
-        unsigned seq = 0, n = 0;
-        for (k = 0; k < 4; k++)
-            if (b >> (2 * k) & 3) seq |= (b >> (2 * k) & 3) << (2 * n++);
-        tag_seq[b] = (uint16_t)(seq | n << 9);
+    unsigned b;
+    for (b = 0; b < 16; b++) /* two tags: the upper one moves down when the lower is 0 */
+        tag_seq[b] = (uint16_t)((b & 3 ? b : b >> 2) | ((unsigned)((b & 3) != 0) + (unsigned)(b > 3)) << 9);
+    for (b = 16; b < 256; b++) { /* the upper two tags after the lower two */
+        unsigned lo = tag_seq[b & 15], hi = tag_seq[b >> 4];
+        tag_seq[b] = (uint16_t)(((lo & 0xFF) | (hi & 0xFF) << (lo >> 8)) | ((lo >> 9) + (hi >> 9)) << 9);
     }
 }
 
@@ -4192,15 +4459,12 @@ static void voxdagi_ref_set_free(voxdagi_mem *m, voxdagi_ref_set *s) {
 static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned high, uint32_t *out) {
     uint32_t brick_level = d->levels - 2, l, at = high ? 1u << d->levels : 0, best = high ? 0 : 4;
     voxdagi_ref_set cur, next;
-    uint8_t wanted[2][VOXDAGI_TRANSFORMS]; /* [half][MI]: the stored octants of the world half */
+    const unsigned lower = a == 0 ? 0x55 : a == 1 ? 0x33 : 0x0F; /* the world octants with bit A clear */
     size_t i;
-    unsigned w, mi;
+    unsigned mi;
     memset(&cur, 0, sizeof cur);
     memset(&next, 0, sizeof next);
-    memset(wanted, 0, sizeof wanted);
-    for (mi = 0; mi < VOXDAGI_TRANSFORMS; mi++)
-        for (w = 0; w < 8; w++) wanted[w >> a & 1][mi] = (uint8_t)(wanted[w >> a & 1][mi] | 1u << d->cube.act[mi][w]);
-    if (!voxdagi_ref_set_add(m, &cur, d->cube.inv[d->root_transform])) return 0;
+    if (!voxdagi_ref_set_add(m, &cur, voxdagi_cube_tables.inv[d->root_transform])) return 0;
     for (l = 0; l < brick_level; l++) {
         unsigned side; /* the half of each cell on the wanted side, then the other */
         for (side = 0; side < 2 && !next.n; side++) {
@@ -4217,12 +4481,13 @@ static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned
                 mi = (unsigned)(key & 63);
                 rec = d->level[l].data + off;
                 header = voxdagi_le16(rec);
-                set = voxdagi_presence(header) & wanted[half][mi];
+                /* the stored octants MI(w) of the world half: world and stored swap under MI^-1 */
+                set = voxdagi_presence(header) & voxdagi_occupancy[voxdagi_cube_tables.inv[mi]][half ? 0xFF ^ lower : lower];
                 if (!set) continue;
                 voxdagi_child_refs(d, l, rec, header, set, ref);
                 for (; set; set &= set - 1) {
                     v = voxdagi_lowest_bit(set);
-                    if (!voxdagi_ref_set_add(m, &next, (ref[v] >> 6) << 6 | d->cube.comp[ref[v] & 63][mi])) {
+                    if (!voxdagi_ref_set_add(m, &next, (ref[v] >> 6) << 6 | voxdagi_cube_tables.comp[ref[v] & 63][mi])) {
                         voxdagi_ref_set_free(m, &cur);
                         voxdagi_ref_set_free(m, &next);
                         return 0;
@@ -4238,7 +4503,7 @@ static int voxdagi_extreme(const voxdag *d, voxdagi_mem *m, unsigned a, unsigned
     for (i = 0; i < cur.cap; i++) { /* the bricks of the slab, in world order */
         uint32_t box[6];
         if (!cur.slot[i]) continue;
-        voxdagi_brick_box(voxdagi_brick_to_world(d, voxdagi_brick(d, (cur.slot[i] - 1) >> 6), (unsigned)((cur.slot[i] - 1) & 63)), box);
+        voxdagi_brick_box(voxdagi_brick_to_world(voxdagi_brick(d, (cur.slot[i] - 1) >> 6), (unsigned)((cur.slot[i] - 1) & 63)), box);
         if (high ? box[a + 3] > best : box[a] < best) best = high ? box[a + 3] : box[a];
     }
     voxdagi_ref_set_free(m, &cur);
@@ -4303,7 +4568,7 @@ static const char *voxdagi_parse_level(voxdag *d, uint32_t l, const uint8_t *e, 
     for (k = 0; k < lv->table_len; k++) {
         if (e[32 + k] >= group) return "transform outside the file's symmetry group";
         lv->table[k] = e[32 + k];
-        lv->table_inv[k] = d->cube.inv[e[32 + k]];
+        lv->table_inv[k] = voxdagi_cube_tables.inv[e[32 + k]];
     }
     lv->width[0] = lv->code_bits[0] = 0;
     lv->code_mask[0] = 0;
@@ -4368,8 +4633,6 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     d->symmetry = (voxdag_symmetry)img[VOXDAG_FILE_OFF_SYMMETRY];
     if (d->symmetry < VOXDAG_SYMMETRY_NONE || d->symmetry > VOXDAG_SYMMETRY_FULL)
         return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "unknown symmetry group", VOXDAG_FILE_OFF_SYMMETRY, UINT64_MAX);
-    voxdagi_cube_init(&d->cube);
-    voxdagi_occupancy_init(d);
     d->voxels = voxdagi_le(img + VOXDAG_FILE_OFF_VOXELS, 8);
     d->levels = img[VOXDAG_FILE_OFF_LEVELS];
     d->root_transform = img[VOXDAG_FILE_OFF_ROOT_TRANSFORM];
@@ -4457,6 +4720,12 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     if (!levels || !nodes || !d->bricks)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_CORRUPT, "missing level, node or brick section");
     brick_level = d->levels - 2;
+    if (brick_level) { /* what the file needs: most DAGs are far below VOXDAG_MAX_LEVELS */
+        d->level = (voxdagi_level *)voxdagi_alloc(m, brick_level * sizeof *d->level);
+        if (!d->level) return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the level table");
+        d->level_count = brick_level;
+        memset(d->level, 0, brick_level * sizeof *d->level);
+    }
     for (l = 0; l < brick_level; l++) {
         const uint8_t *e = levels + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
         voxdagi_level *lv = &d->level[l];
@@ -4643,7 +4912,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     sc.root_transform = e.root_transform;
     sc.symmetry = b->symmetry;
     sc.voxels = b->voxels;
-    if (!voxdagi_voxel_box(&b->mem, r, &e.group->cube, sc.voxel_box)) {
+    if (!voxdagi_voxel_box(&b->mem, r, &voxdagi_cube_tables, sc.voxel_box)) {
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
@@ -4810,7 +5079,7 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "RGB8 colours need 3 bytes per voxel");
     parts[0] = src->image + VOXDAG_FILE_HEADER_SIZE; /* placeholder, replaced below */
     sizes[0] = (uint64_t)(src->levels - 2) * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
-    parts[1] = src->level[0].data ? src->level[0].data : NULL;
+    parts[1] = src->level_count ? src->level[0].data : NULL; /* no inner levels when L = 2 */
     sizes[1] = src->node_bytes + VOXDAG_FILE_NODE_PADDING;
     parts[2] = src->bricks;
     sizes[2] = 8 * src->brick_count;
@@ -4906,8 +5175,8 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
    INVERSE, found in the same pass. */
 static uint64_t voxdagi_preceding(const voxdag *d, uint32_t l, const uint8_t *rec, unsigned header, unsigned mi,
                                   unsigned w, uint64_t *child) {
-    const uint8_t *to_world = d->cube.act[d->cube.inv[mi]];
-    unsigned present = voxdagi_presence(header), set = 0, j, v = d->cube.act[mi][w];
+    const uint8_t *to_world = voxdagi_cube_tables.act[voxdagi_cube_tables.inv[mi]];
+    unsigned present = voxdagi_presence(header), set = 0, j, v = voxdagi_cube_tables.act[mi][w];
     uint64_t idx = 0, ref[8];
     for (j = 0; j < 8; j++)
         if (to_world[j] < w) set |= 1u << j;
@@ -4925,21 +5194,21 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     unsigned mi, p;
     uint64_t at = 0, idx = 0, mask;
     if (!dag || !dag->voxels || (x | y | z) >> dag->levels) return 0;
-    nlevels = dag->levels, brick_level = nlevels - 2, mi = dag->cube.inv[dag->root_transform];
+    nlevels = dag->levels, brick_level = nlevels - 2, mi = voxdagi_cube_tables.inv[dag->root_transform];
     for (l = 0; l < brick_level; l++) {
         const voxdagi_level *lv = &dag->level[l];
         const uint8_t *rec = lv->data + at;
         unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l, v;
         unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
         uint64_t ref = 0; /* set by either call: the child is present */
-        v = dag->cube.act[mi][w];
+        v = voxdagi_cube_tables.act[mi][w];
         if (!(header >> (2 * v) & 3)) return 0;
         if (index) idx += voxdagi_preceding(dag, l, rec, header, mi, w, &ref);
         else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
-        mi = dag->cube.comp[ref & 63][mi];
+        mi = voxdagi_cube_tables.comp[ref & 63][mi];
         at = ref >> 6;
     }
-    mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, at), mi);
+    mask = voxdagi_brick_to_world(voxdagi_brick(dag, at), mi);
     p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
     if (!(mask >> p & 1)) return 0;
     if (index) *index = idx + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
@@ -4960,12 +5229,12 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
     nlevels = dag->levels, brick_level = nlevels - 2;
     stack[0].at = 0;
     stack[0].x = stack[0].y = stack[0].z = 0;
-    stack[0].mi = dag->cube.inv[dag->root_transform];
+    stack[0].mi = voxdagi_cube_tables.inv[dag->root_transform];
     stack[0].next = 0;
     while (depth >= 0) {
         struct frame *f = &stack[depth];
         if ((uint32_t)depth == brick_level) { /* a brick, in world order */
-            uint64_t mask = voxdagi_brick_to_world(dag, voxdagi_brick(dag, f->at), f->mi);
+            uint64_t mask = voxdagi_brick_to_world(voxdagi_brick(dag, f->at), f->mi);
             while (mask) {
                 unsigned p = voxdagi_lowest_bit(mask);
                 uint32_t bx, by, bz;
@@ -4980,10 +5249,10 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
         {
             const voxdagi_level *lv = &dag->level[depth];
             const uint8_t *rec = lv->data + f->at;
-            const uint8_t *to_stored = dag->cube.act[f->mi];
+            const uint8_t *to_stored = voxdagi_cube_tables.act[f->mi];
             unsigned header = voxdagi_le16(rec);
             uint32_t half = 1u << (nlevels - 1 - (uint32_t)depth);
-            unsigned occ = dag->occupancy[f->mi][voxdagi_presence(header)];
+            unsigned occ = voxdagi_occupancy[f->mi][voxdagi_presence(header)];
             while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
             if (f->next == 8) {
                 depth--;
@@ -4994,7 +5263,7 @@ VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn,
                 uint64_t ref = voxdagi_child_ref(dag, (uint32_t)depth, rec, header, to_stored[w], 1);
                 struct frame *c = &stack[depth + 1];
                 c->at = ref >> 6;
-                c->mi = dag->cube.comp[ref & 63][f->mi];
+                c->mi = voxdagi_cube_tables.comp[ref & 63][f->mi];
                 c->x = f->x + (w & 1 ? half : 0);
                 c->y = f->y + (w & 2 ? half : 0);
                 c->z = f->z + (w & 4 ? half : 0);
@@ -5276,7 +5545,7 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
     double ox[3], ix[3], te = -HUGE_VAL, tx = HUGE_VAL, t_stop;
     uint32_t c[3] = {0, 0, 0}, up[3], step[3], q = 0, l = 0;
     int sgn[3];
-    unsigned ae = 0, ax = 0, a, mi = d->cube.inv[d->root_transform], header = 0, occ = 0;
+    unsigned ae = 0, ax = 0, a, mi = voxdagi_cube_tables.inv[d->root_transform], header = 0, occ = 0;
     int split, probe;
     unsigned moving = 0, down = 0, kind[3]; /* for voxdagi_brick_full_ahead */
     const uint8_t *rec = NULL;
@@ -5319,12 +5588,12 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
         if (l < brick_level) {
             rec = d->level[l].data + at;
             header = voxdagi_le16(rec);
-            occ = d->occupancy[mi][voxdagi_presence(header)];
+            occ = voxdagi_occupancy[mi][voxdagi_presence(header)];
             f[l].rec = rec;
             f[l].header = header;
             f[l].occ = occ;
         } else if (l == brick_level) { /* the brick in world order */
-            mask = voxdagi_brick_to_world(d, voxdagi_brick(d, at), mi);
+            mask = voxdagi_brick_to_world(voxdagi_brick(d, at), mi);
             f[l].rec = NULL;
             f[l].header = f[l].occ = 0;
             halves = split ? 1 : 2;
@@ -5409,8 +5678,8 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
         }
         if (l < brick_level) {
             uint64_t ref = voxdagi_child_ref(d, l, rec, header,
-                                             d->cube.act[mi][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
-            mi = d->cube.comp[ref & 63][mi];
+                                             voxdagi_cube_tables.act[mi][(c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2], 1);
+            mi = voxdagi_cube_tables.comp[ref & 63][mi];
             at = ref >> 6;
         }
         l++;

@@ -89,6 +89,13 @@ static void test_crc32c(void) {
     /* The standard check value of CRC-32C. */
     CHECK(voxdagi_crc32c((const uint8_t *)check, 9) == 0xE3069283u);
     CHECK(golden_crc32c((const uint8_t *)check, 9) == 0xE3069283u);
+    for (i = 0; i < 256; i++) { /* the constant byte table: the register after byte i, bit by bit */
+        uint32_t x = (uint32_t)i;
+        int k;
+        for (k = 0; k < 8; k++) x = x >> 1 ^ (x & 1 ? 0x82F63B78u : 0);
+        if (voxdagi_crc_t0[i] != x) bad++;
+    }
+    CHECK_MSG(bad == 0, "%zu entries of the CRC byte table differ", bad);
     for (off = 0; off < 8; off++)
         for (n = 0; n <= 600; n++)
             if (voxdagi_crc32c(buf + off, n) != golden_crc32c(buf + off, n)) bad++;

@@ -651,6 +651,62 @@ static void test_thread_pool(void) {
     scene_free(&s);
 }
 
+/* Voxels added in any order are sorted on the builder's threads: a flush
+   of shuffled voxels on a host pool of 3 threads runs each pass of the
+   radix sort (2 for L = 7: 21 bits, 11 a pass) as two batches of 3 jobs
+   (count, then move), and the file is the one thread's. */
+static void test_parallel_sort(void) {
+    scene s = make_scene(SC_NOISE_DENSE, 7, 41);
+    uint32_t *xyz;
+    uint8_t *rgb;
+    size_t n = scene_voxels(&s, &xyz, &rgb), i, size[2] = {0, 0};
+    uint64_t seed = 9;
+    voxdag *d[2] = {NULL, NULL};
+    int k;
+    CHECK(n >= 1u << 16); /* enough for the parallel sort */
+    for (i = n; i > 1; i--) {
+        size_t j = test_rand(&seed) % i, c;
+        for (c = 0; c < 3; c++) {
+            uint32_t t = xyz[3 * (i - 1) + c];
+            uint8_t v = rgb[3 * (i - 1) + c];
+            xyz[3 * (i - 1) + c] = xyz[3 * j + c], xyz[3 * j + c] = t;
+            rgb[3 * (i - 1) + c] = rgb[3 * j + c], rgb[3 * j + c] = v;
+        }
+    }
+    for (k = 0; k < 2; k++) {
+        voxdag_build_opts o;
+        voxdag_builder *b = NULL;
+        host_pool h;
+        size_t runs, jobs;
+        memset(&o, 0, sizeof o);
+        memset(&h, 0, sizeof h);
+        h.seed = 3;
+        o.levels = 7;
+        o.colors = 1;
+        o.threads = k ? 3 : 1;
+        o.thread_pool.run = host_run;
+        o.thread_pool.wait = host_wait;
+        o.thread_pool.user = &h;
+        CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+        if (!b) continue;
+        CHECK(voxdag_builder_add(b, xyz, rgb, n, NULL) == VOXDAG_OK);
+        runs = h.runs, jobs = h.jobs;
+        CHECK(voxdag_builder_flush(b, NULL) == VOXDAG_OK);
+        if (k) CHECK_MSG(h.runs - runs >= 4 && h.jobs - jobs >= 12, "the flush ran %zu batches, %zu jobs",
+                         h.runs - runs, h.jobs - jobs);
+        CHECK(!h.misuse && !h.open);
+        CHECK(voxdag_builder_finish(b, &d[k], NULL, NULL) == VOXDAG_OK);
+        if (d[k]) voxdag_image(d[k], &size[k]);
+    }
+    CHECK(d[0] && d[1] && size[0] == size[1] &&
+          !memcmp(voxdag_image(d[0], NULL), voxdag_image(d[1], NULL), size[0]));
+    voxdag_free(d[0]);
+    voxdag_free(d[1]);
+    free(xyz);
+    free(rgb);
+    scene_free(&s);
+}
+
 /* Streaming: Morton-ordered chunks flushed one by one (subtrees of 16^3) give
    the same file as one batch; a voxel before a flushed one is refused. */
 static void test_streaming_chunks(void) {
@@ -1099,6 +1155,7 @@ const test_case test_core_cases[] = {
     {"core/mirrored_blob_merges", test_mirrored_blob_merges},
     {"core/determinism", test_determinism},
     {"core/thread_pool", test_thread_pool},
+    {"core/parallel_sort", test_parallel_sort},
     {"core/streaming_chunks", test_streaming_chunks},
     {"core/color_sink", test_color_sink},
     {"core/load_roundtrip", test_load_roundtrip},

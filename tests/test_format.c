@@ -1396,6 +1396,90 @@ done:
 }
 #endif
 
+// -- Tables shared by every DAG, and what one DAG holds
+
+/* The symmetry tables that every DAG and every build share (constants in
+   the header) against their definition: transform T = perm * 8 + m moves
+   axis a of a point to axis perm[a] (the permutations in lexicographic
+   order), then mirrors the axes in m; octant i is the corner point with
+   coordinate a equal to bit a of i. */
+static void test_cube_tables(void) {
+    const voxdagi_cube *c = &voxdagi_cube_tables;
+    unsigned perm[6][3], n = 0, a, b, k, t, u, i, p;
+    for (a = 0; a < 3; a++)
+        for (b = 0; b < 3; b++)
+            for (k = 0; k < 3; k++)
+                if (a != b && b != k && a != k) perm[n][0] = a, perm[n][1] = b, perm[n][2] = k, n++;
+    CHECK(n == 6);
+    for (t = 0; t < 48; t++)
+        for (i = 0; i < 8; i++) {
+            unsigned v[3], w[3];
+            for (a = 0; a < 3; a++) v[a] = i >> a & 1;
+            for (a = 0; a < 3; a++) w[perm[t / 8][a]] = v[a];
+            for (a = 0; a < 3; a++)
+                if (t >> a & 1) w[a] = 1 - w[a];
+            CHECK_MSG(c->act[t][i] == (w[0] | w[1] << 1 | w[2] << 2), "act[%u][%u]", t, i);
+        }
+    for (t = 0; t < 48; t++)
+        for (u = 0; u < t; u++) CHECK(memcmp(c->act[t], c->act[u], 8)); /* the corners tell transforms apart */
+    for (t = 0; t < 48; t++) {
+        CHECK(c->inv[t] < 48 && c->comp[t][c->inv[t]] == 0 && c->comp[c->inv[t]][t] == 0);
+        for (u = 0; u < 48; u++) {
+            CHECK(c->comp[t][u] < 48);
+            for (i = 0; i < 8; i++) /* comp[T][U]: U, then T */
+                CHECK_MSG(c->act[c->comp[t][u]][i] == c->act[t][c->act[u][i]], "comp[%u][%u]", t, u);
+        }
+        for (p = 0; p < 256; p++) {
+            unsigned want = 0;
+            for (i = 0; i < 8; i++) want |= (p >> c->act[t][i] & 1) << i; /* world octant i: stored T(i) */
+            CHECK_MSG(voxdagi_occupancy[t][p] == want, "occupancy[%u][%u]", t, p);
+        }
+    }
+}
+
+/* A loaded DAG holds what its file needs: the tables above are shared, and
+   per inner level it keeps one entry, so a tiny file costs below 2 KB, not
+   25 KB whatever the file (10,000 small props: 16 MB, not 250 MB). */
+static void test_tiny_dag_memory(void) {
+    size_t size = 0;
+    uint8_t *f = read_golden(GOLDEN_ONE_VOXEL, &size);
+    int kind;
+    if (!f) return;
+    {
+        voxdag_load_opts o;
+        count_alloc ca;
+        voxdag *d = NULL;
+        opts_with(&o, &ca, -1);
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        CHECK_MSG(ca.held <= 2048, "%llu bytes held by a DAG of %zu bytes", (unsigned long long)ca.held, size);
+        voxdag_free(d);
+        CHECK(ca.held == 0 && !ca.bad_free);
+    }
+    free(f);
+    for (kind = 0; kind < GOLDEN_COUNT; kind++) { /* no more than its levels need */
+        voxdag_load_opts o;
+        count_alloc ca;
+        voxdag *d = NULL;
+        f = read_golden(kind, &size);
+        if (!f) continue;
+        opts_with(&o, &ca, -1);
+        CHECK(voxdag_load_memory(f, size, &o, &d, NULL) == VOXDAG_OK);
+        CHECK_MSG(d && ca.held == sizeof *d + (d->levels - 2) * sizeof *d->level, "%s: %llu bytes held",
+                  golden_names[kind], (unsigned long long)ca.held);
+        if (d && d->voxels <= 4096) { /* a DAG made from it (L = 2: no inner levels at all) */
+            static uint8_t rgb[3 * 4096];
+            voxdag *c = NULL;
+            CHECK_MSG(voxdag_with_colors(d, VOXDAG_COLORS_RGB8, rgb, 3 * (size_t)d->voxels, &c, NULL) == VOXDAG_OK &&
+                          c && c->levels == d->levels && c->level_count == d->level_count,
+                      "%s: with colours", golden_names[kind]);
+            voxdag_free(c);
+        }
+        voxdag_free(d);
+        CHECK(ca.held == 0 && !ca.bad_free);
+        free(f);
+    }
+}
+
 const test_case test_format_cases[] = {
     {"format/golden_identical", test_golden_identical},
     {"format/offsets_documented", test_offsets_documented},
@@ -1409,6 +1493,8 @@ const test_case test_format_cases[] = {
     {"format/version3_fields", test_version3_fields},
     {"format/save_file", test_save_file},
     {"format/save_temp_path", test_save_temp_path},
+    {"format/cube_tables", test_cube_tables},
+    {"format/tiny_dag_memory", test_tiny_dag_memory},
 #ifdef __unix__
     {"format/save_planted_links", test_save_planted_links},
     {"format/save_directory_and_mode", test_save_directory_and_mode},
