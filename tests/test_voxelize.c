@@ -655,6 +655,18 @@ static void test_solid_shapes(void) {
     gen_box(&g, lo, hi, 0, 0);
     CHECK(check_solid("box over the grid", &g, 4) > 0);
     gen_free(&g);
+    lo[0] = -3000.25, lo[1] = -2500, lo[2] = 5.5; /* edges past 2^31 fixed-point units: 128-bit products */
+    hi[0] = 4100, hi[1] = 3000.75, hi[2] = 11;
+    gen_box(&g, lo, hi, 0, 0);
+    c[0] = 8.5, c[1] = 7.5, c[2] = 8.5;
+    gen_octahedron(&g, c[0], c[1], c[2], 6); /* vertices on centres, inside the slab: winding 2 */
+    CHECK(check_solid("wide slab", &g, 4) > 0);
+    gen_free(&g);
+    lo[0] = -1e13, lo[1] = -3e12, lo[2] = -1e14; /* vertices past +-2^40 voxels: clamped there */
+    hi[0] = 2e13, hi[1] = 1e15, hi[2] = 9.5;
+    gen_box(&g, lo, hi, 1, 0);
+    CHECK(check_solid("huge box, inside out", &g, 4) == 16 * 16 * 9);
+    gen_free(&g);
 }
 
 /* Interior voxels take the colour of the nearest crossing above: under a
@@ -682,6 +694,57 @@ static void test_solid_colors(void) {
     CHECK_MSG(d && surf && inner == 10 * 8 * 12 && bad == 0, "%zu inside voxels, %zu with another colour", inner, bad);
     voxdag_free(d);
     voxdag_free(surf);
+    gen_free(&g);
+}
+
+static int keep_none(void *user, size_t tri, const double bary[3]) {
+    (void)user;
+    (void)tri;
+    (void)bary;
+    return 0;
+}
+
+/* keep cuts surface voxels only: with a keep that cuts everything, a sphere
+   (no centre on its surface) gives exactly the centres inside. */
+static void test_solid_keep(void) {
+    gen_mesh g;
+    double c[3] = {15.3, 16.1, 14.7};
+    voxdag_build_opts o;
+    voxdag_builder *b = NULL;
+    voxdag *d = NULL;
+    voxdag_mesh mesh;
+    uint32_t x, y, z;
+    size_t bad = 0, inside = 0;
+    memset(&g, 0, sizeof g);
+    gen_sphere(&g, c, 12.2, 24, 12, 0);
+    memset(&o, 0, sizeof o);
+    o.levels = 5;
+    o.chunk_levels = 3;
+    o.threads = THREADS;
+    memset(&mesh, 0, sizeof mesh);
+    mesh.positions = g.pos;
+    mesh.vertex_count = g.verts;
+    mesh.indices = g.idx;
+    mesh.triangle_count = g.tris;
+    mesh.keep = keep_none;
+    mesh.solid = 1;
+    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_add_mesh(b, &mesh, NULL) == VOXDAG_OK);
+    CHECK(voxdag_builder_finish(b, &d, NULL, NULL) == VOXDAG_OK);
+    for (z = 0; d && z < 32; z++)
+        for (y = 0; y < 32; y++)
+            for (x = 0; x < 32; x++) {
+                double p[3];
+                int want;
+                p[0] = x + 0.5;
+                p[1] = y + 0.5;
+                p[2] = z + 0.5;
+                want = fabs(solid_winding(&g, p)) > 0.5;
+                inside += (size_t)want;
+                bad += (size_t)(voxdag_lookup(d, x, y, z, NULL) != want);
+            }
+    CHECK_MSG(d && bad == 0 && inside > 5000, "%zu voxels wrong of %zu inside", bad, inside);
+    voxdag_free(d);
     gen_free(&g);
 }
 
@@ -947,6 +1010,7 @@ const test_case test_voxelize_cases[] = {
     {"voxelize/solid_shapes", test_solid_shapes},
     {"voxelize/solid_colors", test_solid_colors},
     {"voxelize/solid_open", test_solid_open},
+    {"voxelize/solid_keep", test_solid_keep},
     {"voxelize/solid_memory_limit", test_solid_memory_limit},
     {"voxelize/solid_sphere", test_solid_sphere},
     {"voxelize/solid_real_meshes", test_solid_real_meshes},
