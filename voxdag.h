@@ -2780,6 +2780,7 @@ static voxdag_status voxdagi_open_edges(voxdagi_mem *m, const voxdag_mesh *mesh,
     *first = UINT64_MAX;
     if (v > 0x7fffffffu) return VOXDAG_ERR_LIMIT;
     if (t > UINT32_MAX) return VOXDAG_ERR_LIMIT;
+    if (t > (size_t)-1 / 24 || v > (size_t)-1 / 16) return VOXDAG_ERR_OUT_OF_MEMORY; /* 32-bit sizes */
     while (hs < 2 * v) hs *= 2;
     canon = (uint32_t *)voxdagi_alloc(m, (v ? v : 1) * 4);
     table = (uint32_t *)voxdagi_alloc(m, hs * 4);
