@@ -111,6 +111,7 @@ typedef enum voxdag_status {
     VOXDAG_ERR_CORRUPT,          /* a field is inconsistent or out of range */
     VOXDAG_ERR_IO,               /* a file could not be read or written */
     VOXDAG_ERR_CANCELLED,        /* the build's progress_cancel callback stopped it */
+    VOXDAG_ERR_NOT_CLOSED,       /* a solid mesh has open edges (voxdag_mesh.solid) */
     VOXDAG_STATUS_COUNT,
     VOXDAG_STATUS_FORCE_32BIT = 0x7fffffff
 } voxdag_status;
@@ -123,6 +124,8 @@ typedef enum voxdag_status {
          the brick's position in that call's arrays;
      voxdag_builder_add_mesh, VOXDAG_ERR_INVALID_ARGUMENT:
          the triangle (an index >= vertex_count or a non-finite vertex);
+     voxdag_builder_add_mesh, VOXDAG_ERR_NOT_CLOSED (mesh->solid): the lowest
+         triangle with an open edge;
      loading, VOXDAG_ERR_CORRUPT: the level (0 = root) of a bad level-table
          entry, or the ordinal of a bad node record within its level (bricks:
          the brick's index); BYTE_OFFSET then points at the entry or record.
@@ -318,6 +321,9 @@ typedef struct voxdag_mesh {
        TRIANGLE is cut away (an alpha-tested texel, say); NULL keeps every
        point. Called once per voxel a triangle touches. */
     int (*keep)(void *user, size_t triangle, const double bary[3]);
+    /* Nonzero: voxelize the inside too (a closed mesh; see
+       voxdag_builder_add_mesh, SOLID). 0: the surface only. */
+    int solid;
 } voxdag_mesh;
 
 /* Voxelizes MESH conservatively: a voxel is full when a triangle intersects
@@ -336,10 +342,55 @@ typedef struct voxdag_mesh {
    touching it, both from several threads at once when opts.threads > 1.
    Call it on a builder that holds no voxels yet; more meshes need one
    combined call. Returns VOXDAG_ERR_INVALID_ARGUMENT for an
-   index >= vertex_count or a non-finite vertex. */
+   index >= vertex_count or a non-finite vertex.
+
+   SOLID (mesh->solid nonzero): a voxel is also full when its centre lies inside
+   the mesh, by the nonzero winding rule: the winding number of the centre is
+   the sum, over the triangles that the ray from the centre towards +z
+   crosses, of +1 where the triangle turns counter-clockwise seen from +z and
+   -1 where it turns clockwise (crossings at the centre itself not counted).
+   So overlapping closed parts are filled once, a shell with an inward-facing
+   inner surface stays hollow, and an inside-out mesh fills like its outward
+   twin. The test is exact on the vertices' x and y rounded to multiples of
+   2^-20 voxel (clamped to +-2^40): integer arithmetic decides which
+   triangles a column crosses, and a column through an edge or a vertex
+   passes beside it as if moved by (e, e^2), e infinitely small, so a column
+   through an edge of two triangles crosses exactly one of them. The
+   rounding moves the surface by less than 2^-20 voxel, which changes only
+   centres that close to it, in voxels the surface touches (full anyway).
+   The mesh must be closed: vertices at the same position are one vertex,
+   and every edge must be used as often from a to b as from b to a (see
+   voxdag_mesh_open_edges); otherwise the call fails with
+   VOXDAG_ERR_NOT_CLOSED (err->node: the lowest triangle with an open edge),
+   adds nothing and leaves the builder usable. Triangles above or below the
+   grid count. keep applies to surface voxels only: a voxel whose centre is
+   inside is full. An inside voxel that no triangle touches takes its
+   colour from the nearest crossing above its centre (of equal heights, the
+   highest triangle) at the crossing's point. Memory, besides the surface
+   path's: the closedness check, 72 bytes per triangle and up to 20 per
+   vertex, freed before voxelizing; the triangles binned by columns of
+   chunks (12 bytes per triangle and column), and 12 bytes per chunk that
+   the inside fills without a triangle touching it; per thread, a chunk's
+   columns (12 bytes each, 24 with colours), its crossings (24 bytes each)
+   and with colours a bit per voxel. Time grows with the inside's volume. */
 #ifndef VOXDAG_NO_BUILD
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh,
                                                  voxdag_error *err);
+
+/* Counts the open edges of MESH, the test of a solid voxelization: vertices
+   at the same position (x, y, z equal as doubles) are one vertex, and an
+   edge {a, b} is open when the triangles use it a different number of times
+   from a to b than from b to a (edges of a triangle with two equal vertices
+   are skipped). Sets *OPEN_EDGES and *FIRST_TRIANGLE (the lowest triangle
+   with an open edge, UINT64_MAX when none); either may be NULL. ALLOCATOR
+   may be NULL (VOXDAG_MALLOC); memory is 72 bytes per triangle and at most
+   20 per vertex, freed before the call returns. Returns VOXDAG_OK (also for an
+   open mesh), VOXDAG_ERR_INVALID_ARGUMENT for a bad index or a non-finite
+   vertex (err->node: the triangle), VOXDAG_ERR_LIMIT for more than 2^31-1
+   vertices, or VOXDAG_ERR_OUT_OF_MEMORY. Thread-safe: reads MESH only. */
+VOXDAG_API voxdag_status voxdag_mesh_open_edges(const voxdag_mesh *mesh, const voxdag_allocator *allocator,
+                                                uint64_t *open_edges, uint64_t *first_triangle,
+                                                voxdag_error *err);
 #endif
 
 /* Per-level node counts of a build, filled by voxdag_builder_finish. Arrays
@@ -813,6 +864,7 @@ VOXDAG_API const char *voxdag_status_string(voxdag_status status) {
     case VOXDAG_ERR_CORRUPT: return "corrupt data";
     case VOXDAG_ERR_IO: return "i/o error";
     case VOXDAG_ERR_CANCELLED: return "cancelled";
+    case VOXDAG_ERR_NOT_CLOSED: return "mesh not closed";
     default: return "unknown status";
     }
 }
@@ -2885,6 +2937,234 @@ static int voxdagi_load_tri(const voxdag_mesh *mesh, size_t i, voxdagi_tri *t) {
     return 1;
 }
 
+// -- Solid voxelization: exact column tests, the closedness check
+
+/* Vertex x and y for the exact column tests: fixed point in units of 2^-20
+   voxel, clamped to +-2^40 voxels, so differences fit 62 bits. Columns run
+   through voxel centres, at odd multiples of 2^19. */
+static int64_t voxdagi_fix(double x) {
+    if (x > 1099511627776.0) x = 1099511627776.0;
+    if (x < -1099511627776.0) x = -1099511627776.0;
+    return (int64_t)voxdagi_floor(x * 1048576.0 + 0.5);
+}
+
+static int64_t voxdagi_fix_centre(int64_t voxel) { return voxel * 1048576 + 524288; }
+
+/* The edge function (B - A) x (Q - A) of fixed-point points, exactly (with
+   128-bit products made of 32-bit halves where the values need them), at Q
+   moved by (e, e^2) for an infinitely small e: returns its sign, never 0
+   unless A = B, and sets *W to its value at Q itself (0 on the edge's line). */
+static int voxdagi_edge_sign(const int64_t a[2], const int64_t b[2], const int64_t q[2], double *w) {
+    int64_t dx = b[0] - a[0], dy = b[1] - a[1], qx = q[0] - a[0], qy = q[1] - a[1];
+    const int64_t small = (int64_t)1 << 31;
+    uint64_t hi = 0, lo = 0;
+    int neg;
+    if (dx > -small && dx < small && dy > -small && dy < small && qx > -small && qx < small && qy > -small &&
+        qy < small) {
+        int64_t v = dx * qy - dy * qx; /* |v| < 2^63 */
+        *w = (double)v;
+        if (v) return v > 0 ? 1 : -1;
+    } else {
+        int64_t f[4];
+        uint64_t h[2], l[2];
+        unsigned k;
+        f[0] = dx, f[1] = qy, f[2] = dy, f[3] = qx;
+        for (k = 0; k < 2; k++) { /* h:l = f[2k] * f[2k+1], two's complement */
+            uint64_t ua = f[2 * k] < 0 ? 0 - (uint64_t)f[2 * k] : (uint64_t)f[2 * k];
+            uint64_t ub = f[2 * k + 1] < 0 ? 0 - (uint64_t)f[2 * k + 1] : (uint64_t)f[2 * k + 1];
+            uint64_t a0 = ua & 0xffffffffu, a1 = ua >> 32, b0 = ub & 0xffffffffu, b1 = ub >> 32;
+            uint64_t p00 = a0 * b0, p01 = a0 * b1, p10 = a1 * b0;
+            uint64_t mid = (p00 >> 32) + (p01 & 0xffffffffu) + (p10 & 0xffffffffu);
+            l[k] = mid << 32 | (p00 & 0xffffffffu);
+            h[k] = a1 * b1 + (p01 >> 32) + (p10 >> 32) + (mid >> 32);
+            if ((f[2 * k] < 0) != (f[2 * k + 1] < 0)) {
+                l[k] = ~l[k] + 1;
+                h[k] = ~h[k] + (uint64_t)(l[k] == 0);
+            }
+        }
+        lo = l[0] - l[1];
+        hi = h[0] - h[1] - (uint64_t)(l[0] < l[1]);
+        neg = (int)(hi >> 63);
+        if (neg) {
+            lo = ~lo + 1;
+            hi = ~hi + (uint64_t)(lo == 0);
+        }
+        if (hi | lo) {
+            *w = ((double)hi * 18446744073709551616.0 + (double)lo) * (neg ? -1.0 : 1.0);
+            return neg ? -1 : 1;
+        }
+        *w = 0;
+    }
+    /* on the line: the value at Q + (e, e^2) is -dy e + dx e^2 */
+    return dy ? (dy < 0 ? 1 : -1) : dx > 0 ? 1 : dx < 0 ? -1 : 0;
+}
+
+/* A triangle for the column tests: x and y in fixed point, z as given. */
+typedef struct voxdagi_ftri {
+    int64_t p[3][2];
+    double z[3];
+} voxdagi_ftri;
+
+static void voxdagi_ftri_init(voxdagi_ftri *f, const voxdagi_tri *t) {
+    unsigned c;
+    for (c = 0; c < 3; c++) {
+        f->p[c][0] = voxdagi_fix(t->v[c][0]);
+        f->p[c][1] = voxdagi_fix(t->v[c][1]);
+        f->z[c] = t->v[c][2];
+    }
+}
+
+/* Whether the column through Q (fixed point, moved by (e, e^2)) crosses T:
+   returns +1 where T turns counter-clockwise seen from +z, -1 where it turns
+   clockwise, and sets *H to the crossing's height and BARY to its
+   barycentric coordinates (from the exact edge values, so H lies within the
+   vertices' heights); 0 where the column passes beside T. */
+static int voxdagi_column_cross(const voxdagi_ftri *t, const int64_t q[2], double *h, double bary[3]) {
+    double w[3], sum;
+    int s = voxdagi_edge_sign(t->p[1], t->p[2], q, &w[0]);
+    if (!s || voxdagi_edge_sign(t->p[2], t->p[0], q, &w[1]) != s || voxdagi_edge_sign(t->p[0], t->p[1], q, &w[2]) != s)
+        return 0;
+    sum = w[0] + w[1] + w[2]; /* twice the area, nonzero when the signs agree */
+    if (sum == 0) {
+        bary[0] = bary[1] = bary[2] = 1.0 / 3;
+    } else {
+        bary[0] = w[0] / sum;
+        bary[1] = w[1] / sum;
+        bary[2] = 1 - bary[0] - bary[1];
+        if (bary[2] < 0) bary[2] = 0;
+    }
+    *h = bary[0] * t->z[0] + bary[1] * t->z[1] + bary[2] * t->z[2];
+    return s;
+}
+
+static uint64_t voxdagi_position_hash(const double *p) {
+    uint64_t h = 0x9E3779B97F4A7C15ull, x;
+    unsigned k;
+    for (k = 0; k < 3; k++) {
+        double v = p[k] + 0.0; /* -0 as +0 */
+        memcpy(&x, &v, 8);
+        h = (h ^ x) * 0xBF58476D1CE4E5B9ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+/* voxdag_mesh_open_edges with memory M. Returns VOXDAG_ERR_INVALID_ARGUMENT
+   with *BAD, the triangle, for a bad index or vertex. */
+static voxdag_status voxdagi_open_edges(voxdagi_mem *m, const voxdag_mesh *mesh, uint64_t *open, uint64_t *first,
+                                        uint64_t *bad) {
+    size_t v = mesh->vertex_count, t = mesh->triangle_count, hs = 16, n = 0, i, j, e = t ? 3 * t : 1;
+    uint32_t *canon = NULL, *table = NULL, *tri = NULL, *tmp_tri = NULL;
+    uint64_t *key = NULL, *tmp_key = NULL;
+    voxdag_status st = VOXDAG_OK;
+    *open = 0;
+    *first = UINT64_MAX;
+    if (v > 0x7fffffffu) return VOXDAG_ERR_LIMIT;
+    if (t > UINT32_MAX) return VOXDAG_ERR_LIMIT;
+    if (t > (size_t)-1 / 24 || v > (size_t)-1 / 16) return VOXDAG_ERR_OUT_OF_MEMORY; /* 32-bit sizes */
+    while (hs < 2 * v) hs *= 2;
+    canon = (uint32_t *)voxdagi_alloc(m, (v ? v : 1) * 4);
+    table = (uint32_t *)voxdagi_alloc(m, hs * 4);
+    key = (uint64_t *)voxdagi_alloc(m, e * 8);
+    tmp_key = (uint64_t *)voxdagi_alloc(m, e * 8);
+    tri = (uint32_t *)voxdagi_alloc(m, e * 4);
+    tmp_tri = (uint32_t *)voxdagi_alloc(m, e * 4);
+    if (!canon || !table || !key || !tmp_key || !tri || !tmp_tri) st = VOXDAG_ERR_OUT_OF_MEMORY;
+    if (st == VOXDAG_OK) {
+        memset(canon, 0xff, (v ? v : 1) * 4);
+        memset(table, 0xff, hs * 4);
+    }
+    for (i = 0; i < t && st == VOXDAG_OK; i++) { /* vertices welded by position, then directed edges */
+        voxdagi_tri tr;
+        uint32_t c[3];
+        unsigned k;
+        if (!voxdagi_load_tri(mesh, i, &tr)) {
+            *bad = i;
+            st = VOXDAG_ERR_INVALID_ARGUMENT;
+            break;
+        }
+        for (k = 0; k < 3; k++) {
+            uint32_t vi = mesh->indices[3 * i + k];
+            if (canon[vi] == UINT32_MAX) {
+                const double *p = mesh->positions + 3 * (size_t)vi;
+                size_t s = (size_t)voxdagi_position_hash(p) & (hs - 1);
+                while (table[s] != UINT32_MAX) {
+                    const double *o = mesh->positions + 3 * (size_t)table[s];
+                    if (o[0] == p[0] && o[1] == p[1] && o[2] == p[2]) break;
+                    s = (s + 1) & (hs - 1);
+                }
+                if (table[s] == UINT32_MAX) table[s] = vi;
+                canon[vi] = table[s];
+            }
+            c[k] = canon[vi];
+        }
+        for (k = 0; k < 3; k++) {
+            uint32_t a = c[k], b = c[(k + 1) % 3];
+            if (a == b) continue;
+            key[n] = (uint64_t)(a < b ? a : b) << 32 | (uint64_t)(a < b ? b : a) << 1 | (uint64_t)(a > b);
+            tri[n++] = (uint32_t)i;
+        }
+    }
+    if (st == VOXDAG_OK) {
+        voxdagi_radix_sort(key, tri, tmp_key, tmp_tri, n, 63);
+        for (i = 0; i < n; i = j) { /* a run of one undirected edge: as often each way? */
+            int64_t sum = 0;
+            uint32_t low = UINT32_MAX;
+            for (j = i; j < n && key[j] >> 1 == key[i] >> 1; j++) {
+                sum += (key[j] & 1) ? -1 : 1;
+                if (tri[j] < low) low = tri[j];
+            }
+            if (sum) {
+                ++*open;
+                if (low < *first) *first = low;
+            }
+        }
+    }
+    voxdagi_free(m, canon, (v ? v : 1) * 4);
+    voxdagi_free(m, table, hs * 4);
+    voxdagi_free(m, key, e * 8);
+    voxdagi_free(m, tmp_key, e * 8);
+    voxdagi_free(m, tri, e * 4);
+    voxdagi_free(m, tmp_tri, e * 4);
+    return st;
+}
+
+VOXDAG_API voxdag_status voxdag_mesh_open_edges(const voxdag_mesh *mesh, const voxdag_allocator *allocator,
+                                                uint64_t *open_edges, uint64_t *first_triangle,
+                                                voxdag_error *err) {
+    voxdagi_mem m;
+    uint64_t open = 0, first = UINT64_MAX, bad = 0;
+    voxdag_status st;
+    if (!mesh || (mesh->triangle_count && (!mesh->indices || !mesh->positions)) ||
+        (allocator && (allocator->alloc == NULL) != (allocator->free == NULL)))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "mesh arrays missing, or half an allocator");
+    voxdagi_mem_init(&m, allocator, 0);
+    st = voxdagi_open_edges(&m, mesh, &open, &first, &bad);
+    voxdagi_mem_destroy(&m);
+    if (open_edges) *open_edges = open;
+    if (first_triangle) *first_triangle = first;
+    if (st == VOXDAG_ERR_INVALID_ARGUMENT)
+        return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, bad);
+    if (st == VOXDAG_ERR_LIMIT) return VOXDAGI_FAIL(err, st, "more than 2^31-1 vertices or 2^32-1 triangles");
+    if (st != VOXDAG_OK) return VOXDAGI_FAIL(err, st, "out of memory");
+    return voxdagi_ok(err);
+}
+
+/* The triangles of a solid mesh by columns of chunks: every triangle whose
+   x and y ranges meet a chunk column's, whatever its z. */
+typedef struct voxdagi_solid {
+    const uint64_t *key; /* sorted: cy << 32 | cx */
+    const uint32_t *tri; /* ascending within a column */
+    size_t n;
+} voxdagi_solid;
+
+/* A column's crossing inside a chunk's range of voxel centres. */
+typedef struct voxdagi_event {
+    double h;
+    uint32_t tri, col;
+    int32_t sign;
+} voxdagi_event;
+
 /* One chunk being voxelized: a bitmap of its voxels in local Morton order
    (so each 64-bit word is a 4^3 brick), then its bricks and colours in Morton
    order, ready for the builder. Each thread owns one. */
@@ -2902,12 +3182,25 @@ typedef struct voxdagi_chunk {
     const uint32_t *tri;       /* this round: its triangles, ascending */
     size_t tri_count;
     int failed;                /* out of memory */
+    /* Solid meshes (voxdagi_chunk_solid), else NULL: */
+    const voxdagi_solid *solid;
+    int32_t *top;              /* per column: the winding number above the chunk */
+    size_t *col_start;         /* per column, and one more: its first event */
+    uint32_t *above;           /* per column: the nearest crossing above the chunk (colours only) */
+    double *above_h;           /* its height (colours only) */
+    uint64_t *inner;           /* like BITS: voxels set by the winding rule (colours only) */
+    voxdagi_event *ev, *ev_sorted;
+    size_t ev_n, ev_cap, ev_sorted_cap;
 } voxdagi_chunk;
 
 static size_t voxdagi_chunk_words(const voxdagi_chunk *c) { return (size_t)1 << (3 * c->shift - 6); }
 static size_t voxdagi_chunk_used_words(const voxdagi_chunk *c) { return (voxdagi_chunk_words(c) + 63) / 64; }
 
-static int voxdagi_chunk_init(voxdagi_chunk *c, voxdag_builder *b, const voxdag_mesh *mesh, unsigned shift) {
+static size_t voxdagi_chunk_columns(const voxdagi_chunk *c) { return (size_t)1 << (2 * c->shift); }
+
+static int voxdagi_chunk_init(voxdagi_chunk *c, voxdag_builder *b, const voxdag_mesh *mesh, unsigned shift,
+                              const voxdagi_solid *solid) {
+    size_t cols;
     memset(c, 0, sizeof *c);
     c->b = b;
     c->mesh = mesh;
@@ -2918,14 +3211,34 @@ static int voxdagi_chunk_init(voxdagi_chunk *c, voxdag_builder *b, const voxdag_
     if (!c->bits || !c->used || (b->opts.colors && !c->owner)) return 0;
     memset(c->bits, 0, voxdagi_chunk_words(c) * 8);
     memset(c->used, 0, voxdagi_chunk_used_words(c) * 8);
+    if (!solid) return 1;
+    cols = voxdagi_chunk_columns(c);
+    c->solid = solid;
+    c->top = (int32_t *)voxdagi_alloc(&b->mem, cols * sizeof *c->top);
+    c->col_start = (size_t *)voxdagi_alloc(&b->mem, (cols + 1) * sizeof *c->col_start);
+    if (!c->top || !c->col_start) return 0;
+    if (!b->opts.colors) return 1;
+    c->above = (uint32_t *)voxdagi_alloc(&b->mem, cols * sizeof *c->above);
+    c->above_h = (double *)voxdagi_alloc(&b->mem, cols * sizeof *c->above_h);
+    c->inner = (uint64_t *)voxdagi_alloc(&b->mem, voxdagi_chunk_words(c) * 8);
+    if (!c->above || !c->above_h || !c->inner) return 0;
+    memset(c->inner, 0, voxdagi_chunk_words(c) * 8);
     return 1;
 }
 
 static void voxdagi_chunk_free(voxdagi_chunk *c) {
     voxdagi_mem *m = &c->b->mem;
+    size_t cols = voxdagi_chunk_columns(c);
     voxdagi_free(m, c->bits, c->bits ? voxdagi_chunk_words(c) * 8 : 0);
     voxdagi_free(m, c->used, c->used ? voxdagi_chunk_used_words(c) * 8 : 0);
     voxdagi_free(m, c->owner, c->owner ? voxdagi_chunk_words(c) * 64 * 4 : 0);
+    voxdagi_free(m, c->top, cols * sizeof *c->top);
+    voxdagi_free(m, c->col_start, (cols + 1) * sizeof *c->col_start);
+    voxdagi_free(m, c->above, cols * sizeof *c->above);
+    voxdagi_free(m, c->above_h, cols * sizeof *c->above_h);
+    voxdagi_free(m, c->inner, c->inner ? voxdagi_chunk_words(c) * 8 : 0);
+    voxdagi_free(m, c->ev, c->ev_cap * sizeof *c->ev);
+    voxdagi_free(m, c->ev_sorted, c->ev_sorted_cap * sizeof *c->ev_sorted);
     voxdagi_free(m, c->brick, c->brick_cap * 16);
     voxdagi_free(m, c->rgb, c->rgb_cap * sizeof *c->rgb);
 }
@@ -3012,25 +3325,163 @@ static void voxdagi_chunk_tri(voxdagi_chunk *c, const voxdagi_tri *t, const voxd
         }
 }
 
+/* Winding numbers of the chunk's voxel centres (the solid rule of
+   voxdag_builder_add_mesh) from the triangles of its chunk column: the
+   crossings above the chunk summed per column, those within it sorted per
+   column from the top down; voxels with a nonzero winding number that no
+   triangle set are set, owned by the nearest crossing above (with
+   colours). */
+static void voxdagi_chunk_solid(voxdagi_chunk *c, const int64_t clo[3]) {
+    const voxdagi_solid *s = c->solid;
+    size_t side = (size_t)1 << c->shift, cols = side * side, lo = 0, hi = s->n, i, e;
+    uint64_t key = (uint64_t)(clo[1] >> c->shift) << 32 | (uint64_t)(clo[0] >> c->shift);
+    double zlo = (double)clo[2] + 0.5, ztop = (double)clo[2] + (double)side - 0.5;
+    uint32_t col;
+    while (lo < hi) { /* the column's first triangle */
+        size_t mid = lo + (hi - lo) / 2;
+        if (s->key[mid] < key) lo = mid + 1;
+        else hi = mid;
+    }
+    memset(c->top, 0, cols * sizeof *c->top);
+    if (c->above) {
+        memset(c->above, 0xff, cols * sizeof *c->above);
+        for (i = 0; i < cols; i++) c->above_h[i] = 1e308;
+    }
+    c->ev_n = 0;
+    for (i = lo; i < s->n && s->key[i] == key; i++) {
+        uint32_t tri = s->tri[i];
+        voxdagi_tri t;
+        voxdagi_ftri f;
+        int64_t fx, lx, fy, ly, x, y;
+        voxdagi_load_tri(c->mesh, tri, &t);
+        if (!(t.hi[2] > zlo)) continue; /* crossings at or below every centre */
+        if (!voxdagi_voxel_range(t.lo[0], t.hi[0], clo[0] + (int64_t)side, &fx, &lx) || lx < clo[0] ||
+            !voxdagi_voxel_range(t.lo[1], t.hi[1], clo[1] + (int64_t)side, &fy, &ly) || ly < clo[1])
+            continue;
+        if (fx < clo[0]) fx = clo[0];
+        if (fy < clo[1]) fy = clo[1];
+        voxdagi_ftri_init(&f, &t);
+        for (y = fy; y <= ly; y++)
+            for (x = fx; x <= lx; x++) {
+                int64_t q[2];
+                double h, bary[3];
+                int sign;
+                q[0] = voxdagi_fix_centre(x);
+                q[1] = voxdagi_fix_centre(y);
+                sign = voxdagi_column_cross(&f, q, &h, bary);
+                if (!sign || !(h > zlo)) continue;
+                col = (uint32_t)((size_t)(y - clo[1]) * side + (size_t)(x - clo[0]));
+                if (h > ztop) {
+                    c->top[col] += sign;
+                    if (c->above && (h < c->above_h[col] || (h == c->above_h[col] && tri > c->above[col]))) {
+                        c->above_h[col] = h;
+                        c->above[col] = tri;
+                    }
+                    continue;
+                }
+                if (!voxdagi_grow(&c->b->mem, (void **)&c->ev, &c->ev_cap, c->ev_n + 1, sizeof *c->ev)) {
+                    c->failed = 1;
+                    return;
+                }
+                c->ev[c->ev_n].h = h;
+                c->ev[c->ev_n].tri = tri;
+                c->ev[c->ev_n].col = col;
+                c->ev[c->ev_n].sign = sign;
+                c->ev_n++;
+            }
+    }
+    /* The events by column (counting sort), each column's from the top down
+       (of equal heights, the highest triangle last: the nearest above). */
+    if (!voxdagi_grow(&c->b->mem, (void **)&c->ev_sorted, &c->ev_sorted_cap, c->ev_n, sizeof *c->ev)) {
+        c->failed = 1;
+        return;
+    }
+    memset(c->col_start, 0, (cols + 1) * sizeof *c->col_start);
+    for (e = 0; e < c->ev_n; e++) c->col_start[c->ev[e].col + 1]++;
+    for (i = 0; i < cols; i++) c->col_start[i + 1] += c->col_start[i];
+    for (e = 0; e < c->ev_n; e++) c->ev_sorted[c->col_start[c->ev[e].col]++] = c->ev[e];
+    for (i = cols; i > 0; i--) c->col_start[i] = c->col_start[i - 1];
+    c->col_start[0] = 0;
+    for (col = 0; col < cols; col++) {
+        size_t first = c->col_start[col], end = c->col_start[col + 1];
+        int32_t w = c->top[col];
+        uint32_t owner = c->above ? c->above[col] : 0, lx = col & (uint32_t)(side - 1), ly = col >> c->shift;
+        uint64_t xy = voxdagi_spread3(lx) | voxdagi_spread3(ly) << 1;
+        int64_t zb;
+        for (e = first + 1; e < end; e++) { /* insertion sort: few per column */
+            voxdagi_event v = c->ev_sorted[e];
+            size_t k = e;
+            while (k > first && (c->ev_sorted[k - 1].h < v.h ||
+                                 (c->ev_sorted[k - 1].h == v.h && c->ev_sorted[k - 1].tri > v.tri))) {
+                c->ev_sorted[k] = c->ev_sorted[k - 1];
+                k--;
+            }
+            c->ev_sorted[k] = v;
+        }
+        e = first;
+        if (!w && e == end) continue;
+        for (zb = (int64_t)side / 4 - 1; zb >= 0; zb--) { /* 4 voxels of a brick at a time */
+            uint64_t code = xy | voxdagi_spread3((uint32_t)(4 * zb)) << 2, pattern = 0;
+            uint32_t own[4];
+            size_t word = (size_t)(code >> 6);
+            int j;
+            for (j = 3; j >= 0; j--) {
+                double centre = (double)(clo[2] + 4 * zb + j) + 0.5;
+                for (; e < end && c->ev_sorted[e].h > centre; e++) {
+                    w += c->ev_sorted[e].sign;
+                    owner = c->ev_sorted[e].tri;
+                }
+                own[j] = owner;
+                if (w) pattern |= 1ull << (voxdagi_spread3((uint32_t)j) << 2); /* bit 0, 4, 32, 36 */
+            }
+            if (!pattern) continue;
+            pattern <<= code & 63;
+            if (c->owner) { /* surface voxels keep their owners */
+                uint64_t m = pattern & ~c->bits[word];
+                c->inner[word] |= m;
+                for (; m; m &= m - 1) {
+                    unsigned bit = voxdagi_lowest_bit(m);
+                    uint32_t zj = voxdagi_compact3((uint64_t)bit >> 2) & 3;
+                    c->owner[64 * word + bit] = own[zj];
+                }
+            }
+            c->bits[word] |= pattern;
+            c->used[word >> 6] |= 1ull << (word & 63);
+        }
+    }
+}
+
 /* Colours of the voxels of brick WORD of the chunk at CLO, appended to RGB:
-   each from its owner triangle at the point nearest to the voxel centre. */
-static void voxdagi_chunk_colors(voxdagi_chunk *c, const int64_t clo[3], size_t word, uint64_t m) {
+   each from its owner triangle at the point nearest to the voxel centre, or
+   for an inside voxel (INNER) at the crossing of its column. */
+static void voxdagi_chunk_colors(voxdagi_chunk *c, const int64_t clo[3], size_t word, uint64_t m, uint64_t inner) {
     voxdagi_tri t;
+    voxdagi_ftri f;
     uint32_t cached = 0;
     int have = 0;
     while (m) {
         uint64_t bit = m & (0 - m), code = 64 * (uint64_t)word + (uint64_t)voxdagi_popcount64(bit - 1);
         uint32_t tri = c->owner[code], xyz[3];
-        double centre[3], bary[3];
+        double centre[3], bary[3], h;
         uint8_t rgb[3];
         unsigned k;
         m ^= bit;
-        if (!have || tri != cached) voxdagi_load_tri(c->mesh, tri, &t);
+        if (!have || tri != cached) {
+            voxdagi_load_tri(c->mesh, tri, &t);
+            if (c->inner) voxdagi_ftri_init(&f, &t);
+        }
         cached = tri;
         have = 1;
         voxdag_morton_decode(code, &xyz[0], &xyz[1], &xyz[2]);
         for (k = 0; k < 3; k++) centre[k] = (double)(clo[k] + xyz[k]) + 0.5;
-        voxdagi_tri_bary(&t, centre, bary);
+        if (inner & bit) {
+            int64_t q[2];
+            q[0] = voxdagi_fix_centre(clo[0] + xyz[0]);
+            q[1] = voxdagi_fix_centre(clo[1] + xyz[1]);
+            if (!voxdagi_column_cross(&f, q, &h, bary)) voxdagi_tri_bary(&t, centre, bary); /* never */
+        } else {
+            voxdagi_tri_bary(&t, centre, bary);
+        }
         c->mesh->color(c->mesh->user, tri, bary, rgb);
         c->rgb[c->voxels++] = (uint32_t)rgb[0] << 16 | (uint32_t)rgb[1] << 8 | rgb[2];
     }
@@ -3050,18 +3501,31 @@ static void *voxdagi_chunk_run(void *arg) {
     for (i = 0; i < c->tri_count; i++) {
         voxdagi_tri t;
         voxdagi_axes x;
+        if (c->tri[i] == UINT32_MAX) continue; /* a chunk that only the inside fills */
         voxdagi_load_tri(c->mesh, c->tri[i], &t);
         voxdagi_axes_init(&x, &t, 1.0);
         voxdagi_chunk_tri(c, &t, &x, c->tri[i], clo);
+    }
+    if (c->solid && !c->failed && !c->owner && c->tri_count == 1 && c->tri[0] == UINT32_MAX) {
+        size_t words = voxdagi_chunk_words(c); /* inside, untouched: every voxel */
+        memset(c->bits, 0xff, words * 8);
+        for (wu = 0; wu < voxdagi_chunk_used_words(c); wu++)
+            c->used[wu] = words - 64 * wu >= 64 ? ~0ull : (1ull << (words - 64 * wu)) - 1;
+    } else if (c->solid && !c->failed) {
+        voxdagi_chunk_solid(c, clo);
     }
     c->bricks = c->voxels = 0;
     for (wu = 0; wu < voxdagi_chunk_used_words(c); wu++)
         while (c->used[wu]) {
             uint64_t low = c->used[wu] & (0 - c->used[wu]);
             size_t word = 64 * wu + (size_t)voxdagi_popcount64(low - 1);
-            uint64_t m = c->bits[word];
+            uint64_t m = c->bits[word], inner = 0;
             c->used[wu] ^= low;
             c->bits[word] = 0;
+            if (c->inner) {
+                inner = c->inner[word];
+                c->inner[word] = 0;
+            }
             if (c->failed || !voxdagi_grow(&c->b->mem, (void **)&c->brick, &c->brick_cap, c->bricks + 1, 16) ||
                 (c->owner && !voxdagi_grow(&c->b->mem, (void **)&c->rgb, &c->rgb_cap,
                                            c->voxels + (size_t)voxdagi_popcount64(m), sizeof *c->rgb))) {
@@ -3071,7 +3535,7 @@ static void *voxdagi_chunk_run(void *arg) {
             c->brick[2 * c->bricks] = c->code << (3 * c->shift - 6) | word;
             c->brick[2 * c->bricks + 1] = m;
             c->bricks++;
-            if (c->owner) voxdagi_chunk_colors(c, clo, word, m);
+            if (c->owner) voxdagi_chunk_colors(c, clo, word, m, inner);
             else c->voxels += (size_t)voxdagi_popcount64(m);
         }
     return NULL;
@@ -3100,13 +3564,99 @@ static voxdag_status voxdagi_builder_take(voxdag_builder *b, const voxdagi_chunk
     return voxdagi_builder_bricks(b, c->brick, NULL, c->rgb, c->bricks, voxels, 0);
 }
 
+/* Sorts N (key, triangle) pairs by the low BITS bits of the keys, stably.
+   Returns 0 when out of memory. */
+static int voxdagi_sort_pairs(voxdagi_mem *m, uint64_t *key, uint32_t *tri, size_t n, unsigned bits) {
+    uint64_t *tmp_key = (uint64_t *)voxdagi_alloc(m, (n ? n : 1) * sizeof *tmp_key);
+    uint32_t *tmp_tri = (uint32_t *)voxdagi_alloc(m, (n ? n : 1) * sizeof *tmp_tri);
+    int ok = tmp_key && tmp_tri;
+    if (ok) voxdagi_radix_sort(key, tri, tmp_key, tmp_tri, n, bits);
+    voxdagi_free(m, tmp_key, (n ? n : 1) * sizeof *tmp_key);
+    voxdagi_free(m, tmp_tri, (n ? n : 1) * sizeof *tmp_tri);
+    return ok;
+}
+
+/* Appends (KEY, TRI) to the pair arrays. Returns 0 when out of memory. */
+static int voxdagi_push_pair(voxdagi_mem *m, uint64_t **key, uint32_t **tri, size_t *n, size_t *cap, size_t *cap2,
+                             uint64_t k, uint32_t t) {
+    if (*n == *cap) {
+        size_t c1 = *cap;
+        int ok = voxdagi_grow(m, (void **)key, &c1, *n + 1, sizeof **key) &&
+                 voxdagi_grow(m, (void **)tri, cap2, c1, sizeof **tri);
+        *cap = c1;
+        if (!ok) return 0;
+    }
+    (*key)[*n] = k;
+    (*tri)[*n] = t;
+    ++*n;
+    return 1;
+}
+
+/* The chunks of a solid mesh that no triangle touches but the inside fills:
+   each chunk column's crossings at its first voxel column give the winding
+   number of each of its chunks' lowest voxel centre, which holds for the
+   whole chunk (no surface passes through it). Appends (chunk, UINT32_MAX)
+   for each to the pairs, whose first SURFACE are sorted. */
+static int voxdagi_solid_chunks(voxdagi_mem *m, const voxdag_mesh *mesh, const voxdagi_solid *s, unsigned shift,
+                                int64_t chunks, uint64_t **pair_chunk, uint32_t **pair_tri, size_t *pairs,
+                                size_t *cap, size_t *cap2) {
+    size_t i, j, k, ev_cap = 0, surface = *pairs;
+    voxdagi_event *ev = NULL;
+    int ok = 1;
+    for (i = 0; i < s->n && ok; i = j) {
+        uint64_t key = s->key[i];
+        uint32_t cx = (uint32_t)(key & 0xffffffffu), cy = (uint32_t)(key >> 32);
+        int64_t q[2], cz;
+        size_t ne = 0;
+        q[0] = voxdagi_fix_centre((int64_t)cx << shift);
+        q[1] = voxdagi_fix_centre((int64_t)cy << shift);
+        for (j = i; j < s->n && s->key[j] == key; j++) {
+            voxdagi_tri t;
+            voxdagi_ftri f;
+            double h, bary[3];
+            int sign;
+            voxdagi_load_tri(mesh, s->tri[j], &t);
+            voxdagi_ftri_init(&f, &t);
+            if (!(sign = voxdagi_column_cross(&f, q, &h, bary))) continue;
+            if (!voxdagi_grow(m, (void **)&ev, &ev_cap, ne + 1, sizeof *ev)) {
+                ok = 0;
+                break;
+            }
+            ev[ne].h = h;
+            ev[ne++].sign = sign;
+        }
+        for (cz = 0; cz < chunks && ok; cz++) {
+            uint64_t code = voxdag_morton_encode(cx, cy, (uint32_t)cz);
+            double centre = (double)(cz << shift) + 0.5;
+            size_t lo = 0, hi = surface;
+            int32_t w = 0;
+            for (k = 0; k < ne; k++)
+                if (ev[k].h > centre) w += ev[k].sign;
+            if (!w) continue;
+            while (lo < hi) { /* touched by a triangle? */
+                size_t mid = lo + (hi - lo) / 2;
+                if ((*pair_chunk)[mid] < code) lo = mid + 1;
+                else hi = mid;
+            }
+            if (lo < surface && (*pair_chunk)[lo] == code) continue;
+            ok = voxdagi_push_pair(m, pair_chunk, pair_tri, pairs, cap, cap2, code, UINT32_MAX);
+        }
+    }
+    voxdagi_free(m, ev, ev_cap * sizeof *ev);
+    return ok;
+}
+
 VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag_mesh *mesh, voxdag_error *err) {
-    unsigned shift = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8, t, k, jobs = 0, sets, cur = 0;
+    unsigned shift = b && b->opts.chunk_levels ? b->opts.chunk_levels : 8, t, k, jobs = 0, sets, cur = 0, bits = 0;
     int64_t n, chunks;
-    uint64_t *pair_chunk = NULL, *tmp_chunk = NULL;
-    uint32_t *pair_tri = NULL, *tmp_tri = NULL;
+    uint64_t *pair_chunk = NULL;
+    uint32_t *pair_tri = NULL;
     size_t pairs = 0, cap = 0, cap2 = 0, i = 0, p;
     voxdagi_chunk chunk[2 * VOXDAGI_MAX_THREADS];
+    voxdagi_solid solid;
+    uint64_t *col_key = NULL;
+    uint32_t *col_tri = NULL;
+    size_t cols = 0, col_cap = 0, col_cap2 = 0;
     voxdag_status st = VOXDAG_OK;
     if (!b || !mesh || (mesh->triangle_count && (!mesh->indices || !mesh->positions)) ||
         (b->opts.colors && !mesh->color))
@@ -3116,6 +3666,24 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "meshes go into a builder without voxels");
     if (mesh->triangle_count > UINT32_MAX)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more than 2^32-1 triangles");
+    if (mesh->solid) { /* closed, or nothing */
+        uint64_t open = 0, first = UINT64_MAX, bad = 0;
+        st = voxdagi_open_edges(&b->mem, mesh, &open, &first, &bad);
+        if (st == VOXDAG_ERR_INVALID_ARGUMENT)
+            return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, bad);
+        if (st == VOXDAG_ERR_LIMIT && !b->mem.over_limit)
+            return VOXDAGI_FAIL(err, st, "a solid mesh has more than 2^31-1 vertices");
+        if (st != VOXDAG_OK) {
+            b->failed = voxdagi_mem_fail(&b->mem, err, st, voxdagi_reduce_message(st));
+            return b->failed;
+        }
+        if (open)
+            return voxdagi_fail(err, VOXDAG_ERR_NOT_CLOSED,
+                                "a solid mesh must be closed: some edge is not used as often each way "
+                                "(voxdag_mesh_open_edges counts them)",
+                                UINT64_MAX, first);
+    }
+    memset(&solid, 0, sizeof solid);
     if (shift > 8) shift = 8;
     if (shift > b->levels) shift = b->levels;
     if (shift < 2) shift = 2;
@@ -3163,24 +3731,40 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
                     pairs++;
                 }
     }
-    if (st == VOXDAG_OK && pairs) { /* stable: each chunk keeps its triangles ascending */
-        tmp_chunk = (uint64_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_chunk);
-        tmp_tri = (uint32_t *)voxdagi_alloc(&b->mem, pairs * sizeof *tmp_tri);
-        if (tmp_chunk && tmp_tri) {
-            unsigned bits = 0;
-            while (((int64_t)1 << bits) < chunks) bits++;
-            voxdagi_radix_sort(pair_chunk, pair_tri, tmp_chunk, tmp_tri, pairs, 3 * bits);
-        } else {
-            st = VOXDAG_ERR_OUT_OF_MEMORY;
+    while (((int64_t)1 << bits) < chunks) bits++;
+    /* stable: each chunk keeps its triangles ascending */
+    if (st == VOXDAG_OK && pairs && !voxdagi_sort_pairs(&b->mem, pair_chunk, pair_tri, pairs, 3 * bits))
+        st = VOXDAG_ERR_OUT_OF_MEMORY;
+    if (st == VOXDAG_OK && mesh->solid) { /* the triangles by chunk columns, and the chunks inside */
+        for (i = 0; i < mesh->triangle_count && st == VOXDAG_OK; i++) {
+            voxdagi_tri tr;
+            int64_t fx, lx, fy, ly, cx, cy;
+            voxdagi_load_tri(mesh, i, &tr);
+            if (!voxdagi_voxel_range(tr.lo[0], tr.hi[0], n, &fx, &lx) ||
+                !voxdagi_voxel_range(tr.lo[1], tr.hi[1], n, &fy, &ly))
+                continue;
+            for (cy = fy >> shift; cy <= ly >> shift && st == VOXDAG_OK; cy++)
+                for (cx = fx >> shift; cx <= lx >> shift && st == VOXDAG_OK; cx++)
+                    if (!voxdagi_push_pair(&b->mem, &col_key, &col_tri, &cols, &col_cap, &col_cap2,
+                                           (uint64_t)cy << 32 | (uint64_t)cx, (uint32_t)i))
+                        st = VOXDAG_ERR_OUT_OF_MEMORY;
         }
-        voxdagi_free(&b->mem, tmp_chunk, pairs * sizeof *tmp_chunk);
-        voxdagi_free(&b->mem, tmp_tri, pairs * sizeof *tmp_tri);
+        if (st == VOXDAG_OK && !voxdagi_sort_pairs(&b->mem, col_key, col_tri, cols, 32 + bits))
+            st = VOXDAG_ERR_OUT_OF_MEMORY;
+        solid.key = col_key;
+        solid.tri = col_tri;
+        solid.n = cols;
+        if (st == VOXDAG_OK && !voxdagi_solid_chunks(&b->mem, mesh, &solid, shift, chunks, &pair_chunk, &pair_tri,
+                                                     &pairs, &cap, &cap2))
+            st = VOXDAG_ERR_OUT_OF_MEMORY;
+        if (st == VOXDAG_OK && pairs && !voxdagi_sort_pairs(&b->mem, pair_chunk, pair_tri, pairs, 3 * bits))
+            st = VOXDAG_ERR_OUT_OF_MEMORY;
     }
     /* Voxelize in rounds of one chunk per thread and reduce each round's
        chunks in Morton order; with threads, while the next round runs. */
     sets = b->threads > 1 ? 2 : 1;
     for (; jobs < sets * b->threads && st == VOXDAG_OK && pairs; jobs++)
-        if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift)) st = VOXDAG_ERR_OUT_OF_MEMORY;
+        if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift, mesh->solid ? &solid : NULL)) st = VOXDAG_ERR_OUT_OF_MEMORY;
     p = 0;
     t = st == VOXDAG_OK ? voxdagi_chunk_assign(chunk, b->threads, pair_chunk, pair_tri, pairs, &p) : 0;
     voxdagi_run_parallel(b, voxdagi_chunk_run, chunk, sizeof *chunk, t);
@@ -3205,6 +3789,8 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
     for (t = 0; t < jobs; t++) voxdagi_chunk_free(&chunk[t]);
     voxdagi_free(&b->mem, pair_chunk, cap * sizeof *pair_chunk);
     voxdagi_free(&b->mem, pair_tri, cap2 * sizeof *pair_tri);
+    voxdagi_free(&b->mem, col_key, col_cap * sizeof *col_key);
+    voxdagi_free(&b->mem, col_tri, col_cap2 * sizeof *col_tri);
     if (st == VOXDAG_ERR_INVALID_ARGUMENT)
         return voxdagi_fail(err, st, "triangle index out of range or non-finite vertex", UINT64_MAX, (uint64_t)i);
     if (st != VOXDAG_OK) {

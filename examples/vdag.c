@@ -175,6 +175,9 @@ static const struct {
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
+     "  --solid            meshes: fill the inside too (default: the surface only): voxels whose\n"
+     "                     centre the mesh encloses (nonzero winding number); a mesh with open\n"
+     "                     edges is refused, with their count\n"
      "  --chunk-levels C   voxelize meshes in chunks of 2^C voxels per axis, 2..8 (default:\n"
      "                     chosen from the mesh: 5 for coloured meshes under 65536 triangles, else 8)\n"
      "  --threads T        worker threads, >= 1 (default: the processors online)\n"
@@ -311,6 +314,7 @@ typedef struct build_args {
     int force;              /* --force: build even past the machine's memory */
     int allow_empty;        /* --allow-empty: an input without triangles or points builds */
     uint32_t chunk_levels;  /* --chunk-levels; 0: chosen from the mesh */
+    int solid;              /* --solid: meshes filled inside */
     uint32_t max_memory;    /* --max-memory in MiB; 0: no limit */
     uint64_t max_texture_pixels; /* --max-texture-pixels; 0: the importer's default */
     uint64_t max_vox_voxels;     /* --max-vox-voxels; 0: the importer's default */
@@ -792,6 +796,21 @@ static double mesh_voxel_estimate(const double *grid, const uint32_t *indices, s
     return sum;
 }
 
+/* The volume a closed mesh encloses, in grid units (|the sum of the signed
+   volumes of the tetrahedra from the origin to each triangle|); for the
+   voxels of a solid build. */
+static double mesh_volume_estimate(const double *grid, const uint32_t *indices, size_t triangles) {
+    double sum = 0;
+    size_t t;
+    for (t = 0; t < triangles; t++) {
+        const double *a = grid + 3 * (size_t)indices[3 * t], *b = grid + 3 * (size_t)indices[3 * t + 1],
+                     *c = grid + 3 * (size_t)indices[3 * t + 2];
+        sum += a[0] * (b[1] * c[2] - b[2] * c[1]) + a[1] * (b[2] * c[0] - b[0] * c[2]) +
+               a[2] * (b[0] * c[1] - b[1] * c[0]);
+    }
+    return fabs(sum) / 6;
+}
+
 static int spill_colors(void *user, const uint8_t *rgb, size_t n) {
     color_spill *s = (color_spill *)user;
     s->n += n;
@@ -968,15 +987,18 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
    memory 4 bytes a voxel up to 2048^3, then 3/4 of that per level more (the
    builder holds the unique nodes, which grow about 3x per level while the
    voxels grow 4x: on a game level its peak fell from 2.4 bytes a voxel at
-   2048^3 to 0.3 at 65536^3), plus 3 a voxel for uncompressed colours. Past
+   2048^3 to 0.3 at 65536^3), plus 3 a voxel for uncompressed colours;
+   with --solid, the inside's voxels (mesh_volume_estimate) count for the
+   colours only, as its nodes are shared all but next to the surface. Past
    the machine's memory the build needs --force. Returns 0 after printing
    why it stops. */
 static int mesh_estimate(const build_args *a, const vdag_scene *sc, const double *grid, int colors) {
-    double voxels = mesh_voxel_estimate(grid, sc->indices, sc->triangle_count), per_voxel = 4, bytes, machine;
+    double surface = mesh_voxel_estimate(grid, sc->indices, sc->triangle_count), per_voxel = 4, bytes, machine;
+    double voxels = surface + (a->solid ? mesh_volume_estimate(grid, sc->indices, sc->triangle_count) : 0);
     long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
     uint32_t l;
     for (l = 12; l <= a->levels; l++) per_voxel *= 0.75;
-    bytes = voxels * (per_voxel + (colors && !a->compress ? 3 : 0));
+    bytes = surface * per_voxel + voxels * (colors && !a->compress ? 3 : 0); /* inside: shared nodes */
     machine = pages > 0 && page > 0 ? (double)pages * (double)page : 0;
     if (voxels > 1e7 && !a->quiet)
         fprintf(stderr, "vdag: estimate: about %.3g voxels and %.0f MiB (rough)\n", voxels, bytes / 1048576.0);
@@ -1003,7 +1025,11 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
         vdag_scene_free(sc);
         return vdag_fail("out of memory");
     }
-    if (build_opts(a, colors, bounds, colors ? mesh_voxel_estimate(grid, sc->indices, sc->triangle_count) : 0, &o)) {
+    if (build_opts(a, colors, bounds,
+                   colors ? mesh_voxel_estimate(grid, sc->indices, sc->triangle_count) +
+                                (a->solid ? mesh_volume_estimate(grid, sc->indices, sc->triangle_count) : 0)
+                          : 0,
+                   &o)) {
         free(grid);
         vdag_scene_free(sc);
         return 1;
@@ -1023,12 +1049,22 @@ static int build_mesh(build_args *a, vdag_scene *sc, double t0) {
     mesh.triangle_count = sc->triangle_count;
     mesh.color = colors ? mesh_color : NULL;
     mesh.user = sc;
+    mesh.solid = a->solid;
     for (i = 0; !a->no_alpha_test && i < sc->image_count; i++)
         if (sc->images[i].alpha) mesh.keep = mesh_keep; /* some texel is not opaque */
     rc = voxdag_builder_create(&o, &b, &err) != VOXDAG_OK;
     if (!rc && voxdag_builder_add_mesh(b, &mesh, &err) != VOXDAG_OK) {
+        uint64_t open = 0, first = 0;
+        voxdag_error e2;
         voxdag_builder_free(b);
         rc = 1;
+        progress_end(a);
+        if (err.status == VOXDAG_ERR_NOT_CLOSED && voxdag_mesh_open_edges(&mesh, NULL, &open, &first, &e2) == VOXDAG_OK)
+            fprintf(stderr,
+                    "vdag: --solid: %s is not closed: %llu open edges (the first at triangle %llu, from 0); an "
+                    "edge is open when its triangles do not use it as often each way (vertices at one position "
+                    "are one vertex). Without --solid the surface builds.\n",
+                    a->in, (unsigned long long)open, (unsigned long long)first);
     }
     rc = finish_build(a, b, rc, &err, t0);
     free(grid);
@@ -1169,6 +1205,8 @@ static int cmd_build(int argc, char **argv) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
+        } else if (!strcmp(argv[k], "--solid")) {
+            a.solid = 1;
         } else if (!strcmp(argv[k], "--no-alpha-test")) {
             a.no_alpha_test = 1;
         } else if (!strcmp(argv[k], "--no-symmetry")) {
@@ -1249,6 +1287,10 @@ static int cmd_build(int argc, char **argv) {
                         "the result has no voxels\n", a.in);
     a.input_items = sc.triangle_count ? sc.triangle_count : sc.point_count;
     if (sc.triangle_count) return build_mesh(&a, &sc, t0);
+    if (a.solid) {
+        vdag_scene_free(&sc);
+        return vdag_fail("%s: --solid fills meshes, and this input has no triangles", a.in);
+    }
     if (!a.levels && !sc.points_are_voxels && sc.point_count && choose_cloud_levels(&sc, &a)) {
         vdag_scene_free(&sc);
         return 1;

@@ -244,6 +244,38 @@ check "--max-memory 1 fails as a limit, one line naming it" sh -c "! '$VDAG' bui
 check "--max-memory 512 builds" "$VDAG" build "$T/alpha.obj" "$T/mm.vdag" --levels 8 --max-memory 512 --quiet
 check "--max-memory 0 is refused" sh -c "! '$VDAG' build '$T/alpha.obj' '$T/mm0.vdag' --max-memory 0 2>/dev/null"
 
+# -- --solid: a closed box fills every voxel of its surface voxels' box (the
+# surface ones kept); the box without its top is refused, naming its 4 open
+# edges; an input without triangles is refused
+python3 - "$T" <<'EOF'
+import sys
+t = sys.argv[1]
+v = [(x, y, z) for z in (0, 1.3) for y in (0, 2) for x in (0, 3)]
+faces = [(0, 2, 3, 1), (4, 5, 7, 6), (0, 1, 5, 4), (2, 6, 7, 3), (0, 4, 6, 2), (1, 3, 7, 5)]
+for name, fs in (("box", faces), ("open", faces[:1] + faces[2:])):
+    with open("%s/%s.off" % (t, name), "w") as f:
+        f.write("OFF\n%d %d 0\n" % (len(v), len(fs)))
+        f.writelines("%g %g %g\n" % p for p in v)
+        f.writelines("4 %d %d %d %d\n" % q for q in fs)
+EOF
+check "--solid fills a closed box: its surface voxels' box, every voxel" sh -c "
+    '$VDAG' build '$T/box.off' '$T/surf.vdag' --levels 5 --quiet && '$VDAG' build '$T/box.off' '$T/solid.vdag' --levels 5 --solid --quiet &&
+    '$VDAG' export-voxels '$T/surf.vdag' >'$T/surf.txt' && '$VDAG' export-voxels '$T/solid.vdag' >'$T/solid.txt' && python3 - '$T' <<'EOF'
+import sys
+t = sys.argv[1]
+load = lambda n: {tuple(map(int, l.split()[:3])) for l in open(t + '/' + n) if l.strip()}
+surf, solid = load('surf.txt'), load('solid.txt')
+lo = [min(p[k] for p in surf) for k in range(3)]
+hi = [max(p[k] for p in surf) for k in range(3)]
+box = {(x, y, z) for x in range(lo[0], hi[0] + 1) for y in range(lo[1], hi[1] + 1) for z in range(lo[2], hi[2] + 1)}
+assert surf < solid == box and len(box) > 2 * len(surf), (len(surf), len(solid), len(box))
+EOF"
+check "--solid refuses a box without its top, naming 4 open edges" sh -c "
+    ! '$VDAG' build '$T/open.off' '$T/open.vdag' --levels 4 --solid 2>'$T/err' && grep -q ' 4 open edges' '$T/err' &&
+    grep -q 'not closed' '$T/err' && [ ! -e '$T/open.vdag' ] && '$VDAG' build '$T/open.off' '$T/open.vdag' --levels 4 --quiet"
+check "--solid refuses an input without triangles" sh -c "
+    printf '1 2 3\n' >'$T/one.xyz' && ! '$VDAG' build '$T/one.xyz' '$T/one.vdag' --solid 2>'$T/err' && grep -q -- '--solid' '$T/err'"
+
 # -- import limits: --max-texture-pixels (all textures, one file counted once
 # however it is named) and --max-vox-voxels (a .vox scene graph's placed
 # voxels) refuse past them with one line naming the option; side files must
@@ -611,7 +643,7 @@ for c in build info validate lookup rays render export-voxels gen; do
     check "vdag $c --help: usage on stdout, exit 0" sh -c "'$VDAG' $c --help >'$T/help' 2>'$T/err' && grep -q '^usage: vdag $c' '$T/help' && [ ! -s '$T/err' ]"
 done
 check "every build and render option in --help with its default" sh -c "
-    for o in --levels --up --symmetry --no-symmetry --color-error --raw-colors --color-bits --color-effort --no-colors --chunk-levels --threads --allow-empty --force --stats --quiet; do
+    for o in --levels --up --symmetry --no-symmetry --color-error --raw-colors --color-bits --color-effort --no-colors --chunk-levels --solid --threads --allow-empty --force --stats --quiet; do
         '$VDAG' build --help | grep -q -- \"\$o .*default\" || '$VDAG' build --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done
     for o in --size --eye --target --fov --shadows --lod --threads; do
         '$VDAG' render --help | grep -A1 -- \"\$o \" | grep -q default || exit 1; done

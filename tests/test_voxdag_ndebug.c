@@ -223,6 +223,7 @@ static void nulls(voxdag *d) {
     check(voxdag_builder_add(NULL, xyz, NULL, 1, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "builder_add NULL", 0);
     check(voxdag_builder_add_bricks(NULL, bricks, NULL, 1, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "add_bricks NULL", 0);
     check(voxdag_builder_add_mesh(NULL, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "add_mesh NULL", 0);
+    check(voxdag_mesh_open_edges(NULL, NULL, NULL, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "open_edges NULL", 0);
     check(voxdag_builder_flush(NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "flush NULL", 0);
     check(voxdag_builder_finish(NULL, &out, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "finish NULL", 0);
     check(voxdag_builder_create(NULL, &b, NULL) == VOXDAG_OK, "builder", 0);
