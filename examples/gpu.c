@@ -1,5 +1,4 @@
 /* The GPU path of the vdag tool: see gpu.h. */
-#include <float.h>
 #include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -8,8 +7,6 @@
 
 #include "gpu.h"
 #include "gpu_vulkan.h"
-
-#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD == 0
 #include "voxdag_gpu.h"
 
 /* The kernel's C build reads and writes plain word arrays. */
@@ -171,31 +168,3 @@ int vdag_gpu_run(vdag_gpu *g, const vdag_gpu_work *w, const uint32_t *in, size_t
                            gx ? (groups + gx - 1) / gx : 1, repeat ? repeat : 1, seconds, err, err_size);
     }
 }
-
-#else /* x87 maths: the kernel's C build needs float arithmetic rounded to float */
-
-struct vdag_gpu {
-    int unused;
-};
-
-int vdag_gpu_open(vdag_gpu **out, vdag_gpu_target target, const voxdag *dag, unsigned threads, char *err,
-                  size_t err_size) {
-    (void)target, (void)dag, (void)threads;
-    *out = NULL;
-    snprintf(err, err_size, "this vdag was built with x87 maths, without the GPU path (build it with SSE maths)");
-    return 1;
-}
-int vdag_gpu_load(vdag_gpu *g, const voxdag *dag, char *err, size_t err_size) {
-    (void)g, (void)dag;
-    return snprintf(err, err_size, "no GPU path in this build"), 1;
-}
-void vdag_gpu_close(vdag_gpu *g) { (void)g; }
-const char *vdag_gpu_device(const vdag_gpu *g) { return (void)g, ""; }
-int vdag_gpu_is_cpu(const vdag_gpu *g) { return (void)g, 1; }
-int vdag_gpu_run(vdag_gpu *g, const vdag_gpu_work *w, const uint32_t *in, size_t in_words, uint32_t *out,
-                 size_t out_words, uint32_t repeat, double *seconds, char *err, size_t err_size) {
-    (void)g, (void)w, (void)in, (void)in_words, (void)out, (void)out_words, (void)repeat, (void)seconds;
-    snprintf(err, err_size, "no GPU path in this build");
-    return 1;
-}
-#endif
