@@ -954,11 +954,11 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_box_near(voxdag_gpu_frustum fr, voxda
 VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpu_frustum_depth(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_frustum fr) {
     voxdag_gpu_u32 st_at[VOXDAG_GPUI_STACK], st_info[VOXDAG_GPUI_STACK], st_x[VOXDAG_GPUI_STACK],
         st_y[VOXDAG_GPUI_STACK], st_z[VOXDAG_GPUI_STACK];
-    voxdag_gpu_u32 sp = 1u, nl = f.levels, near = 0u;
+    voxdag_gpu_u32 sp = 1u, nl = f.levels, nearest = 0u;
     voxdag_gpu_f32 best = VOXDAG_GPUI_LIMIT, margin;
     if (nl == 0u || (f.voxels_lo | f.voxels_hi) == 0u) return best;
     margin = VOXDAG_GPU_F32(1u << nl) * 0.00024414062f; /* 2^-12 of the grid: float rounding of the tests */
-    near |= fr.fx < 0.0f ? 1u : 0u, near |= fr.fy < 0.0f ? 2u : 0u, near |= fr.fz < 0.0f ? 4u : 0u;
+    nearest |= fr.fx < 0.0f ? 1u : 0u, nearest |= fr.fy < 0.0f ? 2u : 0u, nearest |= fr.fz < 0.0f ? 4u : 0u;
     st_at[0] = 0u, st_info[0] = f.root_inverse << 8, st_x[0] = 0u, st_y[0] = 0u, st_z[0] = 0u;
     while (sp > 0u) {
         voxdag_gpu_u32 at, q, mi, cx, cy, cz, k;
@@ -981,11 +981,11 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpu_frustum_depth(voxdag_gpu_buf buf, voxd
         if (q + 2u == nl) { /* a brick: its 2^3 cells, then their voxels, the same way */
             voxdag_gpui_mask m = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
             for (k = 0u; k < 8u; k++) {
-                voxdag_gpu_u32 byte = (k < 4u ? m.lo : m.hi) >> (8u * (k & 3u)) & 0xFFu, v;
+                voxdag_gpu_u32 cell_bits = (k < 4u ? m.lo : m.hi) >> (8u * (k & 3u)) & 0xFFu, v;
                 voxdag_gpu_f32 ex = voxdag_gpui_add(x, VOXDAG_GPU_F32(2u * (k & 1u)));
                 voxdag_gpu_f32 ey = voxdag_gpui_add(y, VOXDAG_GPU_F32(k & 2u));
                 voxdag_gpu_f32 ez = voxdag_gpui_add(z, VOXDAG_GPU_F32(k >> 1 & 2u));
-                if (byte == 0u || !voxdag_gpui_box_in(fr, ex, ey, ez, 2.0f, margin)) continue;
+                if (cell_bits == 0u || !voxdag_gpui_box_in(fr, ex, ey, ez, 2.0f, margin)) continue;
                 d_near = voxdag_gpui_box_near(fr, ex, ey, ez, 2.0f);
                 d_far = voxdag_gpui_box_max(fr.fx, fr.fy, fr.fz, ex, ey, ez, 2.0f);
                 if (2.0f <= voxdag_gpui_mul(fr.width, d_far) || 2.0f < voxdag_gpui_mul(fr.lod, d_far)) {
@@ -996,7 +996,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpu_frustum_depth(voxdag_gpu_buf buf, voxd
                     voxdag_gpu_f32 vx = voxdag_gpui_add(ex, VOXDAG_GPU_F32(v & 1u));
                     voxdag_gpu_f32 vy = voxdag_gpui_add(ey, VOXDAG_GPU_F32(v >> 1 & 1u));
                     voxdag_gpu_f32 vz = voxdag_gpui_add(ez, VOXDAG_GPU_F32(v >> 2));
-                    if ((byte >> v & 1u) != 0u && voxdag_gpui_box_in(fr, vx, vy, vz, 1.0f, margin)) {
+                    if ((cell_bits >> v & 1u) != 0u && voxdag_gpui_box_in(fr, vx, vy, vz, 1.0f, margin)) {
                         voxdag_gpu_f32 d = voxdag_gpui_box_near(fr, vx, vy, vz, 1.0f);
                         if (d < best) best = d;
                     }
@@ -1007,7 +1007,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpu_frustum_depth(voxdag_gpu_buf buf, voxd
         {
             voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_data(buf, f, q) + at), j;
             for (j = 8u; j > 0u; j--) { /* the nearest octant popped first */
-                voxdag_gpu_u32 w = near ^ (j - 1u), sw = voxdag_gpui_act(mi, w);
+                voxdag_gpu_u32 w = nearest ^ (j - 1u), sw = voxdag_gpui_act(mi, w);
                 if ((header >> (2u * sw) & 3u) != 0u) {
                     voxdag_gpui_ref ref = voxdag_gpui_child(buf, f, q, at, header, sw);
                     st_at[sp] = ref.at, st_info[sp] = (q + 1u) | voxdag_gpui_compose(ref.inverse, mi) << 8;

@@ -1,6 +1,10 @@
 /* voxdag_gpu.h in one translation unit in its C mode (no implementation
    macro: every function is static inline). tests/check_all.sh compiles it
-   with every compiler and target; on x87 maths it must stop with #error. */
+   with every compiler and target. On Windows <windows.h> comes first: its
+   macros (near, far, small, ...) must not break the header. */
+#ifdef _WIN32
+#include <windows.h>
+#endif
 #include "voxdag_gpu.h"
 #include "voxdag_gpu.h" /* the guard makes a second inclusion harmless */
 
