@@ -569,6 +569,16 @@ VOXDAG_API voxdag_status voxdag_grid_to_world(const voxdag *dag, const double gr
 VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t z,
                              uint64_t *index);
 
+/* Many voxdag_lookup calls at once: point i is XYZ[3 i .. 3 i + 2]; FULL[i]
+   (when FULL is not NULL) is what voxdag_lookup returns for it and INDEX[i]
+   (when INDEX is not NULL) its voxel index, written only for full points.
+   Returns the number of full points. Consecutive points that share the
+   upper part of their path from the root (nearby points, for example in
+   Morton order) descend only from where the paths part. Thread-safe; no
+   allocation. */
+VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, size_t count, uint8_t *full,
+                                       uint64_t *index);
+
 /* Colour (RGB8) of voxel INDEX, whatever the colour section's kind: raw RGB8,
    or a voxcolor stream when the implementation was compiled with voxcolor.h
    (include voxcolor.h before the unit that defines VOXDAG_IMPLEMENTATION, or
@@ -624,6 +634,11 @@ typedef struct voxdag_ray_opts {
                           (t * lod_factor), is below this; 0 = full detail. Cells
                           are nodes (4^3 bricks and coarser) and the 2^3 cells
                           of a brick (full when any of their 8 voxels is) */
+    int t_max_exclusive; /* 1: the range is half-open, [t_min, t_max): a voxel
+                            entered exactly at t_max is not hit, and t_max is
+                            taken as given (0 is not "no limit"; t_max <= t_min
+                            is empty). For line of sight from point A to B:
+                            origin A, dir B - A, t in [0, 1) */
     uint32_t zero_end; /* must be 0 */
 } voxdag_ray_opts;
 
@@ -651,6 +666,28 @@ VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray,
    voxdag_raycast without level of detail, with less bookkeeping.
    Thread-safe; no allocation. */
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray);
+
+/* voxdag_occluded with ray options: level of detail (a full cell coarser than
+   opts->lod_pixels blocks the ray, for distant shadows) and t_max_exclusive;
+   want_index is ignored. Returns 1 exactly when voxdag_raycast with the same
+   OPTS hits, 0 when it misses, -1 when DAG or RAY is NULL or OPTS is invalid.
+   OPTS may be NULL (then the same as voxdag_occluded). */
+VOXDAG_API int voxdag_occluded_opts(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts);
+
+/* A ray leaving the surface that RAY hit (HIT as voxdag_raycast filled it),
+   in direction DIR, for shadow and reflection rays: *OUT starts at the hit
+   point on the hit cell's entry face, put exactly on the face's plane and
+   inside its square (origin + t * dir rounded can lie inside the cell and
+   hit it again: shadow acne), with t in [0, no limit). A ray that starts on
+   a face starts in the cell it moves into, so when DIR points out of the
+   face (DIR . normal > 0) OUT can never enter the hit cell again, at any
+   level of detail; returns 1. Returns 0 when OUT starts in the hit cell
+   (DIR points into the face or along it, or the hit has no entry face: RAY
+   started inside the cell), so that a shadow ray towards a light behind
+   the surface is blocked at once, as it should be; -1 (OUT untouched) when
+   an argument is NULL. OUT may be RAY. */
+VOXDAG_API int voxdag_ray_from_hit(const voxdag *dag, const voxdag_ray *ray, const voxdag_hit *hit,
+                                   const double dir[3], voxdag_ray *out);
 
 /* Maps a world-space ray (origin and direction in the units of the file's
    bounds, see voxdag_world_to_grid) to grid units: the origin as a point, the
@@ -5801,6 +5838,57 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     return 1;
 }
 
+/* The path of the previous point is kept per node level (its node, the
+   transform into it and the index of its first voxel); the next point
+   starts at the deepest node both paths share: below the highest bit in
+   which their coordinates differ, and no deeper than the previous point
+   got. */
+VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, size_t count, uint8_t *full,
+                                       uint64_t *index) {
+    uint64_t at[VOXDAG_MAX_LEVELS], idx[VOXDAG_MAX_LEVELS], mask = 0, found = 0;
+    unsigned mi[VOXDAG_MAX_LEVELS];
+    uint32_t nlevels, brick_level, reached = 1, prev[3] = {0, 0, 0}; /* reached: levels of the path known */
+    int have_mask = 0; /* MASK: the brick at the end of the path, in world order */
+    size_t i;
+    if (!dag || !xyz) return 0;
+    nlevels = dag->levels, brick_level = nlevels - 2;
+    at[0] = 0, idx[0] = 0, mi[0] = voxdagi_cube_tables.inv[dag->root_transform];
+    for (i = 0; i < count; i++) {
+        uint32_t x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2], diff, l, shared;
+        unsigned p;
+        int is_full = 0;
+        if (!dag->voxels || (x | y | z) >> nlevels) goto answer;
+        diff = (x ^ prev[0]) | (y ^ prev[1]) | (z ^ prev[2]);
+        shared = diff ? nlevels - voxdagi_bit_length(diff) : nlevels; /* levels choosing the same octant */
+        l = shared < reached - 1 ? shared : reached - 1;
+        prev[0] = x, prev[1] = y, prev[2] = z;
+        if (l < brick_level) have_mask = 0;
+        for (; l < brick_level; l++) {
+            const uint8_t *rec = dag->level[l].data + at[l];
+            unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l, w, v;
+            uint64_t ref = 0, before = 0;
+            w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
+            v = voxdagi_cube_tables.act[mi[l]][w];
+            reached = l + 1;
+            if (!(header >> (2 * v) & 3)) goto answer;
+            if (index) before = voxdagi_preceding(dag, l, rec, header, mi[l], w, &ref);
+            else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
+            mi[l + 1] = voxdagi_cube_tables.comp[ref & 63][mi[l]];
+            at[l + 1] = ref >> 6;
+            idx[l + 1] = idx[l] + before;
+        }
+        if (!have_mask) mask = voxdagi_brick_to_world(voxdagi_brick(dag, at[brick_level]), mi[brick_level]);
+        have_mask = 1, reached = brick_level + 1;
+        p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
+        is_full = (int)(mask >> p & 1);
+        if (is_full && index) index[i] = idx[brick_level] + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
+    answer:
+        found += (uint64_t)is_full;
+        if (full) full[i] = (uint8_t)is_full;
+    }
+    return found;
+}
+
 /* Depth-first walk in world Morton order with an explicit stack. */
 VOXDAG_API uint64_t voxdag_for_each_voxel(const voxdag *dag, voxdag_voxel_fn fn, void *user) {
     struct frame {
@@ -6121,10 +6209,21 @@ static uint64_t voxdagi_ray_index(const voxdag *d, const voxdagi_frame *f, uint6
     return idx;
 }
 
+/* The largest double below V (V itself when NaN or -infinity). */
+static double voxdagi_below(double v) {
+    uint64_t u;
+    if (!(v > -HUGE_VAL)) return v;
+    memcpy(&u, &v, sizeof u);
+    u = v > 0 ? u - 1 : v < 0 ? u + 1 : 1ull << 63 | 1; /* 0: minus the smallest denormal */
+    memcpy(&v, &u, sizeof v);
+    return v;
+}
+
 /* The traversal shared by both queries; HIT NULL means any hit will do.
-   *STEPS counts the cells stepped through (for tests; the queries pass a
-   local that the compiler drops). */
-VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index,
+   OPEN: the range is [t_min, t_max) with t_max as given, else [t_min,
+   t_max] with 0 for no limit. *STEPS counts the cells stepped through (for
+   tests; the queries pass a local that the compiler drops). */
+VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double lod, int want_index, int open,
                                  voxdag_hit *hit, uint64_t *steps) {
     const uint32_t nlevels = d->levels, brick_level = nlevels - 2, side = 1u << nlevels;
     voxdagi_frame f[VOXDAG_MAX_LEVELS];
@@ -6137,7 +6236,8 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
     const uint8_t *rec = NULL;
     uint64_t mask = 0, at = 0;
 
-    double t_max = ray->t_max == 0 ? HUGE_VAL : ray->t_max; /* 0: a zeroed ray has no limit */
+    /* 0: a zeroed ray has no limit; t < t_max is t <= the double below it */
+    double t_max = open ? voxdagi_below(ray->t_max) : ray->t_max == 0 ? HUGE_VAL : ray->t_max;
     if (!d->voxels || !(ray->t_min <= t_max)) return 0;
     /* The entry and exit events of the voxel box, without level of detail
        (a hit is then a voxel, inside the box, entered through a plane of the
@@ -6275,46 +6375,69 @@ VOXDAGI_INLINE int voxdagi_trace(const voxdag *d, const voxdag_ray *ray, double 
 /* A finite value >= 0 (not NaN). */
 static int voxdagi_finite_nonneg(double v) { return v >= 0 && v <= 1.7976931348623157e308; }
 
-VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
-                              voxdag_hit *hit) {
-    double lod = 0;
+/* The level-of-detail product lod_factor * lod_pixels of OPTS (NULL:
+   defaults, 0); 0 when OPTS is invalid. */
+static int voxdagi_ray_opts_ok(const voxdag_ray_opts *opts, double *lod) {
+    *lod = 0;
+    if (!opts) return 1;
+    if (opts->zero_begin || opts->zero_end || !voxdagi_finite_nonneg(opts->lod_factor) ||
+        !voxdagi_finite_nonneg(opts->lod_pixels))
+        return 0;
+    if (opts->lod_pixels > 0) *lod = voxdagi_fmul(opts->lod_factor, opts->lod_pixels);
+    return 1;
+}
+
+/* Both queries with OPTS checked (-1 when invalid), in x87 double
+   precision where needed. HIT NULL: any hit. */
+static int voxdagi_query(const voxdag *d, const voxdag_ray *ray, const voxdag_ray_opts *opts, voxdag_hit *hit) {
     uint64_t steps = 0;
-    int r;
+    double lod;
+    int r = -1;
 #ifdef VOXDAGI_X87
-    unsigned cw;
+    unsigned cw = voxdagi_x87_begin();
 #endif
-    if (!dag || !ray || !hit) return -1;
-    if (opts) {
-        if (opts->zero_begin || opts->zero_end || !voxdagi_finite_nonneg(opts->lod_factor) ||
-            !voxdagi_finite_nonneg(opts->lod_pixels))
-            return -1;
-        if (opts->lod_pixels > 0) lod = voxdagi_fmul(opts->lod_factor, opts->lod_pixels);
-    }
-#ifdef VOXDAGI_X87
-    cw = voxdagi_x87_begin();
-#endif
-    r = voxdagi_trace(dag, ray, lod, opts && opts->want_index, hit, &steps);
+    if (voxdagi_ray_opts_ok(opts, &lod))
+        r = voxdagi_trace(d, ray, lod, opts && opts->want_index, opts && opts->t_max_exclusive, hit, &steps);
 #ifdef VOXDAGI_X87
     voxdagi_x87_end(cw);
 #endif
     return r;
 }
 
+VOXDAG_API int voxdag_raycast(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts,
+                              voxdag_hit *hit) {
+    return dag && ray && hit ? voxdagi_query(dag, ray, opts, hit) : -1;
+}
+
 VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
-    uint64_t steps = 0;
-    int r;
-#ifdef VOXDAGI_X87
-    unsigned cw;
-#endif
-    if (!dag || !ray) return -1;
-#ifdef VOXDAGI_X87
-    cw = voxdagi_x87_begin();
-#endif
-    r = voxdagi_trace(dag, ray, 0, 0, NULL, &steps);
-#ifdef VOXDAGI_X87
-    voxdagi_x87_end(cw);
-#endif
-    return r;
+    return dag && ray ? voxdagi_query(dag, ray, NULL, NULL) : -1;
+}
+
+VOXDAG_API int voxdag_occluded_opts(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts) {
+    return dag && ray ? voxdagi_query(dag, ray, opts, NULL) : -1;
+}
+
+VOXDAG_API int voxdag_ray_from_hit(const voxdag *dag, const voxdag_ray *ray, const voxdag_hit *hit,
+                                   const double dir[3], voxdag_ray *out) {
+    double o[3], d[3], size;
+    int k, leaves = 0, on_face;
+    if (!dag || !ray || !hit || !dir || !out || hit->level > dag->levels) return -1;
+    size = (double)(1u << (dag->levels - hit->level));
+    on_face = (hit->normal[0] | hit->normal[1] | hit->normal[2]) != 0;
+    for (k = 0; k < 3; k++) {
+        double lo = hit->xyz[k], hi = lo + size, v = ray->origin[k] + hit->t * ray->dir[k];
+        if (hit->normal[k]) { /* exactly on the entry face's plane */
+            v = hit->normal[k] < 0 ? lo : hi;
+            leaves = dir[k] * hit->normal[k] > 0;
+        } else if (on_face) { /* inside the face's square */
+            v = v < lo ? lo : v > hi ? hi : v;
+        }
+        o[k] = v, d[k] = dir[k];
+    }
+    memcpy(out->origin, o, sizeof o);
+    memcpy(out->dir, d, sizeof d);
+    out->t_min = 0, out->t_max = 0;
+    return leaves;
 }
 
 VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *world_ray, voxdag_ray *grid_ray) {

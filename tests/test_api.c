@@ -687,7 +687,7 @@ static void test_miss_cost(void) {
                 ray.origin[(a + 1) % 3] = 8.0 * lane + 2.5 + (lane & 1); /* between the lattice planes */
                 ray.origin[(a + 2) % 3] = 8.0 * (7 - lane) + 3.5;
                 if (lane == 7) ray.dir[(a + 1) % 3] = 0.01 * sign; /* across the lattice, slowly */
-                CHECK_MSG(voxdagi_trace(d, &ray, 0, 0, &hit, &steps) == 0, "axis %u lane %u: a hit", a, lane);
+                CHECK_MSG(voxdagi_trace(d, &ray, 0, 0, 0, &hit, &steps) == 0, "axis %u lane %u: a hit", a, lane);
                 full = full_cells_crossed(&s, ray.origin, ray.dir);
                 CHECK_MSG(steps <= 2 * full + s.levels, "axis %u lane %u sign %d: %llu steps for %llu full cells crossed",
                           a, lane, sign, (unsigned long long)steps, (unsigned long long)full);

@@ -160,8 +160,78 @@ static uint64_t oracle_first(const rscene *s, const uint32_t c[3], uint32_t q, u
 
 typedef struct ray_stats {
     uint64_t rays, hits, edges, lod_hits, starts_inside;
+    uint64_t secondary, naive_self_hits; /* rays from voxdag_ray_from_hit; naive origins that re-hit */
     uint64_t lod_by_depth[3]; /* LOD hits on 2^3 cells of bricks, on bricks, coarser */
 } ray_stats;
+
+/* Field by field (the struct has padding). */
+static int same_hit(const voxdag_hit *a, const voxdag_hit *b) {
+    return a->t == b->t && !memcmp(a->xyz, b->xyz, sizeof a->xyz) && !memcmp(a->normal, b->normal, sizeof a->normal) &&
+           a->level == b->level && a->index == b->index;
+}
+
+/* t_max_exclusive, from its definition: the half-open range [t_min, t_max)
+   has the closed range's first hit when that hit enters before t_max, and
+   no hit otherwise (a later cell enters no earlier). HIT: the closed range's
+   answer under OPTS (NULL: a miss). */
+static void check_half_open(const voxdag *d, const voxdag_ray *ray, const voxdag_ray_opts *opts,
+                            const voxdag_hit *hit) {
+    voxdag_ray_opts open = *opts;
+    voxdag_ray cut = *ray;
+    voxdag_hit h;
+    int want;
+    open.t_max_exclusive = 1;
+    if (ray->t_max != 0) { /* the same t_max: hits before it stay */
+        want = hit && hit->t < ray->t_max;
+        CHECK(voxdag_raycast(d, ray, &open, &h) == want && voxdag_occluded_opts(d, ray, &open) == want);
+        if (want) CHECK(same_hit(&h, hit));
+    }
+    if (!hit) return;
+    cut.t_max = hit->t; /* ends where the hit cell begins: nothing in between */
+    CHECK(voxdag_raycast(d, &cut, &open, &h) == 0 && voxdag_occluded_opts(d, &cut, &open) == 0);
+    cut.t_max = nextafter(hit->t, HUGE_VAL); /* the hit's entry just inside */
+    CHECK(voxdag_raycast(d, &cut, &open, &h) == 1 && same_hit(&h, hit));
+}
+
+/* voxdag_ray_from_hit: a ray leaving the hit cell in a random direction
+   never enters it again (at the same level of detail, OPTS; NULL: full
+   detail), and at full detail it meets what the flat DDA meets from the
+   same origin. Also counts how often the naive origin, origin + t dir,
+   re-hits the voxel (shadow acne), to show the case is exercised. */
+static void check_secondary(const rscene *s, const voxdag *d, const voxdag_ray *ray, const voxdag_hit *hit,
+                            const voxdag_ray_opts *opts, uint64_t *r, ray_stats *st) {
+    voxdag_ray out, naive;
+    voxdag_hit h;
+    visit v;
+    double dir[3];
+    int k, a = -1, leaves, got;
+    for (k = 0; k < 3; k++) {
+        dir[k] = rand_in(r, -1, 1);
+        if (hit->normal[k]) a = k;
+    }
+    if (test_rand_below(r, 4) == 0) dir[test_rand_below(r, 3)] = 0; /* along a face, now and then */
+    leaves = voxdag_ray_from_hit(d, ray, hit, dir, &out);
+    CHECK(leaves == (a >= 0 && dir[a] * hit->normal[a] > 0));
+    CHECK(out.t_min == 0 && out.t_max == 0 && out.dir[0] == dir[0] && out.dir[1] == dir[1] && out.dir[2] == dir[2]);
+    if (!leaves) return;
+    st->secondary++;
+    for (k = 0; k < 3; k++) { /* on the entry face: its plane, inside its square */
+        double lo = hit->xyz[k], hi = lo + (double)(1u << (s->levels - hit->level));
+        CHECK(k == a ? out.origin[k] == (hit->normal[k] < 0 ? lo : hi) : out.origin[k] >= lo && out.origin[k] <= hi);
+    }
+    got = voxdag_raycast(d, &out, opts, &h);
+    CHECK(got >= 0);
+    if (got) CHECK(!(h.level == hit->level && !memcmp(h.xyz, hit->xyz, sizeof h.xyz)));
+    if (!opts) {
+        int want = oracle_walk(s, &out, s->levels, stop_full, NULL, &v);
+        CHECK(got == want);
+        if (got && want) CHECK(h.t == v.t && h.xyz[0] == v.c[0] && h.xyz[1] == v.c[1] && h.xyz[2] == v.c[2]);
+        naive = out;
+        for (k = 0; k < 3; k++) naive.origin[k] = ray->origin[k] + hit->t * ray->dir[k];
+        if (voxdag_raycast(d, &naive, NULL, &h) == 1 && !memcmp(h.xyz, hit->xyz, sizeof h.xyz)) st->naive_self_hits++;
+    }
+}
+
 
 static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count, ray_stats *st) {
     rscene s;
@@ -181,7 +251,8 @@ static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count
         st->rays++;
         CHECK_MSG(got == want, "scene %d L=%u sym=%d ray %u: hit %d, oracle %d", kind, levels, symmetric, i,
                   got, want);
-        CHECK(voxdag_occluded(d, &ray) == want);
+        CHECK(voxdag_occluded(d, &ray) == want && voxdag_occluded_opts(d, &ray, NULL) == want);
+        check_half_open(d, &ray, &opts, got ? &hit : NULL);
         if (ray.t_min == 0 && ray.t_max == HUGE_VAL) { /* a zeroed ray with origin and dir: the same answer */
             voxdag_ray z;
             voxdag_hit zh;
@@ -205,6 +276,7 @@ static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count
                       v.c[2]);
             CHECK(hit.normal[0] == normal[0] && hit.normal[1] == normal[1] && hit.normal[2] == normal[2]);
             CHECK(hit.index == s.rank[rcell(s.n, v.c[0], v.c[1], v.c[2])]);
+            check_secondary(&s, d, &ray, &hit, NULL, &r, st);
         }
         if (want && levels > 2) { /* the same ray with level of detail */
             voxdag_ray_opts lo = opts;
@@ -213,7 +285,9 @@ static void check_scene(int kind, uint32_t levels, int symmetric, uint32_t count
             visit lv;
             lo.lod_factor = rand_in(&r, 0.002, 0.2);
             lo.lod_pixels = 1;
-            CHECK(voxdag_raycast(d, &ray, &lo, &lh) == 1);
+            CHECK(voxdag_raycast(d, &ray, &lo, &lh) == 1 && voxdag_occluded_opts(d, &ray, &lo) == 1);
+            check_half_open(d, &ray, &lo, &lh);
+            check_secondary(&s, d, &ray, &lh, &lo, &r, st);
             CHECK(lh.t <= v.t && lh.level >= 1 && lh.level <= levels);
             /* the same cell, level, distance, normal and first voxel index as
                the brute-force level of detail */
@@ -279,14 +353,79 @@ static void test_raytrace_oracle(void) {
         for (kind = 0; kind < RS_COUNT; kind++)
             for (sym = 0; sym < 3; sym++) check_scene(kind, levels, sym, levels < 7 ? 1000 : 2000, &st);
     fprintf(stderr, "  %llu rays, %llu hits (%llu through edges or corners, %llu starting inside), %llu LOD hits "
-            "(%llu on 2^3 cells of bricks, %llu on bricks, %llu coarser)\n",
+            "(%llu on 2^3 cells of bricks, %llu on bricks, %llu coarser); %llu rays leaving hits (%llu naive "
+            "origins re-hit their voxel)\n",
             (unsigned long long)st.rays, (unsigned long long)st.hits, (unsigned long long)st.edges,
             (unsigned long long)st.starts_inside, (unsigned long long)st.lod_hits,
             (unsigned long long)st.lod_by_depth[0], (unsigned long long)st.lod_by_depth[1],
-            (unsigned long long)st.lod_by_depth[2]);
+            (unsigned long long)st.lod_by_depth[2], (unsigned long long)st.secondary,
+            (unsigned long long)st.naive_self_hits);
+    CHECK(st.secondary > 10000 && st.naive_self_hits > 100);
     CHECK(st.rays >= 100000);
     CHECK(st.edges > 1000 && st.lod_hits > 1000);
     CHECK(st.lod_by_depth[0] > 300 && st.lod_by_depth[1] > 300 && st.lod_by_depth[2] > 300);
+}
+
+/* voxdag_lookup_many against the dense grid and its Morton ranks, on point
+   lists that share paths in every way: all cells in Morton order, small
+   random steps with repeats, random points with some outside the grid. */
+static void test_lookup_many(void) {
+    uint32_t levels, *xyz = NULL;
+    uint64_t *index = NULL, *index2 = NULL, points = 0;
+    uint8_t *full = NULL, *full2 = NULL;
+    int kind, sym;
+    for (levels = 2; levels <= 5; levels++)
+        for (kind = 0; kind < RS_COUNT; kind++)
+            for (sym = 0; sym < 3; sym += 2) {
+                rscene s;
+                uint64_t r = 0x100C + (uint64_t)kind * 100 + levels * 7 + (uint64_t)sym, want = 0, m, i;
+                voxdag *d = rscene_make(&s, kind, levels, sym, r);
+                uint64_t cells = (uint64_t)s.n * s.n * s.n, count = 3 * cells;
+                xyz = (uint32_t *)realloc(xyz, 3 * count * sizeof *xyz);
+                index = (uint64_t *)realloc(index, count * sizeof *index);
+                index2 = (uint64_t *)realloc(index2, count * sizeof *index2);
+                full = (uint8_t *)realloc(full, count), full2 = (uint8_t *)realloc(full2, count);
+                for (m = 0; m < cells; m++) /* Morton order */
+                    voxdag_morton_decode(m, &xyz[3 * m], &xyz[3 * m + 1], &xyz[3 * m + 2]);
+                for (i = cells; i < 2 * cells; i++) { /* a random walk of small steps */
+                    uint32_t k;
+                    for (k = 0; k < 3; k++) {
+                        uint32_t prev = i > cells ? xyz[3 * (i - 1) + k] : s.n / 2;
+                        uint32_t step = test_rand_below(&r, 3);
+                        xyz[3 * i + k] = step == 0 && prev > 0 ? prev - 1 : step == 2 && prev + 1 < s.n ? prev + 1 : prev;
+                    }
+                }
+                for (i = 2 * cells; i < count; i++) { /* random, 1 in 16 outside */
+                    uint32_t k;
+                    for (k = 0; k < 3; k++) xyz[3 * i + k] = test_rand_below(&r, s.n);
+                    if (test_rand_below(&r, 16) == 0) xyz[3 * i + test_rand_below(&r, 3)] += s.n << test_rand_below(&r, 20);
+                }
+                for (i = 0; d && i < count; i++) {
+                    uint32_t x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+                    want += x < s.n && y < s.n && z < s.n && s.occ[levels][rcell(s.n, x, y, z)];
+                }
+                memset(index, 0xEE, count * sizeof *index);
+                memset(index2, 0xEE, count * sizeof *index2);
+                CHECK(d && voxdag_lookup_many(d, xyz, (size_t)count, full, index) == want);
+                CHECK(voxdag_lookup_many(d, xyz, (size_t)count, full2, NULL) == want);
+                CHECK(voxdag_lookup_many(d, xyz, (size_t)count, NULL, index2) == want);
+                for (i = 0; d && i < count; i++) {
+                    uint32_t x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+                    int in = x < s.n && y < s.n && z < s.n && s.occ[levels][rcell(s.n, x, y, z)];
+                    uint64_t one = 0xEEEEEEEEEEEEEEEEull;
+                    CHECK_MSG(full[i] == in && full2[i] == in && voxdag_lookup(d, x, y, z, &one) == in,
+                              "L=%u scene %d sym %d point %llu (%u %u %u): %d, want %d", levels, kind, sym,
+                              (unsigned long long)i, x, y, z, full[i], in);
+                    CHECK(index[i] == index2[i] && index[i] == one);
+                    if (in) CHECK(index[i] == s.rank[rcell(s.n, x, y, z)]);
+                }
+                points += count;
+                voxdag_free(d);
+                rscene_free(&s);
+            }
+    fprintf(stderr, "  %llu points\n", (unsigned long long)points);
+    CHECK(voxdag_lookup_many(NULL, xyz, 1, full, index) == 0);
+    free(xyz), free(index), free(index2), free(full), free(full2);
 }
 
 /* Hand-checked cases: the conventions of the header's comment. */
@@ -317,6 +456,24 @@ static void test_raytrace_conventions(void) {
     CHECK(!voxdag_raycast(d, &ray, NULL, &h));
     ray.dir[1] = NAN;
     CHECK(!voxdag_raycast(d, &ray, NULL, &h));
+    { /* line of sight with t_max_exclusive: [0, 0) is empty, even inside a voxel; a
+         target on the face of the next voxel is not blocked, one past it is */
+        voxdag_ray_opts open;
+        voxdag_ray los;
+        memset(&open, 0, sizeof open);
+        memset(&los, 0, sizeof los);
+        open.t_max_exclusive = 1;
+        los.origin[0] = 2.5, los.origin[1] = 1.5, los.origin[2] = 1.5;
+        CHECK(voxdag_raycast(d, &los, NULL, &h) == 1 && voxdag_occluded_opts(d, &los, &open) == 0);
+        los.dir[0] = 1;
+        CHECK(voxdag_occluded_opts(d, &los, &open) == 0); /* t_max 0: [0, 0) */
+        los.origin[0] = -1, los.t_max = 1;              /* from x = -1 to the grid's face x = 0 */
+        CHECK(voxdag_occluded_opts(d, &los, &open) == 0 && voxdag_occluded_opts(d, &los, NULL) == 1);
+        los.t_max = 1.25;
+        CHECK(voxdag_occluded_opts(d, &los, &open) == 1 && voxdag_raycast(d, &los, &open, &h) == 1 && h.t == 1);
+        open.zero_end = 1;
+        CHECK(voxdag_occluded_opts(d, &los, &open) == -1 && voxdag_occluded_opts(NULL, &los, NULL) == -1);
+    }
     voxdag_free(d);
     rscene_free(&s);
 }
@@ -473,6 +630,7 @@ static void test_raytrace_render_image(void) {
 const test_case test_raytrace_cases[] = {
     {"raytrace_conventions", test_raytrace_conventions},
     {"raytrace_oracle", test_raytrace_oracle},
+    {"lookup_many", test_lookup_many},
 #ifndef TEST_PORTABLE
     {"raytrace_render_image", test_raytrace_render_image},
 #endif
