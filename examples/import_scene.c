@@ -4,22 +4,34 @@
    text cursor, bounds-checked binary reader and texture cache; it is not
    compiled on its own.
 
-   - .spm: "SP", a byte version << 3 | kind (kinds 0 and 1, skinned meshes,
-     are refused), a flags byte (1 normals, 2 vertex colours, 4 tangents), a
-     bounding box of 6 f32 (ignored). A u16 material count, each material two
-     texture names (u8 length + bytes); a u16 mesh count, each mesh a u16
-     buffer count, each buffer a u32 vertex count, a u32 index count (a
-     multiple of 3) and a u16 material. Per vertex: 3 f32 position, a u32
-     normal if flagged, a colour if flagged (one byte: 128 is white, any
-     other value is followed by R G B), 2 f16 texture coordinates if the
-     material has a first texture (then 2 more f16 if it has a second, and a
-     u32 tangent if flagged). Indices are u8 for buffers of at most 255
-     vertices, else u16. Little-endian; nothing may follow the last buffer.
+   - .spm: "SP", a byte version << 3 | kind (kind 1: animated, "skinned";
+     kind 2: static; others are refused), a flags byte (1 normals, 2 vertex
+     colours, 4 tangents), a bounding box of 6 f32 (ignored). A u16
+     material count, each material two texture names (u8 length + bytes); a
+     u16 mesh count, each mesh a u16 buffer count, each buffer a u32 vertex
+     count, a u32 index count (a multiple of 3) and a u16 material. Per
+     vertex: 3 f32 position, a u32 normal if flagged, a colour if flagged
+     (one byte: 128 is white, any other value is followed by R G B), 2 f16
+     texture coordinates if the material has a first texture (then 2 more
+     f16 if it has a second, and a u32 tangent if flagged), and in animated
+     files 4 i16 joint indices (-1: none) and 4 f16 weights. Indices are u8
+     for buffers of at most 255 vertices, else u16. An animated file ends
+     with its armatures: a u8 count and a u16 (unused), then per armature a
+     u16 count of joints used, a u16 joint count N (at least the former), N
+     names (u8 length + bytes), N transforms of 10 f32 (location, rotation
+     quaternion, scale), N i16 parents (-1 or a joint below N), and a u16
+     keyframe count, each keyframe a u16 frame and N transforms. Every
+     joint a vertex names must exist (numbered across the armatures in
+     order). Animated meshes are imported in their bind pose: the vertex
+     positions as stored, no joint transform or keyframe applied.
+     Little-endian; nothing may follow the last buffer (static) or armature
+     (animated).
      One scene material per file material, white, textured by its first
      texture: looked up beside the file, then in ../../textures/ and
      ../../library/<any>/ (a SuperTuxKart data tree). Vertex colours, when
-     present, tint the texture. Positions (x, y, z), y up and left-handed,
-     become (x, z, y): z up and right-handed, the vdag tool's axes.
+     present, tint the texture.
+     Positions (x, y, z), y up and left-handed, become (x, z, y): z up and
+     right-handed, the vdag tool's axes.
    - .ac: "AC3D" header, MATERIAL lines (their rgb is the Kd colour), then
      OBJECT blocks: loc (translation) and rot (3x3, row-major) place the
      object's own vertices and, composed, its kids; texture (the first one;
@@ -137,6 +149,45 @@ typedef struct vs_spm_mat {
     vi_span tex1, tex2;
 } vs_spm_mat;
 
+/* The armature section of a skinned file, after its meshes: read and checked
+   (every joint a vertex names must exist), not applied (the bind pose is the
+   vertices as stored). MAX_JOINT: the largest joint index the vertices name,
+   or -1. */
+static int vs_spm_armatures(vi_ctx *c, vi_reader *r, int32_t max_joint) {
+    const uint8_t *b;
+    uint32_t narm, a, total = 0;
+    if (!(b = vi_take(r, 3))) return vi_fail(c, "truncated armature count");
+    narm = b[0];
+    for (a = 0; a < narm; a++) {
+        uint32_t used, n, j, keys;
+        if (!vs_u16(r, &used) || !vs_u16(r, &n)) return vi_fail(c, "armature %u: truncated joint count", (unsigned)a);
+        if (used > n) return vi_fail(c, "armature %u: %u joints used of %u", (unsigned)a, (unsigned)used, (unsigned)n);
+        for (j = 0; j < n; j++) {
+            const uint8_t *len = vi_take(r, 1);
+            if (!len || !vi_take(r, *len))
+                return vi_fail(c, "armature %u joint %u: truncated name", (unsigned)a, (unsigned)j);
+        }
+        if (!vi_take(r, 40 * (size_t)n)) return vi_fail(c, "armature %u: truncated joint transforms", (unsigned)a);
+        for (j = 0; j < n; j++) {
+            uint32_t parent;
+            if (!vs_u16(r, &parent)) return vi_fail(c, "armature %u: truncated joint parents", (unsigned)a);
+            if (parent != 0xffff && parent >= n)
+                return vi_fail(c, "armature %u joint %u: parent %u of %u joints", (unsigned)a, (unsigned)j,
+                               (unsigned)parent, (unsigned)n);
+        }
+        if (!vs_u16(r, &keys)) return vi_fail(c, "armature %u: truncated keyframe count", (unsigned)a);
+        if ((uint64_t)keys * (2 + 40 * (uint64_t)n) > r->size - r->pos)
+            return vi_fail(c, "armature %u: %u keyframes of %u joints need more bytes than remain", (unsigned)a,
+                           (unsigned)keys, (unsigned)n);
+        r->pos += (size_t)keys * (2 + 40 * (size_t)n);
+        total += n;
+    }
+    if (max_joint >= (int32_t)total)
+        return vi_fail(c, "a vertex names joint %d of %u (the joints of all armatures)", (int)max_joint,
+                       (unsigned)total);
+    return 1;
+}
+
 static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
     vi_buf mats = {NULL, 0, 0}, pos = {NULL, 0, 0}, uv = {NULL, 0, 0}, rgb = {NULL, 0, 0};
@@ -144,13 +195,16 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     vi_texcache cache = {{NULL, 0, 0}, 0};
     const uint8_t *h;
     uint32_t nmat, nmesh, mesh, flags, i;
-    int ok = 0, any_tex = 0;
+    int32_t max_joint = -1;
+    int ok = 0, any_tex = 0, skinned;
     r.data = data;
     r.size = size;
     r.pos = 0;
     r.big_endian = 0;
     if (!(h = vi_take(&r, 28)) || h[0] != 'S' || h[1] != 'P') return vi_fail(c, "not an SPM file (no \"SP\" header)");
-    if ((h[2] & 7) < 2) return vi_fail(c, "skinned meshes (kind %u) are not supported", (unsigned)(h[2] & 7));
+    if ((h[2] & 7) != 1 && (h[2] & 7) != 2)
+        return vi_fail(c, "unknown mesh kind %u (known: 1, animated; 2, static)", (unsigned)(h[2] & 7));
+    skinned = (h[2] & 7) == 1;
     flags = h[3];
     if (!vs_u16(&r, &nmat)) return vi_fail(c, "truncated material count");
     for (i = 0; i < nmat; i++) {
@@ -198,8 +252,9 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             m = &((const vs_spm_mat *)mats.data)[mid];
             tex1 = m->tex1.s != m->tex1.e;
             tex2 = tex1 && m->tex2.s != m->tex2.e;
-            vbytes = (uint64_t)vc * (12 + (flags & 1 ? 4 : 0) + (flags & 2 ? 1 : 0) +
-                                     (tex1 ? 4 + (tex2 ? 4 : 0) + (flags & 4 ? 4 : 0) : 0));
+            vbytes = (uint64_t)vc * (uint64_t)(12 + (flags & 1 ? 4 : 0) + (flags & 2 ? 1 : 0) +
+                                               (tex1 ? 4 + (tex2 ? 4 : 0) + (flags & 4 ? 4 : 0) : 0) +
+                                               (skinned ? 16 : 0));
             ibytes = (uint64_t)ic * (vc > 255 ? 2 : 1);
             if (ic % 3) {
                 vi_fail(c, "mesh %u buffer %u: %u indices, not whole triangles", (unsigned)mesh, (unsigned)buf,
@@ -238,6 +293,19 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                     if (tex2) bad |= !vi_take(&r, 4);
                     if (flags & 4) bad |= !vi_take(&r, 4);
                 }
+                if (skinned && !bad) { /* 4 i16 joints (-1: none), 4 f16 weights: not needed for the bind pose */
+                    const uint8_t *jw = vi_take(&r, 16);
+                    for (k = 0; jw && k < 4; k++) {
+                        int32_t j = (int32_t)vi_signed(vi_uint(jw + 2 * k, 2, 0), 16);
+                        if (j < -1) {
+                            vi_fail(c, "mesh %u buffer %u vertex %u: joint %d", (unsigned)mesh, (unsigned)buf,
+                                    (unsigned)v, (int)j);
+                            goto done;
+                        }
+                        if (j > max_joint) max_joint = j;
+                    }
+                    bad = !jw;
+                }
                 if (bad) {
                     vi_fail(c, "mesh %u buffer %u vertex %u: %s", (unsigned)mesh, (unsigned)buf, (unsigned)v,
                             r.pos >= r.size ? "truncated" : "not a finite number");
@@ -267,8 +335,9 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             }
         }
     }
+    if (skinned && !vs_spm_armatures(c, &r, max_joint)) goto done;
     if (r.pos != r.size) {
-        vi_fail(c, "%llu bytes after the last mesh", (vi_ull)(r.size - r.pos));
+        vi_fail(c, "%llu bytes after the last %s", (vi_ull)(r.size - r.pos), skinned ? "armature" : "mesh");
         goto done;
     }
     if (!(out->materials = (vdag_material *)vi_alloc(c, nmat, sizeof *out->materials))) goto done;
