@@ -29,7 +29,16 @@
      One scene material per file material, white, textured by its first
      texture: looked up beside the file, then in ../../textures/ and
      ../../library/<any>/ (a SuperTuxKart data tree). Vertex colours, when
-     present, tint the texture.
+     present, tint the texture, except in materials that SuperTuxKart draws
+     with its grass shader (trees, bushes, grass, flags), whose vertex
+     colours are wind weights: its grass vertex shader moves vertices by
+     them and its fragment shader ignores them, so those vertices get white
+     (the texture's own colours). A material is drawn so when the first
+     <material> element named as its texture (outside XML comments, the
+     name matched byte for byte) says shader="grass", looked up in the
+     materials.xml beside the file, else in ../../textures/materials.xml
+     (the track's or object's own file first, then the game's shared one).
+     No base directory (an import from memory): no look-up, colours tint.
      Positions (x, y, z), y up and left-handed, become (x, z, y): z up and
      right-handed, the vdag tool's axes.
    - .ac: "AC3D" header, MATERIAL lines (their rgb is the Kd colour), then
@@ -147,7 +156,122 @@ static int vs_half(uint32_t h, double *v) {
 
 typedef struct vs_spm_mat {
     vi_span tex1, tex2;
+    int wind; /* 1: SuperTuxKart's grass shader: vertex colours are wind weights */
 } vs_spm_mat;
+
+static int vs_xml_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n'; }
+
+/* The value of attribute NAME in TAG, the text of an XML start tag after its
+   element name (up to its '>'), into *VALUE (quoted with " or '). Returns 1
+   when TAG has it; 0 when it has not, or when TAG stops being attributes. */
+static int vs_xml_attr(vi_span tag, const char *name, vi_span *value) {
+    const char *p = tag.s, *e = tag.e;
+    while (p < e) {
+        vi_span key;
+        char q;
+        while (p < e && (vs_xml_space(*p) || *p == '/')) p++;
+        key.s = p;
+        while (p < e && !vs_xml_space(*p) && *p != '=') p++;
+        key.e = p;
+        while (p < e && vs_xml_space(*p)) p++;
+        if (p == e || *p++ != '=') return 0;
+        while (p < e && vs_xml_space(*p)) p++;
+        if (p == e || (*p != '"' && *p != '\'')) return 0;
+        q = *p++;
+        value->s = p;
+        while (p < e && *p != q) p++;
+        if (p == e) return 0;
+        value->e = p++;
+        if (vi_is(key, name)) return 1;
+    }
+    return 0;
+}
+
+/* Looks up texture NAME in XML, the text of a SuperTuxKart materials.xml:
+   the first <material> element (outside comments) whose name attribute is
+   NAME, byte for byte (an unterminated last tag is no element). Returns 1
+   when there is one, with its shader
+   attribute in *SHADER (empty when it has none); 0 when there is none. */
+static int vs_xml_material(vi_span xml, vi_span name, vi_span *shader) {
+    const char *p = xml.s, *e = xml.e;
+    while (p < e) {
+        const char *lt = (const char *)memchr(p, '<', (size_t)(e - p)), *q;
+        vi_span tag, value;
+        char quote = 0;
+        if (!lt) return 0;
+        p = lt + 1;
+        if (e - p >= 3 && !memcmp(p, "!--", 3)) { /* a comment: up to its "-->" */
+            for (p += 3; e - p >= 3 && memcmp(p, "-->", 3); p++) {}
+            p = e - p >= 3 ? p + 3 : e;
+            continue;
+        }
+        if (e - p < 9 || memcmp(p, "material", 8) || !(vs_xml_space(p[8]) || p[8] == '/' || p[8] == '>')) continue;
+        tag.s = p + 8;
+        for (q = tag.s; q < e && (quote || *q != '>'); q++) /* the tag's '>', outside quoted values */
+            if (*q == '"' || *q == '\'') quote = quote == *q ? 0 : quote ? quote : *q;
+        if (q == e) return 0; /* an unterminated tag */
+        tag.e = q;
+        p = q;
+        if (!vs_xml_attr(tag, "name", &value) || vi_len(value) != vi_len(name) ||
+            memcmp(value.s, name.s, vi_len(name)))
+            continue;
+        if (!vs_xml_attr(tag, "shader", shader)) shader->s = shader->e = tag.s;
+        return 1;
+    }
+    return 0;
+}
+
+/* SuperTuxKart's materials.xml in DIR/SUB, read whole into *DATA and *SIZE
+   (malloc'd), or *DATA = NULL when there is none or it cannot be opened (a
+   warning). Returns 0 on an error (refused, too large, out of memory). */
+static int vs_stk_materials(vi_ctx *c, const char *dir, const char *sub, char **data, size_t *size) {
+    vi_span name;
+    char *path = NULL, why[512];
+    int r;
+    name.s = "materials.xml";
+    name.e = name.s + 13;
+    *data = NULL;
+    *size = 0;
+    if (!vs_try(c, dir, sub, name, &path)) return 0;
+    if (!path) return 1;
+    if (!vi_may_read(c, path)) {
+        free(path);
+        return 0;
+    }
+    r = vi_read_side(c, path, data, size, why, sizeof why);
+    if (r < 0 && !c->limits.quiet) fprintf(stderr, "vdag: warning: %s; its shaders are not applied\n", why);
+    free(path);
+    return r != 0;
+}
+
+/* Marks the materials of MATS whose first texture SuperTuxKart draws with
+   its grass shader, which reads vertex colours as wind weights, never as
+   colours: the material in the materials.xml beside the file, else in
+   ../../textures/materials.xml (a SuperTuxKart data tree). Returns 0 on an
+   error. */
+static int vs_spm_wind(vi_ctx *c, vi_buf *mats) {
+    static const char *const subs[2] = {".", "../../textures"};
+    char *xml[2] = {NULL, NULL};
+    size_t n[2] = {0, 0}, i;
+    int ok = 1, k;
+    for (k = 0; k < 2 && ok; k++) ok = vs_stk_materials(c, c->base_dir, subs[k], &xml[k], &n[k]);
+    for (i = 0; ok && i < mats->count; i++) {
+        vs_spm_mat *m = &((vs_spm_mat *)mats->data)[i];
+        vi_span shader;
+        shader.s = shader.e = NULL;
+        for (k = 0; k < 2 && m->tex1.s != m->tex1.e; k++) {
+            vi_span whole;
+            if (!xml[k]) continue;
+            whole.s = xml[k];
+            whole.e = xml[k] + n[k];
+            if (vs_xml_material(whole, m->tex1, &shader)) break;
+        }
+        m->wind = k < 2 && vi_is(shader, "grass");
+    }
+    free(xml[0]);
+    free(xml[1]);
+    return ok;
+}
 
 /* The armature section of a skinned file, after its meshes: read and checked
    (every joint a vertex names must exist), not applied (the bind pose is the
@@ -223,8 +347,10 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             t[k]->s = (const char *)s;
             t[k]->e = (const char *)s + *len;
         }
+        m->wind = 0;
         any_tex |= m->tex1.s != m->tex1.e;
     }
+    if (c->base_dir && (flags & 2) && any_tex && !vs_spm_wind(c, &mats)) goto done;
     if (!vs_u16(&r, &nmesh)) {
         vi_fail(c, "truncated mesh count");
         goto done;
@@ -281,7 +407,7 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                 if (flags & 2) {
                     const uint8_t *ci = vi_take(&r, 1), *c3 = ci && *ci != 128 ? vi_take(&r, 3) : NULL;
                     bad |= !ci || (*ci != 128 && !c3);
-                    if (!bad) memcpy(col, c3 ? c3 : (const uint8_t *)"\377\377\377", 3);
+                    if (!bad) memcpy(col, c3 && !m->wind ? c3 : (const uint8_t *)"\377\377\377", 3);
                 }
                 if (t) t[0] = t[1] = 0;
                 if (tex1) {

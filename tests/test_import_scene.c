@@ -741,6 +741,95 @@ static void test_scene_files(void) {
     rmdir(dir);
 }
 
+/* SuperTuxKart's grass shader reads vertex colours as wind weights, never
+   as colours: materials drawn with it (the materials.xml beside the file
+   first, then ../../textures/materials.xml; comments skipped) get white
+   vertices, the texture's own colours; others keep their tint. Foliage
+   with wind weights of about 0.05 came out near-black before. */
+static void test_spm_wind(void) {
+    static const char *const tex[] = {"leaf.png", "bark.png", "shared.png", "over.png",
+                                      "commented.png", "quoted.png", "", "leaf.png.bak"};
+    static const int wind[] = {1, 0, 1, 0, 0, 1, 0, 0};
+    enum { NMAT = sizeof wind / sizeof wind[0] };
+    static const char beside[] =
+        "<?xml version=\"1.0\"?>\n<materials>\n"
+        "  <!-- <material name=\"commented.png\" shader=\"grass\"/> -->\n"
+        "  <material name=\"leaf.png\" shader=\"grass\" ignore=\"Y\" grass-speed=\"1.50\"/>\n"
+        "  <material name=\"bark.png\" normal-map=\"a>b.png\" shader=\"alphatest\"/>\n"
+        "  <material name=\"over.png\" shader=\"alphatest\"/>\n"
+        "  <material\n     shader = 'grass'\n     name='quoted.png' />\n"
+        "  <material name=\"leaf.png\" shader=\"solid\"/>\n"
+        "</materials>\n";
+    static const char shared[] =
+        "<materials>\n<material name=\"shared.png\" shader=\"grass\"/>\n"
+        "<material name=\"over.png\" shader=\"grass\"/>\n<material name=\"leaf.png.bak\" shader=\"grass\"\n";
+    static const char *const made[] = {"tracks", "tracks/t", "textures"};
+    char dir[] = "/tmp/vdag-wind-XXXXXX", p[8][320], err[512];
+    vdag_import_limits quiet;
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    int i, k, pass, n = 0;
+    memset(&quiet, 0, sizeof quiet);
+    quiet.quiet = 1; /* the textures are missing: white, with warnings */
+    CHECK(mkdtemp(dir) != NULL);
+    for (i = 0; i < 3; i++) {
+        snprintf(p[n], sizeof p[n], "%s/%s", dir, made[i]);
+        CHECK(mkdir(p[n++], 0700) == 0);
+    }
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/materials.xml", dir);
+    CHECK(sfile(p[n++], beside, strlen(beside)));
+    snprintf(p[n], sizeof p[n], "%s/textures/materials.xml", dir);
+    CHECK(sfile(p[n++], shared, strlen(shared)));
+    put(&b, "SP", 2);
+    put_uint(&b, 1 << 3 | 2, 1, 0);
+    put_uint(&b, 2, 1, 0); /* vertex colours */
+    for (i = 0; i < 6; i++) put_f32(&b, 0);
+    put_uint(&b, NMAT, 2, 0);
+    for (i = 0; i < NMAT; i++) {
+        put_uint(&b, strlen(tex[i]), 1, 0);
+        put(&b, tex[i], strlen(tex[i]));
+        put_uint(&b, 0, 1, 0);
+    }
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, NMAT, 2, 0);
+    for (i = 0; i < NMAT; i++) { /* one buffer per material: 3 vertices of colour (i, 10 + k, 50) */
+        put_uint(&b, 3, 4, 0);
+        put_uint(&b, 3, 4, 0);
+        put_uint(&b, (uint64_t)i, 2, 0);
+        for (k = 0; k < 3; k++) {
+            put_f32(&b, (float)k), put_f32(&b, (float)i), put_f32(&b, 0);
+            put_uint(&b, 0, 1, 0);
+            put_uint(&b, (uint64_t)i, 1, 0), put_uint(&b, 10 + (uint64_t)k, 1, 0), put_uint(&b, 50, 1, 0);
+            if (tex[i][0]) put_uint(&b, 0, 4, 0); /* texture coordinates */
+        }
+        put(&b, "\0\1\2", 3);
+    }
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/track.spm", dir);
+    CHECK(sfile(p[n++], b.p, b.n));
+    for (pass = 0; pass < 2; pass++) { /* from the file; from memory (no look-up) */
+        int ok = pass == 0 ? vdag_import_file(p[n - 1], &quiet, &s, err, sizeof err)
+                           : vdag_import_memory("spm", b.p, b.n, NULL, &quiet, &s, err, sizeof err);
+        if (!ok) {
+            CHECK_MSG(0, "%s", err);
+            continue;
+        }
+        CHECK(s.vertex_count == 3 * NMAT && s.vertex_rgb != NULL);
+        for (i = 0; i < NMAT && s.vertex_rgb && s.vertex_count == 3 * NMAT; i++)
+            for (k = 0; k < 3; k++) {
+                const uint8_t *got = s.vertex_rgb + 3 * (3 * (size_t)i + (size_t)k);
+                uint8_t want[3];
+                want[0] = (uint8_t)i, want[1] = (uint8_t)(10 + k), want[2] = 50;
+                if (pass == 0 && wind[i]) memset(want, 255, 3);
+                CHECK_MSG(!memcmp(got, want, 3), "pass %d material %s vertex %d: %u %u %u", pass, tex[i], k,
+                          got[0], got[1], got[2]);
+            }
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+    while (n-- > 0) remove(p[n]); /* files, then folders, deepest first */
+    rmdir(dir);
+}
+
 const test_case test_import_scene_cases[] = {
     {"import_scene/spm roundtrip", test_spm_roundtrip},
     {"import_scene/spm sweep", test_spm_sweep},
@@ -751,5 +840,6 @@ const test_case test_import_scene_cases[] = {
     {"import_scene/ac errors", test_ac_errors},
     {"import_scene/ac subdiv warns", test_ac_subdiv_warns},
     {"import_scene/texture files", test_scene_files},
+    {"import_scene/spm grass shader colours", test_spm_wind},
     {NULL, NULL},
 };
