@@ -190,8 +190,8 @@ static int vs_xml_attr(vi_span tag, const char *name, vi_span *value) {
 /* Looks up texture NAME in XML, the text of a SuperTuxKart materials.xml:
    the first <material> element (outside comments) whose name attribute is
    NAME, byte for byte (an unterminated last tag is no element). Returns 1
-   when there is one, with its shader
-   attribute in *SHADER (empty when it has none); 0 when there is none. */
+   when there is one, with its shader attribute in *SHADER (empty when it
+   has none); 0 when there is none. */
 static int vs_xml_material(vi_span xml, vi_span name, vi_span *shader) {
     const char *p = xml.s, *e = xml.e;
     while (p < e) {
