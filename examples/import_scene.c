@@ -4,22 +4,43 @@
    text cursor, bounds-checked binary reader and texture cache; it is not
    compiled on its own.
 
-   - .spm: "SP", a byte version << 3 | kind (kinds 0 and 1, skinned meshes,
-     are refused), a flags byte (1 normals, 2 vertex colours, 4 tangents), a
-     bounding box of 6 f32 (ignored). A u16 material count, each material two
-     texture names (u8 length + bytes); a u16 mesh count, each mesh a u16
-     buffer count, each buffer a u32 vertex count, a u32 index count (a
-     multiple of 3) and a u16 material. Per vertex: 3 f32 position, a u32
-     normal if flagged, a colour if flagged (one byte: 128 is white, any
-     other value is followed by R G B), 2 f16 texture coordinates if the
-     material has a first texture (then 2 more f16 if it has a second, and a
-     u32 tangent if flagged). Indices are u8 for buffers of at most 255
-     vertices, else u16. Little-endian; nothing may follow the last buffer.
+   - .spm: "SP", a byte version << 3 | kind (kind 1: animated, "skinned";
+     kind 2: static; others are refused), a flags byte (1 normals, 2 vertex
+     colours, 4 tangents), a bounding box of 6 f32 (ignored). A u16
+     material count, each material two texture names (u8 length + bytes); a
+     u16 mesh count, each mesh a u16 buffer count, each buffer a u32 vertex
+     count, a u32 index count (a multiple of 3) and a u16 material. Per
+     vertex: 3 f32 position, a u32 normal if flagged, a colour if flagged
+     (one byte: 128 is white, any other value is followed by R G B), 2 f16
+     texture coordinates if the material has a first texture (then 2 more
+     f16 if it has a second, and a u32 tangent if flagged), and in animated
+     files 4 i16 joint indices (-1: none) and 4 f16 weights. Indices are u8
+     for buffers of at most 255 vertices, else u16. An animated file ends
+     with its armatures: a u8 count and a u16 (unused), then per armature a
+     u16 count of joints used, a u16 joint count N (at least the former), N
+     names (u8 length + bytes), N transforms of 10 f32 (location, rotation
+     quaternion, scale), N i16 parents (-1 or a joint below N), and a u16
+     keyframe count, each keyframe a u16 frame and N transforms. Every
+     joint a vertex names must exist (numbered across the armatures in
+     order). Animated meshes are imported in their bind pose: the vertex
+     positions as stored, no joint transform or keyframe applied.
+     Little-endian; nothing may follow the last buffer (static) or armature
+     (animated).
      One scene material per file material, white, textured by its first
      texture: looked up beside the file, then in ../../textures/ and
      ../../library/<any>/ (a SuperTuxKart data tree). Vertex colours, when
-     present, tint the texture. Positions (x, y, z), y up and left-handed,
-     become (x, z, y): z up and right-handed, the vdag tool's axes.
+     present, tint the texture, except in materials that SuperTuxKart draws
+     with its grass shader (trees, bushes, grass, flags), whose vertex
+     colours are wind weights: its grass vertex shader moves vertices by
+     them and its fragment shader ignores them, so those vertices get white
+     (the texture's own colours). A material is drawn so when the first
+     <material> element named as its texture (outside XML comments, the
+     name matched byte for byte) says shader="grass", looked up in the
+     materials.xml beside the file, else in ../../textures/materials.xml
+     (the track's or object's own file first, then the game's shared one).
+     No base directory (an import from memory): no look-up, colours tint.
+     Positions (x, y, z), y up and left-handed, become (x, z, y): z up and
+     right-handed, the vdag tool's axes.
    - .ac: "AC3D" header, MATERIAL lines (their rgb is the Kd colour), then
      OBJECT blocks: loc (translation) and rot (3x3, row-major) place the
      object's own vertices and, composed, its kids; texture (the first one;
@@ -135,7 +156,161 @@ static int vs_half(uint32_t h, double *v) {
 
 typedef struct vs_spm_mat {
     vi_span tex1, tex2;
+    int wind; /* 1: SuperTuxKart's grass shader: vertex colours are wind weights */
 } vs_spm_mat;
+
+static int vs_xml_space(char ch) { return ch == ' ' || ch == '\t' || ch == '\r' || ch == '\n'; }
+
+/* The value of attribute NAME in TAG, the text of an XML start tag after its
+   element name (up to its '>'), into *VALUE (quoted with " or '). Returns 1
+   when TAG has it; 0 when it has not, or when TAG stops being attributes. */
+static int vs_xml_attr(vi_span tag, const char *name, vi_span *value) {
+    const char *p = tag.s, *e = tag.e;
+    while (p < e) {
+        vi_span key;
+        char q;
+        while (p < e && (vs_xml_space(*p) || *p == '/')) p++;
+        key.s = p;
+        while (p < e && !vs_xml_space(*p) && *p != '=') p++;
+        key.e = p;
+        while (p < e && vs_xml_space(*p)) p++;
+        if (p == e || *p++ != '=') return 0;
+        while (p < e && vs_xml_space(*p)) p++;
+        if (p == e || (*p != '"' && *p != '\'')) return 0;
+        q = *p++;
+        value->s = p;
+        while (p < e && *p != q) p++;
+        if (p == e) return 0;
+        value->e = p++;
+        if (vi_is(key, name)) return 1;
+    }
+    return 0;
+}
+
+/* Looks up texture NAME in XML, the text of a SuperTuxKart materials.xml:
+   the first <material> element (outside comments) whose name attribute is
+   NAME, byte for byte (an unterminated last tag is no element). Returns 1
+   when there is one, with its shader attribute in *SHADER (empty when it
+   has none); 0 when there is none. */
+static int vs_xml_material(vi_span xml, vi_span name, vi_span *shader) {
+    const char *p = xml.s, *e = xml.e;
+    while (p < e) {
+        const char *lt = (const char *)memchr(p, '<', (size_t)(e - p)), *q;
+        vi_span tag, value;
+        char quote = 0;
+        if (!lt) return 0;
+        p = lt + 1;
+        if (e - p >= 3 && !memcmp(p, "!--", 3)) { /* a comment: up to its "-->" */
+            for (p += 3; e - p >= 3 && memcmp(p, "-->", 3); p++) {}
+            p = e - p >= 3 ? p + 3 : e;
+            continue;
+        }
+        if (e - p < 9 || memcmp(p, "material", 8) || !(vs_xml_space(p[8]) || p[8] == '/' || p[8] == '>')) continue;
+        tag.s = p + 8;
+        for (q = tag.s; q < e && (quote || *q != '>'); q++) /* the tag's '>', outside quoted values */
+            if (*q == '"' || *q == '\'') quote = quote == *q ? 0 : quote ? quote : *q;
+        if (q == e) return 0; /* an unterminated tag */
+        tag.e = q;
+        p = q;
+        if (!vs_xml_attr(tag, "name", &value) || vi_len(value) != vi_len(name) ||
+            memcmp(value.s, name.s, vi_len(name)))
+            continue;
+        if (!vs_xml_attr(tag, "shader", shader)) shader->s = shader->e = tag.s;
+        return 1;
+    }
+    return 0;
+}
+
+/* SuperTuxKart's materials.xml in DIR/SUB, read whole into *DATA and *SIZE
+   (malloc'd), or *DATA = NULL when there is none or it cannot be opened (a
+   warning). Returns 0 on an error (refused, too large, out of memory). */
+static int vs_stk_materials(vi_ctx *c, const char *dir, const char *sub, char **data, size_t *size) {
+    vi_span name;
+    char *path = NULL, why[512];
+    int r;
+    name.s = "materials.xml";
+    name.e = name.s + 13;
+    *data = NULL;
+    *size = 0;
+    if (!vs_try(c, dir, sub, name, &path)) return 0;
+    if (!path) return 1;
+    if (!vi_may_read(c, path)) {
+        free(path);
+        return 0;
+    }
+    r = vi_read_side(c, path, data, size, why, sizeof why);
+    if (r < 0 && !c->limits.quiet) fprintf(stderr, "vdag: warning: %s; its shaders are not applied\n", why);
+    free(path);
+    return r != 0;
+}
+
+/* Marks the materials of MATS whose first texture SuperTuxKart draws with
+   its grass shader, which reads vertex colours as wind weights, never as
+   colours: the material in the materials.xml beside the file, else in
+   ../../textures/materials.xml (a SuperTuxKart data tree). Returns 0 on an
+   error. */
+static int vs_spm_wind(vi_ctx *c, vi_buf *mats) {
+    static const char *const subs[2] = {".", "../../textures"};
+    char *xml[2] = {NULL, NULL};
+    size_t n[2] = {0, 0}, i;
+    int ok = 1, k;
+    for (k = 0; k < 2 && ok; k++) ok = vs_stk_materials(c, c->base_dir, subs[k], &xml[k], &n[k]);
+    for (i = 0; ok && i < mats->count; i++) {
+        vs_spm_mat *m = &((vs_spm_mat *)mats->data)[i];
+        vi_span shader;
+        shader.s = shader.e = NULL;
+        for (k = 0; k < 2 && m->tex1.s != m->tex1.e; k++) {
+            vi_span whole;
+            if (!xml[k]) continue;
+            whole.s = xml[k];
+            whole.e = xml[k] + n[k];
+            if (vs_xml_material(whole, m->tex1, &shader)) break;
+        }
+        m->wind = k < 2 && vi_is(shader, "grass");
+    }
+    free(xml[0]);
+    free(xml[1]);
+    return ok;
+}
+
+/* The armature section of a skinned file, after its meshes: read and checked
+   (every joint a vertex names must exist), not applied (the bind pose is the
+   vertices as stored). MAX_JOINT: the largest joint index the vertices name,
+   or -1. */
+static int vs_spm_armatures(vi_ctx *c, vi_reader *r, int32_t max_joint) {
+    const uint8_t *b;
+    uint32_t narm, a, total = 0;
+    if (!(b = vi_take(r, 3))) return vi_fail(c, "truncated armature count");
+    narm = b[0];
+    for (a = 0; a < narm; a++) {
+        uint32_t used, n, j, keys;
+        if (!vs_u16(r, &used) || !vs_u16(r, &n)) return vi_fail(c, "armature %u: truncated joint count", (unsigned)a);
+        if (used > n) return vi_fail(c, "armature %u: %u joints used of %u", (unsigned)a, (unsigned)used, (unsigned)n);
+        for (j = 0; j < n; j++) {
+            const uint8_t *len = vi_take(r, 1);
+            if (!len || !vi_take(r, *len))
+                return vi_fail(c, "armature %u joint %u: truncated name", (unsigned)a, (unsigned)j);
+        }
+        if (!vi_take(r, 40 * (size_t)n)) return vi_fail(c, "armature %u: truncated joint transforms", (unsigned)a);
+        for (j = 0; j < n; j++) {
+            uint32_t parent;
+            if (!vs_u16(r, &parent)) return vi_fail(c, "armature %u: truncated joint parents", (unsigned)a);
+            if (parent != 0xffff && parent >= n)
+                return vi_fail(c, "armature %u joint %u: parent %u of %u joints", (unsigned)a, (unsigned)j,
+                               (unsigned)parent, (unsigned)n);
+        }
+        if (!vs_u16(r, &keys)) return vi_fail(c, "armature %u: truncated keyframe count", (unsigned)a);
+        if ((uint64_t)keys * (2 + 40 * (uint64_t)n) > r->size - r->pos)
+            return vi_fail(c, "armature %u: %u keyframes of %u joints need more bytes than remain", (unsigned)a,
+                           (unsigned)keys, (unsigned)n);
+        r->pos += (size_t)keys * (2 + 40 * (size_t)n);
+        total += n;
+    }
+    if (max_joint >= (int32_t)total)
+        return vi_fail(c, "a vertex names joint %d of %u (the joints of all armatures)", (int)max_joint,
+                       (unsigned)total);
+    return 1;
+}
 
 static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene *out) {
     vi_reader r;
@@ -144,13 +319,16 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
     vi_texcache cache = {{NULL, 0, 0}, 0};
     const uint8_t *h;
     uint32_t nmat, nmesh, mesh, flags, i;
-    int ok = 0, any_tex = 0;
+    int32_t max_joint = -1;
+    int ok = 0, any_tex = 0, skinned;
     r.data = data;
     r.size = size;
     r.pos = 0;
     r.big_endian = 0;
     if (!(h = vi_take(&r, 28)) || h[0] != 'S' || h[1] != 'P') return vi_fail(c, "not an SPM file (no \"SP\" header)");
-    if ((h[2] & 7) < 2) return vi_fail(c, "skinned meshes (kind %u) are not supported", (unsigned)(h[2] & 7));
+    if ((h[2] & 7) != 1 && (h[2] & 7) != 2)
+        return vi_fail(c, "unknown mesh kind %u (known: 1, animated; 2, static)", (unsigned)(h[2] & 7));
+    skinned = (h[2] & 7) == 1;
     flags = h[3];
     if (!vs_u16(&r, &nmat)) return vi_fail(c, "truncated material count");
     for (i = 0; i < nmat; i++) {
@@ -169,8 +347,10 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             t[k]->s = (const char *)s;
             t[k]->e = (const char *)s + *len;
         }
+        m->wind = 0;
         any_tex |= m->tex1.s != m->tex1.e;
     }
+    if (c->base_dir && (flags & 2) && any_tex && !vs_spm_wind(c, &mats)) goto done;
     if (!vs_u16(&r, &nmesh)) {
         vi_fail(c, "truncated mesh count");
         goto done;
@@ -198,8 +378,9 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             m = &((const vs_spm_mat *)mats.data)[mid];
             tex1 = m->tex1.s != m->tex1.e;
             tex2 = tex1 && m->tex2.s != m->tex2.e;
-            vbytes = (uint64_t)vc * (12 + (flags & 1 ? 4 : 0) + (flags & 2 ? 1 : 0) +
-                                     (tex1 ? 4 + (tex2 ? 4 : 0) + (flags & 4 ? 4 : 0) : 0));
+            vbytes = (uint64_t)vc * (uint64_t)(12 + (flags & 1 ? 4 : 0) + (flags & 2 ? 1 : 0) +
+                                               (tex1 ? 4 + (tex2 ? 4 : 0) + (flags & 4 ? 4 : 0) : 0) +
+                                               (skinned ? 16 : 0));
             ibytes = (uint64_t)ic * (vc > 255 ? 2 : 1);
             if (ic % 3) {
                 vi_fail(c, "mesh %u buffer %u: %u indices, not whole triangles", (unsigned)mesh, (unsigned)buf,
@@ -226,7 +407,7 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                 if (flags & 2) {
                     const uint8_t *ci = vi_take(&r, 1), *c3 = ci && *ci != 128 ? vi_take(&r, 3) : NULL;
                     bad |= !ci || (*ci != 128 && !c3);
-                    if (!bad) memcpy(col, c3 ? c3 : (const uint8_t *)"\377\377\377", 3);
+                    if (!bad) memcpy(col, c3 && !m->wind ? c3 : (const uint8_t *)"\377\377\377", 3);
                 }
                 if (t) t[0] = t[1] = 0;
                 if (tex1) {
@@ -237,6 +418,19 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
                     t[1] = (float)dv;
                     if (tex2) bad |= !vi_take(&r, 4);
                     if (flags & 4) bad |= !vi_take(&r, 4);
+                }
+                if (skinned && !bad) { /* 4 i16 joints (-1: none), 4 f16 weights: not needed for the bind pose */
+                    const uint8_t *jw = vi_take(&r, 16);
+                    for (k = 0; jw && k < 4; k++) {
+                        int32_t j = (int32_t)vi_signed(vi_uint(jw + 2 * k, 2, 0), 16);
+                        if (j < -1) {
+                            vi_fail(c, "mesh %u buffer %u vertex %u: joint %d", (unsigned)mesh, (unsigned)buf,
+                                    (unsigned)v, (int)j);
+                            goto done;
+                        }
+                        if (j > max_joint) max_joint = j;
+                    }
+                    bad = !jw;
                 }
                 if (bad) {
                     vi_fail(c, "mesh %u buffer %u vertex %u: %s", (unsigned)mesh, (unsigned)buf, (unsigned)v,
@@ -267,8 +461,9 @@ static int vi_parse_spm(vi_ctx *c, const uint8_t *data, size_t size, vdag_scene 
             }
         }
     }
+    if (skinned && !vs_spm_armatures(c, &r, max_joint)) goto done;
     if (r.pos != r.size) {
-        vi_fail(c, "%llu bytes after the last mesh", (vi_ull)(r.size - r.pos));
+        vi_fail(c, "%llu bytes after the last %s", (vi_ull)(r.size - r.pos), skinned ? "armature" : "mesh");
         goto done;
     }
     if (!(out->materials = (vdag_material *)vi_alloc(c, nmat, sizeof *out->materials))) goto done;

@@ -40,9 +40,13 @@ static double rand_eighths(uint64_t *seed, int range) {
 
 enum { SPM_MAX_V = 300, SPM_MAX_T = 400 };
 
-/* A random SPM scene and what importing it must give. */
+/* A random SPM scene and what importing it must give. Animated ("skinned")
+   files add joints and weights to each vertex and armatures after the
+   meshes; the import is their bind pose, the positions as stored. */
 typedef struct spm_case {
     unsigned flags, nbuf, nmat;
+    int skinned;
+    unsigned narm, joints[3], keys[3]; /* armatures: joints and keyframes of each */
     unsigned vc[3], ic[3], mid[3];
     const char *tex1[3], *tex2[3];
     size_t nv, nt;
@@ -53,10 +57,32 @@ typedef struct spm_case {
     int32_t tmat[3 * SPM_MAX_T];
 } spm_case;
 
+/* The armatures of T (after the meshes of an animated file): names, joint
+   transforms, parents (-1 or a joint of the same armature), keyframes. */
+static void write_spm_armatures(bytes *b, const spm_case *t, uint64_t *seed) {
+    unsigned a, j, k, f;
+    put_uint(b, t->narm, 1, 0);
+    put_uint(b, 20, 2, 0);
+    for (a = 0; a < t->narm; a++) {
+        unsigned n = t->joints[a];
+        put_uint(b, n - test_rand_below(seed, 2) * (n > 1), 2, 0); /* joints used <= n */
+        put_uint(b, n, 2, 0);
+        for (j = 0; j < n; j++) putf(b, "%cBone.%03u", 8, j);
+        for (j = 0; j < 10 * n; j++) put_f32(b, (float)rand_eighths(seed, 4));
+        for (j = 0; j < n; j++) put_uint(b, j == 0 ? 0xffff : test_rand_below(seed, n), 2, 0);
+        put_uint(b, t->keys[a], 2, 0);
+        for (k = 0; k < t->keys[a]; k++) {
+            put_uint(b, 5 * k, 2, 0);
+            for (f = 0; f < 10 * n; f++) put_f32(b, (float)rand_eighths(seed, 4));
+        }
+    }
+}
+
 static void write_spm(bytes *b, spm_case *t, uint64_t *seed) {
-    unsigned i, k, buf;
+    unsigned i, k, buf, njoints = 0;
+    for (i = 0; t->skinned && i < t->narm; i++) njoints += t->joints[i];
     put(b, "SP", 2);
-    put_uint(b, 1 << 3 | 2, 1, 0);
+    put_uint(b, 1 << 3 | (t->skinned ? 1 : 2), 1, 0);
     put_uint(b, t->flags, 1, 0);
     for (i = 0; i < 6; i++) put_f32(b, (float)i);
     put_uint(b, t->nmat, 2, 0);
@@ -103,6 +129,10 @@ static void write_spm(bytes *b, spm_case *t, uint64_t *seed) {
                 if (tex2) put_uint(b, test_rand(seed), 4, 0);
                 if (t->flags & 4) put_uint(b, test_rand(seed), 4, 0);
             }
+            if (t->skinned) { /* joints -1 or any of all armatures, weights any halves */
+                for (k = 0; k < 4; k++) put_uint(b, njoints ? test_rand_below(seed, njoints + 1) - 1 : 0xffff, 2, 0);
+                for (k = 0; k < 4; k++) put_uint(b, test_rand(seed), 2, 0);
+            }
             t->nv++;
         }
         for (i = 0; i < tc; i++) {
@@ -114,6 +144,7 @@ static void write_spm(bytes *b, spm_case *t, uint64_t *seed) {
             t->tmat[t->nt++] = (int32_t)mid;
         }
     }
+    if (t->skinned) write_spm_armatures(b, t, seed);
 }
 
 static void random_spm(spm_case *t, uint64_t *seed) {
@@ -132,6 +163,12 @@ static void random_spm(spm_case *t, uint64_t *seed) {
         t->mid[i] = test_rand_below(seed, t->nmat);
     }
     t->ic[0] = 3 * (1 + t->ic[0] / 3); /* at least one triangle */
+    t->skinned = (int)test_rand_below(seed, 2);
+    t->narm = t->skinned ? test_rand_below(seed, 4) : 0;
+    for (i = 0; i < t->narm; i++) {
+        t->joints[i] = 1 + test_rand_below(seed, 5);
+        t->keys[i] = test_rand_below(seed, 4);
+    }
 }
 
 static void check_spm(const vdag_scene *s, const spm_case *t) {
@@ -155,16 +192,19 @@ static void check_spm(const vdag_scene *s, const spm_case *t) {
         CHECK(s->materials[i].image == -1 && s->materials[i].rgb[0] == 255 && s->materials[i].rgb[2] == 255);
 }
 
+/* Random files, static and animated: animated ones import in their bind
+   pose, the positions as stored (joints, weights and armatures unused). */
 static void test_spm_roundtrip(void) {
     static spm_case t;
     uint64_t seed = 61;
-    int round;
+    int round, animated = 0;
     for (round = 0; round < 40; round++) {
         bytes b = {NULL, 0, 0};
         vdag_scene s;
         char err[256];
         random_spm(&t, &seed);
         write_spm(&b, &t, &seed);
+        animated += t.skinned;
         if (!import("spm", &b, &s, err, sizeof err)) {
             CHECK_MSG(0, "round %d: %s", round, err);
         } else {
@@ -173,6 +213,7 @@ static void test_spm_roundtrip(void) {
         }
         free(b.p);
     }
+    CHECK(animated >= 10 && animated <= 30);
 }
 
 /* A small file with every optional field, cut and patched everywhere. */
@@ -187,6 +228,28 @@ static void test_spm_sweep(void) {
     t.nbuf = 2;
     t.vc[0] = 3, t.ic[0] = 3, t.mid[0] = 0;
     t.vc[1] = 4, t.ic[1] = 6, t.mid[1] = 1;
+    write_spm(&b, &t, &seed);
+    sweep("spm", &b, 1);
+    free(b.p);
+}
+
+/* An animated ("skinned") file, as SuperTuxKart's karts are: two armatures
+   with keyframes, cut and patched everywhere. */
+static void test_spm_skinned_sweep(void) {
+    static spm_case t;
+    uint64_t seed = 9;
+    bytes b = {NULL, 0, 0};
+    memset(&t, 0, sizeof t);
+    t.flags = 3;
+    t.nmat = 1;
+    t.tex1[0] = "t.png", t.tex2[0] = "";
+    t.nbuf = 2;
+    t.vc[0] = 3, t.ic[0] = 3, t.mid[0] = 0;
+    t.vc[1] = 3, t.ic[1] = 3, t.mid[1] = 0;
+    t.skinned = 1;
+    t.narm = 2;
+    t.joints[0] = 2, t.keys[0] = 1;
+    t.joints[1] = 1, t.keys[1] = 0;
     write_spm(&b, &t, &seed);
     sweep("spm", &b, 1);
     free(b.p);
@@ -220,6 +283,40 @@ static void spm_buffer(bytes *b, uint32_t vc, uint32_t ic, unsigned mid, const u
     for (i = 0; i < n; i++) put_uint(b, idx[i], 1, 0);
 }
 
+/* An animated file: one buffer of 3 vertices naming joint JOINT, then one
+   armature of N joints used of USED, joint 1's parent PARENT (when N > 1),
+   KEYS keyframes, and TAIL bytes of keyframes cut off (negative: extra
+   bytes after the armature). */
+static void spm_skinned(bytes *b, int joint, unsigned used, unsigned n, unsigned parent, unsigned keys, int tail) {
+    static const uint32_t tri[3] = {0, 1, 2};
+    size_t i;
+    b->n = 0;
+    spm_header(b, 1, 0, "");
+    put_uint(b, 1, 2, 0);
+    put_uint(b, 1, 2, 0);
+    put_uint(b, 3, 4, 0);
+    put_uint(b, 3, 4, 0);
+    put_uint(b, 0, 2, 0);
+    for (i = 0; i < 3; i++) {
+        put_f32(b, (float)i), put_f32(b, 0), put_f32(b, 0);
+        put_uint(b, (uint64_t)(int64_t)(i == 2 ? joint : 0), 2, 0);
+        put_uint(b, 0xffff, 2, 0), put_uint(b, 0xffff, 2, 0), put_uint(b, 0xffff, 2, 0);
+        put_uint(b, 0x3c00, 2, 0), put_uint(b, 0, 2, 0), put_uint(b, 0, 2, 0), put_uint(b, 0, 2, 0);
+    }
+    for (i = 0; i < 3; i++) put_uint(b, tri[i], 1, 0);
+    put_uint(b, 1, 1, 0);
+    put_uint(b, 0, 2, 0);
+    put_uint(b, used, 2, 0);
+    put_uint(b, n, 2, 0);
+    for (i = 0; i < n; i++) putf(b, "%cj%u", 2, (unsigned)i % 10);
+    for (i = 0; i < 10 * n; i++) put_f32(b, 0);
+    for (i = 0; i < n; i++) put_uint(b, i == 1 ? parent : 0xffff, 2, 0);
+    put_uint(b, keys, 2, 0);
+    for (i = 0; i < keys * (2 + 40 * (size_t)n); i++) put_uint(b, 0, 1, 0);
+    if (tail > 0) b->n -= (size_t)tail;
+    for (; tail < 0; tail++) put_uint(b, 0, 1, 0);
+}
+
 static void test_spm_errors(void) {
     static const uint32_t tri[3] = {0, 1, 2}, bad[3] = {0, 1, 3};
     bytes b = {NULL, 0, 0};
@@ -227,8 +324,11 @@ static void test_spm_errors(void) {
     uint32_t u;
     expect_error_text("spm", "", "no \"SP\" header");
     expect_error_text("spm", "PS\x0a\x03", "no \"SP\" header");
-    spm_header(&b, 1, 0, "");
-    expect_error("spm", &b, "skinned");
+    spm_header(&b, 0, 0, "");
+    expect_error("spm", &b, "unknown mesh kind 0 (known: 1, animated; 2, static)");
+    b.n = 0;
+    spm_header(&b, 3, 0, "");
+    expect_error("spm", &b, "unknown mesh kind 3");
     b.n = 0;
     spm_header(&b, 2, 0, "");
     spm_buffer(&b, 3, 3, 1, tri, 3);
@@ -284,6 +384,38 @@ static void test_spm_errors(void) {
     put_f32(&b, 0), put_f32(&b, 0), put_f32(&b, 0);
     put_uint(&b, 7, 1, 0);
     expect_error("spm", &b, "truncated");
+    /* Animated files: the armatures are checked and must end the file. */
+    spm_skinned(&b, 1, 2, 2, 0, 2, 0);
+    {
+        vdag_scene s;
+        char err[256];
+        if (!import("spm", &b, &s, err, sizeof err)) {
+            CHECK_MSG(0, "%s", err);
+        } else {
+            CHECK(s.vertex_count == 3 && s.triangle_count == 1 && s.positions[3] == 1);
+            vdag_scene_free(&s);
+        }
+    }
+    spm_skinned(&b, 2, 2, 2, 0, 2, 0);
+    expect_error("spm", &b, "a vertex names joint 2 of 2 (the joints of all armatures)");
+    spm_skinned(&b, -2, 2, 2, 0, 2, 0);
+    expect_error("spm", &b, "mesh 0 buffer 0 vertex 2: joint -2");
+    spm_skinned(&b, 1, 3, 2, 0, 2, 0);
+    expect_error("spm", &b, "armature 0: 3 joints used of 2");
+    spm_skinned(&b, 1, 2, 2, 2, 2, 0);
+    expect_error("spm", &b, "armature 0 joint 1: parent 2 of 2 joints");
+    spm_skinned(&b, 1, 2, 2, 0, 2, 1);
+    expect_error("spm", &b, "armature 0: 2 keyframes of 2 joints need more bytes than remain");
+    spm_skinned(&b, 1, 2, 2, 0, 0, -10);
+    b.p[b.n - 12] = b.p[b.n - 11] = 0xff; /* 65535 keyframes, 10 bytes of them */
+    expect_error("spm", &b, "armature 0: 65535 keyframes of 2 joints need more bytes than remain");
+    spm_skinned(&b, 1, 2, 2, 0, 0, -1);
+    expect_error("spm", &b, "1 bytes after the last armature");
+    spm_skinned(&b, 0, 1, 1, 0, 0, 0);
+    b.n -= 2 + 2 + 40 + 3 + 2 + 2; /* keyframe count, parents, transforms, name, joint counts */
+    expect_error("spm", &b, "armature 0: truncated joint count");
+    b.n -= 3;
+    expect_error("spm", &b, "truncated armature count");
     free(b.p);
 }
 
@@ -609,14 +741,105 @@ static void test_scene_files(void) {
     rmdir(dir);
 }
 
+/* SuperTuxKart's grass shader reads vertex colours as wind weights, never
+   as colours: materials drawn with it (the materials.xml beside the file
+   first, then ../../textures/materials.xml; comments skipped) get white
+   vertices, the texture's own colours; others keep their tint. Foliage
+   with wind weights of about 0.05 came out near-black before. */
+static void test_spm_wind(void) {
+    static const char *const tex[] = {"leaf.png", "bark.png", "shared.png", "over.png",
+                                      "commented.png", "quoted.png", "", "leaf.png.bak"};
+    static const int wind[] = {1, 0, 1, 0, 0, 1, 0, 0};
+    enum { NMAT = sizeof wind / sizeof wind[0] };
+    static const char beside[] =
+        "<?xml version=\"1.0\"?>\n<materials>\n"
+        "  <!-- <material name=\"commented.png\" shader=\"grass\"/> -->\n"
+        "  <material name=\"leaf.png\" shader=\"grass\" ignore=\"Y\" grass-speed=\"1.50\"/>\n"
+        "  <material name=\"bark.png\" normal-map=\"a>b.png\" shader=\"alphatest\"/>\n"
+        "  <material name=\"over.png\" shader=\"alphatest\"/>\n"
+        "  <material\n     shader = 'grass'\n     name='quoted.png' />\n"
+        "  <material name=\"leaf.png\" shader=\"solid\"/>\n"
+        "</materials>\n";
+    static const char shared[] =
+        "<materials>\n<material name=\"shared.png\" shader=\"grass\"/>\n"
+        "<material name=\"over.png\" shader=\"grass\"/>\n<material name=\"leaf.png.bak\" shader=\"grass\"\n";
+    static const char *const made[] = {"tracks", "tracks/t", "textures"};
+    char dir[] = "/tmp/vdag-wind-XXXXXX", p[8][320], err[512];
+    vdag_import_limits quiet;
+    bytes b = {NULL, 0, 0};
+    vdag_scene s;
+    int i, k, pass, n = 0;
+    memset(&quiet, 0, sizeof quiet);
+    quiet.quiet = 1; /* the textures are missing: white, with warnings */
+    CHECK(mkdtemp(dir) != NULL);
+    for (i = 0; i < 3; i++) {
+        snprintf(p[n], sizeof p[n], "%s/%s", dir, made[i]);
+        CHECK(mkdir(p[n++], 0700) == 0);
+    }
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/materials.xml", dir);
+    CHECK(sfile(p[n++], beside, strlen(beside)));
+    snprintf(p[n], sizeof p[n], "%s/textures/materials.xml", dir);
+    CHECK(sfile(p[n++], shared, strlen(shared)));
+    put(&b, "SP", 2);
+    put_uint(&b, 1 << 3 | 2, 1, 0);
+    put_uint(&b, 2, 1, 0); /* vertex colours */
+    for (i = 0; i < 6; i++) put_f32(&b, 0);
+    put_uint(&b, NMAT, 2, 0);
+    for (i = 0; i < NMAT; i++) {
+        put_uint(&b, strlen(tex[i]), 1, 0);
+        put(&b, tex[i], strlen(tex[i]));
+        put_uint(&b, 0, 1, 0);
+    }
+    put_uint(&b, 1, 2, 0);
+    put_uint(&b, NMAT, 2, 0);
+    for (i = 0; i < NMAT; i++) { /* one buffer per material: 3 vertices of colour (i, 10 + k, 50) */
+        put_uint(&b, 3, 4, 0);
+        put_uint(&b, 3, 4, 0);
+        put_uint(&b, (uint64_t)i, 2, 0);
+        for (k = 0; k < 3; k++) {
+            put_f32(&b, (float)k), put_f32(&b, (float)i), put_f32(&b, 0);
+            put_uint(&b, 0, 1, 0);
+            put_uint(&b, (uint64_t)i, 1, 0), put_uint(&b, 10 + (uint64_t)k, 1, 0), put_uint(&b, 50, 1, 0);
+            if (tex[i][0]) put_uint(&b, 0, 4, 0); /* texture coordinates */
+        }
+        put(&b, "\0\1\2", 3);
+    }
+    snprintf(p[n], sizeof p[n], "%s/tracks/t/track.spm", dir);
+    CHECK(sfile(p[n++], b.p, b.n));
+    for (pass = 0; pass < 2; pass++) { /* from the file; from memory (no look-up) */
+        int ok = pass == 0 ? vdag_import_file(p[n - 1], &quiet, &s, err, sizeof err)
+                           : vdag_import_memory("spm", b.p, b.n, NULL, &quiet, &s, err, sizeof err);
+        if (!ok) {
+            CHECK_MSG(0, "%s", err);
+            continue;
+        }
+        CHECK(s.vertex_count == 3 * NMAT && s.vertex_rgb != NULL);
+        for (i = 0; i < NMAT && s.vertex_rgb && s.vertex_count == 3 * NMAT; i++)
+            for (k = 0; k < 3; k++) {
+                const uint8_t *got = s.vertex_rgb + 3 * (3 * (size_t)i + (size_t)k);
+                uint8_t want[3];
+                want[0] = (uint8_t)i, want[1] = (uint8_t)(10 + k), want[2] = 50;
+                if (pass == 0 && wind[i]) memset(want, 255, 3);
+                CHECK_MSG(!memcmp(got, want, 3), "pass %d material %s vertex %d: %u %u %u", pass, tex[i], k,
+                          got[0], got[1], got[2]);
+            }
+        vdag_scene_free(&s);
+    }
+    free(b.p);
+    while (n-- > 0) remove(p[n]); /* files, then folders, deepest first */
+    rmdir(dir);
+}
+
 const test_case test_import_scene_cases[] = {
     {"import_scene/spm roundtrip", test_spm_roundtrip},
     {"import_scene/spm sweep", test_spm_sweep},
+    {"import_scene/spm skinned sweep", test_spm_skinned_sweep},
     {"import_scene/spm errors", test_spm_errors},
     {"import_scene/ac roundtrip", test_ac_roundtrip},
     {"import_scene/ac sweep", test_ac_sweep},
     {"import_scene/ac errors", test_ac_errors},
     {"import_scene/ac subdiv warns", test_ac_subdiv_warns},
     {"import_scene/texture files", test_scene_files},
+    {"import_scene/spm grass shader colours", test_spm_wind},
     {NULL, NULL},
 };
