@@ -308,6 +308,22 @@ if [ -n "${FG:-}" ]; then
     check "a PNG named .obj is refused as one" refused "$T/nets.obj" 'PNG image'
 fi
 
+# -- README's walk-through ("Convert a model and look at it"): its vdag
+# commands, as written, on the model it names (Assimp's spider, its .mtl and
+# textures beside it): no warning, and a 640x480 PNG.
+if [ -n "${M:-}" ]; then
+    mkdir -p "$T/walk" && cp "$M"/OBJ/spider.obj "$M"/OBJ/spider.mtl "$M"/OBJ/*.jpg "$T/walk/"
+    vabs=$(cd "$(dirname "$VDAG")" && pwd)/vdag
+    awk '/^### Convert a model/ { w = 1 } w && /^```sh$/ { c = 1; next } c && /^```/ { exit }
+         c && /^build\/vdag / { sub(/ *#.*/, ""); print }' README.md | sed "s|^build/vdag |'$vabs' |" >"$T/walk.sh"
+    check "README's walk-through has its 3 vdag commands" test "$(wc -l <"$T/walk.sh")" = 3
+    check "README's walk-through runs as written, without a warning" \
+        sh -c "cd '$T/walk' && sh -e '$T/walk.sh' >/dev/null 2>'$T/err' && ! grep -q warning '$T/err'"
+    check "README's walk-through renders a 640x480 PNG" \
+        test "$(od -An -tu1 -N24 "$T/walk/spider.png" 2>/dev/null | tr -s ' \n' ' ')" = \
+        " 137 80 78 71 13 10 26 10 0 0 0 13 73 72 68 82 0 0 2 128 0 0 1 224 "
+fi
+
 # -- 2 and 3. SuperTuxKart's foliage and karts (tests/real_stk.sh), on the
 # unpacked supertuxkart-data (628 MB).
 if [ -f tests/real_stk.sh ]; then
