@@ -2,8 +2,9 @@
 # The importers' and the tool's fixes on the real third-party files they
 # were found on (`make test-real`, not part of `make test`): each check
 # compares what vdag does with an answer computed from the file itself
-# (tests/real.py, awk, od) or with a bound justified here, never with a
-# number taken from vdag's output.
+# (tests/real.py, od), with a bound justified here, or with vdag's own
+# answer under the option that should give the same (--up, --raw-colors),
+# never with a figure copied from an earlier run. Every check is printed.
 #
 # The files are fetched once, nothing installed: Debian packages with
 # apt-get download and dpkg-deb -x into BUILD/cache/x/PACKAGE (a package
