@@ -3,6 +3,7 @@
 #   make test     install missing test packages, run every test
 #   make test-full the same with exhaustive mutation sweeps (long)
 #   make check-all build matrix, link/symbol checks, determinism (in make test)
+#   make test-real the importers' fixes on real third-party files (fetched; not in make test)
 #   make demo     build, colour-compress, save and render the default scene
 #   make bench    regenerate BENCHMARKS.md
 
@@ -222,6 +223,15 @@ check-all:
 # The importers' triangles, printed for tests/third_party.sh (sanitized).
 $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
+
+# Each fix of the importers and the tool checked on the real third-party
+# files it was found on (tests/real.sh): Debian and npm packages fetched once
+# into $(BUILD)/cache (about 1 GB with SuperTuxKart's data; packages that
+# bench/fetch.sh unpacked into bench/data/x are used from there). Not part
+# of `make test`.
+.PHONY: test-real
+test-real: $(BUILD)/vdag $(BUILD)/import_dump
+	@sh tests/real.sh $(BUILD)
 
 TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
                  $(if $(VULKAN),$(VK_SMOKE:.h=.spv) $(VDAG_KERNEL:.h=.spv) $(README_SHADERS))
