@@ -59,6 +59,22 @@
    Win32 threads on Windows; workers started once and reused) or over the
    host's (opts.thread_pool: run a batch of jobs, wait), with the same bytes.
 
+   ERRORS, reported in three shapes, by what a function does:
+   - Work that can fail on its own (memory, files, limits, bad data: build,
+     load, save, voxdag_with_colors) returns a voxdag_status, VOXDAG_OK or
+     the reason, with a message and a byte offset in an optional
+     voxdag_error.
+   - Ray queries, where a wrong call must not look like "no hit", return an
+     int: 1 yes, 0 no, -1 for a NULL argument or invalid options
+     (voxdag_raycast, voxdag_occluded, voxdag_occluded_opts,
+     voxdag_ray_from_hit): test `> 0`. voxdag_color: 1 when it wrote a
+     colour, 0 when there is none (no colours, an index past the last
+     voxel, a NULL argument), -1 when the colours cannot be decoded.
+   - Lookups and counts (voxdag_lookup, voxdag_lookup_many,
+     voxdag_for_each_voxel) treat a NULL DAG as an empty scene: 0. They
+     keep that shape because -1 would read as "full" in the
+     `if (voxdag_lookup(...))` that existing code writes.
+
    FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
 */
 #ifndef VOXDAG_H
@@ -202,7 +218,11 @@ typedef void (*voxdag_job_fn)(void *job_user, uint32_t index);
    returns or before WAIT returns. WAIT returns when every job of the batch
    has returned. The builder calls both from the thread that called it, one
    batch at a time, never from inside a job, and may do its own work between
-   RUN and WAIT. Files are the same bytes whatever the pool does. */
+   RUN and WAIT. Files are the same bytes whatever the pool does.
+   voxcolor.h, which does not depend on this header, takes its own
+   voxcolor_thread_pool: one RUN that returns when the batch is done. The
+   same host pool serves both: give voxcolor a RUN that calls this RUN and
+   then WAIT. */
 typedef struct voxdag_thread_pool {
     void (*run)(void *user, voxdag_job_fn job, void *job_user, uint32_t count);
     void (*wait)(void *user);
