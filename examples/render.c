@@ -13,12 +13,20 @@
      voxel), eye along (1, -1.4, 0.9) from it, far enough that the box's
      bounding sphere fits the narrower field of view.
    - Shading: colour x (AMBIENT + (1 - AMBIENT) max(0, n . l)) with n the
-     entry face normal and l = normalize(LIGHT); the voxel a ray starts in
-     gets factor 1. With --shadows, a lit face whose shadow ray towards l is
-     blocked gets AMBIENT alone; the shadow ray starts on the face plane
-     exactly, so it starts in the neighbouring voxel and needs no offset.
-     Each channel is (int)(c * factor + 0.5). Misses are BACKGROUND.
-   - --lod P stops at cells smaller than P pixels (lod_factor = 2 s / H). */
+     entry face normal and l = normalize(LIGHT) (--light x y z: towards the
+     light); the voxel a ray starts in gets factor 1. With --shadows, a lit
+     face whose shadow ray towards l is blocked gets AMBIENT alone; the
+     shadow ray starts on the hit face (voxdag_ray_from_hit: on the face's
+     plane exactly, inside its square), so it starts in the neighbouring
+     voxel and needs no offset. Each channel is (int)(c * factor + 0.5).
+     Misses are BACKGROUND.
+   - --samples N (N = n^2, n = 1..8): pixel (i, j) averages the n x n rays
+     of pixels (n i + a, n j + b), a, b in 0..n-1, of the same view at n W x
+     n H (an ordered grid), each channel (sum + N / 2) / N of the samples'
+     8-bit values: the picture is exactly that larger one's n x n blocks
+     averaged.
+   - --lod P stops at cells smaller than P pixels (lod_factor = 2 s / H),
+     or P samples with --samples (2 s / (n H)). */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -254,6 +262,7 @@ typedef struct render_job {
     camera cam;
     voxdag_ray_opts opts;
     int shadows;
+    uint32_t side; /* samples per pixel: side x side */
     uint32_t levels;
     uint8_t *rgb;
     uint32_t tiles_x, tiles, next, done;
@@ -264,9 +273,10 @@ typedef struct render_job {
 
 enum { TILE = 32 };
 
-static void render_pixel(const render_job *job, uint32_t i, uint32_t j, uint8_t *out) {
+/* The colour of the ray through pixel (I, J) of a W x H picture of the view. */
+static void render_sample(const render_job *job, uint32_t i, uint32_t j, double w, double h, uint8_t *out) {
     const camera *c = &job->cam;
-    double sx = (2 * (i + 0.5) / c->w - 1) * c->s * c->w / c->h, sy = (1 - 2 * (j + 0.5) / c->h) * c->s;
+    double sx = (2 * (i + 0.5) / w - 1) * c->s * w / h, sy = (1 - 2 * (j + 0.5) / h) * c->s;
     voxdag_ray ray;
     voxdag_hit hit;
     uint8_t rgb[3];
@@ -289,21 +299,30 @@ static void render_pixel(const render_job *job, uint32_t i, uint32_t j, uint8_t 
         factor = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
         if (job->shadows && lit > 0) {
             voxdag_ray shadow;
-            memset(&shadow, 0, sizeof shadow);
-            for (k = 0; k < 3; k++) {
-                shadow.origin[k] = ray.origin[k] + hit.t * ray.dir[k];
-                if (hit.normal[k]) /* exactly on the face plane */
-                    shadow.origin[k] = hit.xyz[k] + (hit.normal[k] > 0 ? (double)(1u << (job->levels - hit.level)) : 0);
-                shadow.dir[k] = c->light[k];
-            }
-            shadow.t_max = HUGE_VAL;
-            if (voxdag_occluded(job->file->dag, &shadow)) factor = AMBIENT;
+            if (voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow) > 0 &&
+                voxdag_occluded(job->file->dag, &shadow) > 0)
+                factor = AMBIENT;
         }
     }
     for (k = 0; k < 3; k++) {
         double v = rgb[k] * factor + 0.5;
         out[k] = (uint8_t)(v > 255 ? 255 : v);
     }
+}
+
+static void render_pixel(const render_job *job, uint32_t i, uint32_t j, uint8_t *out) {
+    uint32_t n = job->side, a, b, k, sum[3] = {0, 0, 0};
+    uint8_t rgb[3];
+    if (n == 1) {
+        render_sample(job, i, j, job->cam.w, job->cam.h, out);
+        return;
+    }
+    for (b = 0; b < n; b++)
+        for (a = 0; a < n; a++) {
+            render_sample(job, n * i + a, n * j + b, (double)n * job->cam.w, (double)n * job->cam.h, rgb);
+            for (k = 0; k < 3; k++) sum[k] += rgb[k];
+        }
+    for (k = 0; k < 3; k++) out[k] = (uint8_t)((sum[k] + n * n / 2) / (n * n));
 }
 
 static void *render_worker(void *arg) {
@@ -414,11 +433,13 @@ static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels
 
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--lod PIXELS] [--quiet] [--gpu | --gpu-emulate [--beam]]";
+                                "[--fov deg] [--threads T] [--shadows] [--light x y z] [--lod PIXELS] [--samples N] [--quiet] "
+                                "[--gpu | --gpu-emulate [--beam]]";
     render_job job;
     vdag_file f;
     voxdag_info info;
     double eye[3], target[3], fov = 50, lod = 0, threads_d = 0, up[3] = {0, 0, 1}, t0, cpu0, secs, cpu;
+    double light[3] = {LIGHT[0], LIGHT[1], LIGHT[2]}, samples = 1;
     int have_eye = 0, have_target = 0, quiet = 0, gpu = -1, beam = 0, i, k;
     uint32_t box[6];
     unsigned threads, t;
@@ -448,6 +469,13 @@ int vdag_cmd_render(int argc, char **argv) {
             if (!parse_numbers(argc, argv, &i, &lod, 1) || lod < 0) return vdag_fail("render: --lod takes pixels >= 0");
         } else if (!strcmp(a, "--shadows")) {
             job.shadows = 1;
+        } else if (!strcmp(a, "--light")) {
+            if (!parse_numbers(argc, argv, &i, light, 3) || dot3(light, light) == 0 || !(dot3(light, light) < HUGE_VAL))
+                return vdag_fail("render: --light takes 3 numbers, a direction towards the light (not 0 0 0)");
+        } else if (!strcmp(a, "--samples")) {
+            if (!parse_numbers(argc, argv, &i, &samples, 1) || !(samples >= 1 && samples <= 64) ||
+                floor(sqrt(samples)) * floor(sqrt(samples)) != samples)
+                return vdag_fail("render: --samples takes a square number of rays per pixel: 1, 4, 9, ..., 64");
         } else if (!strcmp(a, "--quiet")) {
             quiet = 1;
         } else if (!strcmp(a, "--gpu")) {
@@ -462,6 +490,7 @@ int vdag_cmd_render(int argc, char **argv) {
     }
     if (gpu == VDAG_GPU_GLSL && threads_d > 0) return vdag_fail("render: --threads is for the CPU; --gpu takes none");
     if (beam && gpu < 0) return vdag_fail("render: --beam is a pass of the GPU kernel: add --gpu or --gpu-emulate");
+    if (gpu >= 0 && samples > 1) return vdag_fail("render: --samples is for the CPU renderer; the GPU kernel takes one ray a pixel");
     {   /* the picture is a PNG: an OUT named otherwise would hold PNG bytes under another name */
         const char *slash = strrchr(argv[2], '/'), *dot = strrchr(slash ? slash : argv[2], '.');
         if (!dot || strlen(dot) != 4 || (dot[1] | 0x20) != 'p' || (dot[2] | 0x20) != 'n' || (dot[3] | 0x20) != 'g')
@@ -488,7 +517,7 @@ int vdag_cmd_render(int argc, char **argv) {
     for (k = 0; k < 3; k++) {
         job.cam.eye[k] = eye[k];
         job.cam.f[k] = target[k] - eye[k];
-        job.cam.light[k] = LIGHT[k];
+        job.cam.light[k] = light[k];
     }
     if (dot3(job.cam.f, job.cam.f) == 0) {
         vdag_close(&f);
@@ -501,7 +530,8 @@ int vdag_cmd_render(int argc, char **argv) {
     normalize3(job.cam.r);
     cross3(job.cam.r, job.cam.f, job.cam.u);
     job.opts.want_index = 1;
-    job.opts.lod_factor = 2 * job.cam.s / job.cam.h;
+    job.side = (uint32_t)floor(sqrt(samples));
+    job.opts.lod_factor = 2 * job.cam.s / ((double)job.side * job.cam.h);
     job.opts.lod_pixels = lod;
     job.rgb = (uint8_t *)malloc(3 * (size_t)job.cam.w * job.cam.h);
     if (!job.rgb) {
@@ -530,11 +560,12 @@ int vdag_cmd_render(int argc, char **argv) {
     secs = seconds_now(CLOCK_MONOTONIC) - t0;
     cpu = seconds_now(CLOCK_PROCESS_CPUTIME_ID) - cpu0;
     pthread_mutex_destroy(&job.lock);
-    if (!quiet)
+    if (!quiet) { /* primary rays: one a sample */
+        double rays = (double)job.cam.w * job.cam.h * job.side * job.side;
         fprintf(stderr, "%srender: %ux%u in %.3f s (%.3f CPU-s), %.2f Mrays/s, %.2f Mrays/CPU-s (%u threads)\n",
-                job.tty ? "\r" : "", job.cam.w, job.cam.h, secs, cpu,
-                (double)job.cam.w * job.cam.h / (secs > 0 ? secs : 1e-9) * 1e-6,
-                (double)job.cam.w * job.cam.h / (cpu > 0 ? cpu : 1e-9) * 1e-6, threads);
+                job.tty ? "\r" : "", job.cam.w, job.cam.h, secs, cpu, rays / (secs > 0 ? secs : 1e-9) * 1e-6,
+                rays / (cpu > 0 ? cpu : 1e-9) * 1e-6, threads);
+    }
     errno = 0;
     if (!write_png(argv[2], job.rgb, job.cam.w, job.cam.h)) {
         free(job.rgb);

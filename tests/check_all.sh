@@ -347,6 +347,7 @@ job "readme: README.md's C code compiled as C99 and as C++11 ($cxx1), run on a v
      (cd $out/readme && ./readme) >$out/readme/out.txt
      cat $out/readme/out.txt
      grep -q '^hit voxel .* colour [0-9]* [0-9]* [0-9]*\$' $out/readme/out.txt
+     grep -qx 'lit\|in shadow' $out/readme/out.txt
      $cxx1 $CXX11 -Wno-unused -O1 -o $out/readme/readme_cxx -I. $out/readme/readme.c $LIBS
      (cd $out/readme && ./readme_cxx) >$out/readme/out_cxx.txt
      cmp $out/readme/out.txt $out/readme/out_cxx.txt"

@@ -838,6 +838,12 @@ check "render: an OUT not named .png (any case) is refused, one line, nothing wr
     '$VDAG' render '$T/r.vdag' '$T/r2.PNG' --size 4x4 --quiet && [ -s '$T/r2.PNG' ]"
 check "render: a bad --size fails with one line" sh -c "! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 0x10 2>'$T/err' &&
     [ \$(wc -l <'$T/err') = 1 ] && ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 12 2>/dev/null && [ ! -e '$T/bad.png' ]"
+check "render: --samples takes 1, 4, ..., 64 (CPU only) and --light a nonzero direction, else one line" sh -c "
+    for bad in '--samples 5' '--samples 0' '--samples 81' '--samples 4 --gpu-emulate' '--light 0 0 0' '--light 1 2'; do
+        ! '$VDAG' render '$T/r.vdag' '$T/bad.png' --size 4x4 \$bad 2>'$T/err' && [ \$(wc -l <'$T/err') = 1 ] &&
+        [ ! -e '$T/bad.png' ] || exit 1
+    done
+    '$VDAG' render '$T/r.vdag' '$T/s.png' --size 4x4 --samples 9 --light 1 -1 2 --shadows --quiet && [ -s '$T/s.png' ]"
 
 # -- vdag rays --gpu / vdag render --gpu on the machine's Vulkan device
 # (lavapipe without a GPU): the same answers and pixels as the kernel's C

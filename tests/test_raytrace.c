@@ -517,7 +517,11 @@ static void reference_pixel(const rscene *s, const view *c, double lod, uint32_t
         lit = n * c->light[v.axis];
         factor = 0.3 + (1 - 0.3) * (lit > 0 ? lit : 0);
         memset(&sh, 0, sizeof sh);
-        for (k = 0; k < 3; k++) sh.origin[k] = ray.origin[k] + v.t * ray.dir[k], sh.dir[k] = c->light[k];
+        for (k = 0; k < 3; k++) { /* on the hit face: its plane, inside its square */
+            double lo = (double)(v.c[k] << (s->levels - q)), hi = (double)((v.c[k] + 1) << (s->levels - q));
+            double o = ray.origin[k] + v.t * ray.dir[k];
+            sh.origin[k] = o < lo ? lo : o > hi ? hi : o, sh.dir[k] = c->light[k];
+        }
         sh.origin[v.axis] = (double)((v.c[v.axis] + (n > 0)) << (s->levels - q));
         sh.t_max = HUGE_VAL;
         if (lit > 0 && oracle_walk(s, &sh, s->levels, stop_full, NULL, &sv)) factor = 0.3;
@@ -617,8 +621,43 @@ static void test_raytrace_render_image(void) {
             vdag_image_free(&lod);
             remove(lod_png);
         }
+        { /* --light: the brute-force render with that light */
+            double other[3] = {-0.7, 0.2, 0.4};
+            view lc = c;
+            for (k = 0; k < 3; k++) lc.light[k] = other[k];
+            unit3(lc.light);
+            CHECK(run_render(file, lod_png, "--light -0.7 0.2 0.4"));
+            CHECK(vdag_image_load(lod_png, &lod, err, sizeof err));
+            for (differ = 0, j = 0; lod.rgb && j < c.h; j++)
+                for (i = 0; i < c.w; i++) {
+                    uint8_t want[3];
+                    reference_pixel(&s, &lc, 0, i, j, want);
+                    differ += memcmp(want, lod.rgb + 3 * ((size_t)j * c.w + i), 3) != 0;
+                }
+            CHECK(lod.rgb && differ == 0);
+            vdag_image_free(&lod);
+        }
+        for (k = 0; k < 2; k++) { /* --samples 4: the 2x larger picture's 2x2 blocks averaged, with
+                                     level of detail too (then in samples) */
+            vdag_image big, four;
+            uint32_t ch;
+            CHECK(run_render(file, lod_png, k ? "--size 192x144 --lod 2" : "--size 192x144"));
+            CHECK(run_render(file, png, k ? "--samples 4 --lod 2" : "--samples 4"));
+            CHECK(vdag_image_load(lod_png, &big, err, sizeof err) && vdag_image_load(png, &four, err, sizeof err));
+            for (differ = 0, j = 0; big.rgb && four.rgb && j < c.h; j++)
+                for (i = 0; i < c.w; i++)
+                    for (ch = 0; ch < 3; ch++) {
+                        const uint8_t *q = big.rgb + 3 * ((size_t)2 * j * big.width + 2 * i) + ch;
+                        uint32_t sum = q[0] + q[3] + q[3 * big.width] + q[3 * big.width + 3];
+                        differ += four.rgb[3 * ((size_t)j * c.w + i) + ch] != (sum + 2) / 4;
+                    }
+            CHECK_MSG(big.rgb && four.rgb && differ == 0, "--samples 4: %u channels differ", differ);
+            vdag_image_free(&big);
+            vdag_image_free(&four);
+        }
         vdag_image_free(&got);
         remove(png);
+        remove(lod_png);
         remove(file);
         voxdag_free(d);
         rscene_free(&s);
