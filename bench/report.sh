@@ -51,6 +51,7 @@ if optional color; then
     section color $make -s --no-print-directory bench-color BUILD="$build" BENCH_COLOR_FLAGS="$color_flags"
 fi
 section image sh bench/image_quality.sh "$mode" "$build/vdag" "$build/bench/ssim" bench/data "$docs"
+section distance sh bench/distance.sh "$mode" "$build/vdag" bench/data
 section gpu sh bench/gpu.sh "$mode" "$build/vdag" bench/data
 step "plots"
 
@@ -92,6 +93,7 @@ tmp=$out/BENCHMARKS.md.tmp
         sh bench/plots.sh "$docs" "$docs" color
     fi
     cat "$out/image.md"
+    cat "$out/distance.md"
     cat "$out/gpu.md"
     if [ -f bench/reading.md ]; then cat bench/reading.md; echo; fi
     if [ -f bench/real_scenes.md ]; then cat bench/real_scenes.md; echo; fi
