@@ -46,7 +46,9 @@
    bit operations and four Newton steps, the same everywhere. Domain: finite
    inputs; a direction component below 2^-64 in magnitude counts as 0, a ray
    with one above 2^32, or an origin coordinate beyond 2^30, misses, and an
-   origin coordinate below 2^-32 in magnitude counts as 0. Against
+   origin coordinate below 2^-32 in magnitude counts as 0; t_min below
+   2^-64 in magnitude counts as 0, and so does t_max with
+   VOXDAG_GPU_T_MAX_EXCLUSIVE; t limits beyond 2^100 count as 2^100. Against
    voxdag_raycast's exact double-precision answers a hit is the same voxel,
    normal and index except at near-ties: where two planes' t differ by about
    float32 rounding at the grid's scale (2^-24 relative: at 65536^3 about
@@ -209,6 +211,8 @@ typedef struct voxdag_gpu_frustum voxdag_gpu_frustum;
 
 #define VOXDAG_GPU_VERSION 1      /* of this header's interface */
 #define VOXDAG_GPU_WANT_INDEX 1u  /* voxdag_gpu_ray.flags: fill the hit's voxel index */
+#define VOXDAG_GPU_T_MAX_EXCLUSIVE 2u /* flags: the range is [t_min, t_max), t_max as given (0 too),
+                                         as voxdag_ray_opts.t_max_exclusive */
 #define VOXDAG_GPU_COLORS_NONE 0u /* voxdag_gpu_file.color_kind, as voxdag_color_kind */
 #define VOXDAG_GPU_COLORS_RGB8 1u
 #define VOXDAG_GPU_COLORS_VOXCOLOR 2u
@@ -235,7 +239,7 @@ struct voxdag_gpu_file {
    t (voxdag_ray_opts' lod_factor * lod_pixels; 0: full detail). */
 struct voxdag_gpu_ray {
     voxdag_gpu_f32 ox, oy, oz, dx, dy, dz, t_min, t_max, lod;
-    voxdag_gpu_u32 flags; /* VOXDAG_GPU_WANT_INDEX */
+    voxdag_gpu_u32 flags; /* VOXDAG_GPU_WANT_INDEX, VOXDAG_GPU_T_MAX_EXCLUSIVE */
 };
 
 /* A ray's answer, as voxdag_hit: hit is 0 on a miss (the rest is then 0). */
@@ -700,6 +704,15 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_clamp_t(voxdag_gpu_f32 x) {
     return (bits & 0x7FFFFFFFu) >= 0x71800000u ? VOXDAG_GPU_BITS_FLOAT((bits & 0x80000000u) | 0x71800000u) : x;
 }
 
+/* The largest float below X, for X within the domain (0 or of magnitude at
+   least 2^-64): a plane's t is 0 or at least 2^-87 in magnitude (|o| at
+   least 2^-32 or 0, |d| at most 2^32), so below 0 the largest negative
+   normal float, -2^-126, serves: no t lies between it and 0. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 voxdag_gpui_below(voxdag_gpu_f32 x) {
+    voxdag_gpu_u32 bits = VOXDAG_GPU_FLOAT_BITS(x);
+    return x > 0.0f ? VOXDAG_GPU_BITS_FLOAT(bits - 1u) : x < 0.0f ? VOXDAG_GPU_BITS_FLOAT(bits + 1u) : VOXDAG_GPU_BITS_FLOAT(0x80800000u);
+}
+
 VOXDAG_GPU_FUNC voxdag_gpu_bool voxdag_gpui_is_nan(voxdag_gpu_f32 x) {
     return (VOXDAG_GPU_FLOAT_BITS(x) & 0x7FFFFFFFu) > 0x7F800000u;
 }
@@ -773,10 +786,18 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpui_trace(voxdag_gpu_buf buf, voxdag_gpu_
     mask.lo = 0u, mask.hi = 0u;
     if (nl == 0u || (f.voxels_lo | f.voxels_hi) == 0u) return h;
     if (voxdag_gpui_is_nan(ray.t_min) || voxdag_gpui_is_nan(ray.t_max) || voxdag_gpui_is_nan(ray.lod)) return h;
-    /* the domain: t limits within 2^100 (t_max 0: none), lod 0 or within [2^-20, 2^20] */
+    /* the domain: t limits within 2^100, t_min (and an exclusive t_max)
+       below 2^-64 zero, t_max 0 none unless exclusive, lod 0 or within
+       [2^-20, 2^20] */
     t_min = voxdag_gpui_flush(voxdag_gpui_clamp_t(ray.t_min), 0x1F800000u);
-    t_max = (VOXDAG_GPU_FLOAT_BITS(ray.t_max) & 0x7FFFFFFFu) == 0u ? VOXDAG_GPUI_LIMIT : voxdag_gpui_clamp_t(ray.t_max);
-    lod = any_hit || !(ray.lod > 0.0f) ? 0.0f : voxdag_gpui_flush(ray.lod < 1048576.0f ? ray.lod : 1048576.0f, 0x35800000u);
+    if ((ray.flags & VOXDAG_GPU_T_MAX_EXCLUSIVE) != 0u) { /* t < t_max: t <= the float below it */
+        t_max = voxdag_gpui_flush(voxdag_gpui_clamp_t(ray.t_max), 0x1F800000u);
+        if (!(t_min < t_max)) return h;
+        t_max = voxdag_gpui_below(t_max);
+    } else {
+        t_max = (VOXDAG_GPU_FLOAT_BITS(ray.t_max) & 0x7FFFFFFFu) == 0u ? VOXDAG_GPUI_LIMIT : voxdag_gpui_clamp_t(ray.t_max);
+    }
+    lod = !(ray.lod > 0.0f) ? 0.0f : voxdag_gpui_flush(ray.lod < 1048576.0f ? ray.lod : 1048576.0f, 0x35800000u);
     /* the voxel box without level of detail (a hit is a voxel, inside it),
        else the grid (a coarse cell may reach outside the box) */
     hi = VOXDAG_GPU_F32(1u << nl);
@@ -887,7 +908,8 @@ VOXDAG_GPU_FUNC voxdag_gpu_hit voxdag_gpu_raycast(voxdag_gpu_buf buf, voxdag_gpu
     return voxdag_gpui_trace(buf, f, ray, VOXDAG_GPUI_FALSE);
 }
 
-/* Whether any full voxel lies along RAY (level of detail ignored): 1 or 0. */
+/* Whether any full voxel (or level-of-detail cell, with ray.lod) lies along
+   RAY, as voxdag_occluded_opts: 1 or 0. */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_occluded(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_ray ray) {
     return voxdag_gpui_trace(buf, f, ray, VOXDAG_GPUI_TRUE).hit;
 }

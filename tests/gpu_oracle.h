@@ -21,13 +21,15 @@ static inline voxdag_gpu_ray gpu_ray(const voxdag_ray *ray, double lod, int want
     return g;
 }
 
-/* Whether the exact answer to RAY is G's (voxel, level, normal, index). */
-static inline int same_answer(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g) {
+/* Whether the exact answer to RAY is G's (voxel, level, normal, index);
+   EXCLUSIVE: with t_max_exclusive. */
+static inline int same_answer_opts(const voxdag *d, const voxdag_ray *ray, double lod, int exclusive,
+                                   const voxdag_gpu_hit *g) {
     voxdag_ray_opts o;
     voxdag_hit h;
     int r;
     memset(&o, 0, sizeof o);
-    o.want_index = 1, o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0;
+    o.want_index = 1, o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0, o.t_max_exclusive = exclusive;
     r = voxdag_raycast(d, ray, &o, &h);
     if (r != (int)g->hit) return 0;
     return !r || (h.xyz[0] == g->x && h.xyz[1] == g->y && h.xyz[2] == g->z && h.level == g->level &&
@@ -35,9 +37,14 @@ static inline int same_answer(const voxdag *d, const voxdag_ray *ray, double lod
                   h.index == ((uint64_t)g->index_hi << 32 | g->index_lo));
 }
 
+static inline int same_answer(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g) {
+    return same_answer_opts(d, ray, lod, 0, g);
+}
+
 /* A near-tie: the exact answer of RAY moved by EPS grid units along an axis,
    or with a limit moved by EPS, is G's. */
-static inline int near_tie(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g, double eps) {
+static inline int near_tie_opts(const voxdag *d, const voxdag_ray *ray, double lod, int exclusive,
+                                const voxdag_gpu_hit *g, double eps) {
     double m = fmax(fabs(ray->dir[0]), fmax(fabs(ray->dir[1]), fabs(ray->dir[2])));
     int a, s;
     for (a = 0; a < 5; a++)
@@ -46,9 +53,13 @@ static inline int near_tie(const voxdag *d, const voxdag_ray *ray, double lod, c
             if (a < 3) p.origin[a] += s * eps;
             else if (a == 3) p.t_min += s * eps / m;
             else if (p.t_max != HUGE_VAL) p.t_max += s * eps / m;
-            if (same_answer(d, &p, lod, g)) return 1;
+            if (same_answer_opts(d, &p, lod, exclusive, g)) return 1;
         }
     return 0;
+}
+
+static inline int near_tie(const voxdag *d, const voxdag_ray *ray, double lod, const voxdag_gpu_hit *g, double eps) {
+    return near_tie_opts(d, ray, lod, 0, g, eps);
 }
 
 /* A ray from make_ray with every component rounded to float (the GPU's input). */

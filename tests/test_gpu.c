@@ -110,10 +110,34 @@ static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, co
                   ray->dir[1], ray->dir[2], ray->t_min, ray->t_max, lod, g.hit, g.x, g.y, g.z, g.level, g.nx, g.ny,
                   g.nz);
     }
-    if (lod == 0) {
-        unsigned occ = voxdag_gpu_occluded(buf, f, gpu_ray(ray, 0, 0));
+    { /* any hit, with the same level of detail */
+        voxdag_ray_opts o;
+        unsigned occ = voxdag_gpu_occluded(buf, f, gpu_ray(ray, lod, 0));
+        memset(&o, 0, sizeof o);
+        o.lod_factor = lod, o.lod_pixels = lod > 0 ? 1 : 0;
         CHECK(occ == g.hit);
-        if (occ != (unsigned)voxdag_occluded(d, ray)) CHECK(near_tie(d, ray, 0, &g, eps));
+        if (occ != (unsigned)voxdag_occluded_opts(d, ray, &o)) CHECK(near_tie(d, ray, lod, &g, eps));
+        if (lod == 0) CHECK(occ == (unsigned)voxdag_occluded(d, ray) || near_tie(d, ray, 0, &g, eps));
+    }
+    if (g.hit) { /* t_max_exclusive: a range ending where the hit cell begins meets nothing; just past, the
+                    hit (exactly so on the GPU; the exact tracer's t differs by rounding: near-ties by
+                    construction, not counted) */
+        voxdag_gpu_ray x = gpu_ray(ray, lod, 1);
+        voxdag_ray exact = *ray;
+        voxdag_gpu_hit e;
+        x.flags |= VOXDAG_GPU_T_MAX_EXCLUSIVE;
+        x.t_max = g.t;
+        e = voxdag_gpu_raycast(buf, f, x);
+        CHECK(e.hit == 0 && voxdag_gpu_occluded(buf, f, x) == 0);
+        exact.t_max = g.t;
+        if (!same_answer_opts(d, &exact, lod, 1, &e)) CHECK(near_tie_opts(d, &exact, lod, 1, &e, eps));
+        x.t_max = nextafterf(g.t, 1e30f);
+        if (x.t_max >= (float)ldexp(1, -64)) { /* (below, t_max is 0: an empty range) */
+            e = voxdag_gpu_raycast(buf, f, x);
+            CHECK(e.hit && e.t == g.t && e.x == g.x && e.y == g.y && e.z == g.z && e.level == g.level);
+            exact.t_max = x.t_max;
+            if (!same_answer_opts(d, &exact, lod, 1, &e)) CHECK(near_tie_opts(d, &exact, lod, 1, &e, eps));
+        }
     }
 }
 
