@@ -6441,11 +6441,17 @@ VOXDAG_API int voxdag_ray_from_hit(const voxdag *dag, const voxdag_ray *ray, con
                                    const double dir[3], voxdag_ray *out) {
     double o[3], d[3], size;
     int k, leaves = 0, on_face;
+#ifdef VOXDAGI_X87
+    unsigned cw;
+#endif
     if (!dag || !ray || !hit || !dir || !out || hit->level > dag->levels) return -1;
     size = (double)(1u << (dag->levels - hit->level));
     on_face = (hit->normal[0] | hit->normal[1] | hit->normal[2]) != 0;
+#ifdef VOXDAGI_X87
+    cw = voxdagi_x87_begin(); /* the same origin as on other processors */
+#endif
     for (k = 0; k < 3; k++) {
-        double lo = hit->xyz[k], hi = lo + size, v = ray->origin[k] + hit->t * ray->dir[k];
+        double lo = hit->xyz[k], hi = lo + size, v = ray->origin[k] + voxdagi_fmul(hit->t, ray->dir[k]);
         if (hit->normal[k]) { /* exactly on the entry face's plane */
             v = hit->normal[k] < 0 ? lo : hi;
             leaves = dir[k] * hit->normal[k] > 0;
@@ -6454,6 +6460,9 @@ VOXDAG_API int voxdag_ray_from_hit(const voxdag *dag, const voxdag_ray *ray, con
         }
         o[k] = v, d[k] = dir[k];
     }
+#ifdef VOXDAGI_X87
+    voxdagi_x87_end(cw);
+#endif
     memcpy(out->origin, o, sizeof o);
     memcpy(out->dir, d, sizeof d);
     out->t_min = 0, out->t_max = 0;
