@@ -423,10 +423,81 @@ static void test_lod_colors_corrupt(void) {
     rscene_free(&s);
 }
 
+/* A file written before the section (the coloured golden scene as it was):
+   it loads, and gains or loses the section as the only change. */
+static uint8_t *read_all(const char *name, size_t *size) {
+    char path[4096];
+    FILE *f;
+    long n;
+    uint8_t *p = NULL;
+    snprintf(path, sizeof path, "%s/%s", test_data_dir(), name);
+    f = fopen(path, "rb");
+    if (!f) return NULL;
+    if (fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0) {
+        p = (uint8_t *)malloc((size_t)n);
+        if (fread(p, 1, (size_t)n, f) != (size_t)n) free(p), p = NULL;
+        *size = (size_t)n;
+    }
+    fclose(f);
+    return p;
+}
+
+static void test_lod_colors_older_file(void) {
+    size_t old_size = 0, new_size = 0, a_size, b_size, pn;
+    uint8_t *old = read_all("lod/mirrored_blob_l5_before_lod.vdag", &old_size);
+    uint8_t *cur = read_all("golden/mirrored_blob_l5.vdag", &new_size);
+    voxdag *o = NULL, *c = NULL, *added = NULL, *dropped = NULL;
+    voxdag_build_opts opts;
+    voxdag_info info;
+    const void *pc, *a, *b;
+    CHECK(old && cur);
+    if (!old || !cur) goto done;
+    CHECK(voxdag_load_memory(old, old_size, NULL, &o, NULL) == VOXDAG_OK);
+    CHECK(voxdag_load_memory(cur, new_size, NULL, &c, NULL) == VOXDAG_OK);
+    if (!o || !c) goto done;
+    voxdag_get_info(o, &info);
+    CHECK(info.lod_color_bytes == 0 && info.color_kind == VOXDAG_COLORS_RGB8);
+    voxdag_get_info(c, &info);
+    CHECK(info.lod_color_bytes > 0);
+    CHECK(voxdag_colors(o, &pc, &pn) == VOXDAG_COLORS_RGB8);
+    CHECK(voxdag_with_colors(o, VOXDAG_COLORS_RGB8, pc, pn, &added, NULL) == VOXDAG_OK);
+    memset(&opts, 0, sizeof opts);
+    opts.no_lod_colors = 1;
+    CHECK(voxdag_with_colors_opts(c, VOXDAG_COLORS_RGB8, pc, pn, &opts, &dropped, NULL) == VOXDAG_OK);
+    a = voxdag_image(added, &a_size);
+    b = voxdag_image(dropped, &b_size);
+    CHECK(a_size == new_size && !memcmp(a, cur, new_size));
+    CHECK(b_size == old_size && !memcmp(b, old, old_size));
+    { /* the root (192 voxels) without the section: its first voxel's colour; with it: the mean */
+        voxdag_hit hit;
+        uint8_t first[3], got[3], mean[3];
+        uint64_t sum[3] = {0, 0, 0}, i;
+        unsigned k;
+        voxdag_get_info(o, &info);
+        for (i = 0; i < info.voxels; i++) {
+            CHECK(voxdag_color(o, i, got) == 1);
+            for (k = 0; k < 3; k++) sum[k] += got[k];
+        }
+        for (k = 0; k < 3; k++) mean[k] = (uint8_t)((sum[k] + info.voxels / 2) / info.voxels);
+        memset(&hit, 0, sizeof hit);
+        CHECK(voxdag_color(o, 0, first) == 1);
+        CHECK(voxdag_cell_color(o, &hit, got) == 1 && !memcmp(got, first, 3));
+        CHECK(voxdag_cell_color(c, &hit, got) == 1 && !memcmp(got, mean, 3));
+    }
+done:
+    voxdag_free(added);
+    voxdag_free(dropped);
+    voxdag_free(o);
+    voxdag_free(c);
+    free(old);
+    free(cur);
+}
+
 const test_case test_lod_colors_cases[] = {
     {"lod_colors_oracle", test_lod_colors_oracle},
     {"lod_colors_hits", test_lod_colors_hits},
     {"lod_colors_option", test_lod_colors_option},
     {"lod_colors_corrupt", test_lod_colors_corrupt},
+    {"lod_colors_older_file", test_lod_colors_older_file},
     {NULL, NULL},
 };
