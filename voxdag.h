@@ -69,7 +69,8 @@
      (voxdag_raycast, voxdag_occluded, voxdag_occluded_opts,
      voxdag_ray_from_hit): test `> 0`. voxdag_color: 1 when it wrote a
      colour, 0 when there is none (no colours, an index past the last
-     voxel, a NULL argument), -1 when the colours cannot be decoded.
+     voxel, a NULL argument), -1 when the colours cannot be decoded;
+     voxdag_cell_color (a hit's level-of-detail cell) the same way.
    - Lookups and counts (voxdag_lookup, voxdag_lookup_many,
      voxdag_for_each_voxel) treat a NULL DAG as an empty scene: 0. They
      keep that shape because -1 would read as "full" in the
