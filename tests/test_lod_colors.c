@@ -10,6 +10,7 @@
 #include "voxdag.h"
 #include "rscene.h"
 #include "golden.h"
+#include "count_alloc.h"
 
 #include <math.h>
 
@@ -493,11 +494,67 @@ done:
     free(cur);
 }
 
+/* Every allocation of voxdag_with_colors failing in turn, for both kinds:
+   VOXDAG_ERR_OUT_OF_MEMORY with nothing held, or the same file. */
+static void test_lod_colors_allocation_failures(void) {
+    rscene s;
+    voxdag *d = rscene_make(&s, RS_SPHERE, 5, 1, 0xA110C), *v = NULL;
+    int kind;
+    if (!d) return;
+    v = recolored(d, &s, VOXDAG_COLORS_VOXCOLOR, NULL);
+    for (kind = 0; kind < 2 && v; kind++) {
+        const voxdag *src = kind ? v : d;
+        const void *img, *pc, *want;
+        size_t size, pn, want_size;
+        count_alloc ca;
+        voxdag_load_opts lo;
+        voxdag *dag = NULL, *ref = NULL;
+        voxdag_color_kind ck;
+        long n;
+        int done = 0;
+        img = voxdag_image(src, &size);
+        memset(&lo, 0, sizeof lo);
+        lo.allocator = ca_start(&ca, -1);
+        CHECK(voxdag_load_memory(img, size, &lo, &dag, NULL) == VOXDAG_OK);
+        if (!dag) continue;
+        ck = voxdag_colors(dag, &pc, &pn);
+        CHECK(voxdag_with_colors(dag, ck, pc, pn, &ref, NULL) == VOXDAG_OK);
+        want = voxdag_image(ref, &want_size);
+        for (n = 0; !done && n < 1000; n++) {
+            uint64_t held = ca.held;
+            voxdag *out = NULL;
+            voxdag_status st;
+            ca.calls = 0, ca.fail_at = n;
+            st = voxdag_with_colors(dag, ck, pc, pn, &out, NULL);
+            CHECK_MSG(st == VOXDAG_OK || (st == VOXDAG_ERR_OUT_OF_MEMORY && !out), "kind %d, allocation %ld: %d",
+                      kind, n, (int)st);
+            if (st == VOXDAG_OK) {
+                size_t got_size;
+                const void *got = voxdag_image(out, &got_size);
+                CHECK(got_size == want_size && !memcmp(got, want, want_size));
+                done = ca.calls <= n;
+            }
+            voxdag_free(out);
+            CHECK_MSG(ca.held == held && !ca.bad_free, "kind %d, allocation %ld: %llu bytes left", kind, n,
+                      (unsigned long long)(ca.held - held));
+        }
+        CHECK(done);
+        ca.fail_at = -1;
+        voxdag_free(ref);
+        voxdag_free(dag);
+        CHECK(ca.held == 0 && !ca.bad_free);
+    }
+    voxdag_free(v);
+    voxdag_free(d);
+    rscene_free(&s);
+}
+
 const test_case test_lod_colors_cases[] = {
     {"lod_colors_oracle", test_lod_colors_oracle},
     {"lod_colors_hits", test_lod_colors_hits},
     {"lod_colors_option", test_lod_colors_option},
     {"lod_colors_corrupt", test_lod_colors_corrupt},
     {"lod_colors_older_file", test_lod_colors_older_file},
+    {"lod_colors_allocation_failures", test_lod_colors_allocation_failures},
     {NULL, NULL},
 };
