@@ -16,10 +16,12 @@
    Progress and diagnostics go to stderr; stdout carries only documented
    output. Exit status 0 on success, 1 with a one-line message otherwise. */
 #define _POSIX_C_SOURCE 200809L
-#define VOXDAG_IMPLEMENTATION
-#include "voxdag.h"
+/* voxcolor.h first: voxdag.h's implementation then decodes voxcolor colours
+   (voxdag_color, and the level-of-detail means voxdag_with_colors writes). */
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
+#define VOXDAG_IMPLEMENTATION
+#include "voxdag.h"
 
 #include <errno.h>
 #include <math.h>
@@ -1421,9 +1423,10 @@ static int cmd_info(int argc, char **argv) {
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.nodes[l]);
         printf("], \"bytes_per_level\": [");
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.level_bytes[l]);
-        printf("], \"bytes\": {\"file\": %llu, \"nodes\": %llu, \"bricks\": %llu, \"colors\": %llu}, ",
+        printf("], \"bytes\": {\"file\": %llu, \"nodes\": %llu, \"bricks\": %llu, \"lod_colors\": %llu, \"colors\": %llu}, ",
                (unsigned long long)in.file_bytes, (unsigned long long)in.node_bytes,
-               (unsigned long long)in.brick_bytes, (unsigned long long)in.color_bytes);
+               (unsigned long long)in.brick_bytes, (unsigned long long)in.lod_color_bytes,
+               (unsigned long long)in.color_bytes);
         printf("\"bits_per_voxel\": %.6f, \"color_format\": \"%s\", \"color_bits_per_voxel\": %.6f", geo_bits,
                color_kind_name(in.color_kind), in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
         if (in.has_bounds) /* the grid's world box */
@@ -1443,6 +1446,9 @@ static int cmd_info(int argc, char **argv) {
         printf("colours     %s, %llu bytes (%.3f bits/voxel)\n", color_kind_name(in.color_kind),
                (unsigned long long)in.color_bytes,
                in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
+        if (in.lod_color_bytes) /* the means of level-of-detail cells of more than 64 voxels */
+            printf("lod colours %llu bytes (%.1f %% of the colours)\n", (unsigned long long)in.lod_color_bytes,
+                   100.0 * (double)in.lod_color_bytes / (double)in.color_bytes);
         printf("file        %llu bytes\n", (unsigned long long)in.file_bytes);
         if (in.voxels)
             printf("occupied    voxels (%u, %u, %u) - (%u, %u, %u), grid units, half-open\n", in.voxel_box[0],
