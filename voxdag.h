@@ -711,6 +711,16 @@ typedef struct voxdag_hit {
    Thread-safe; no allocation. */
 VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]);
 
+/* The voxels of the level-LEVEL cell (a cube 2^(L-LEVEL) voxels a side on
+   that level's grid; LEVEL L is one voxel) that holds voxel (X, Y, Z):
+   returns their count, and sets *FIRST (when FIRST is not NULL) to the
+   index of the cell's first voxel in Morton order (its voxels are the
+   indices [*FIRST, *FIRST + count)). Returns 0 (FIRST untouched) for an
+   empty cell, a point outside the grid, LEVEL > L or a NULL DAG. A descent
+   like voxdag_lookup's; thread-safe; no allocation. */
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first);
+
 /* Finds the first full voxel (or level-of-detail cell) along RAY and fills
    *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched), -1 (HIT untouched)
    when DAG, RAY or HIT is NULL or OPTS is invalid (see voxdag_ray_opts), in
@@ -6817,6 +6827,23 @@ static void voxdagi_cell_range(const voxdag *d, uint32_t q, uint32_t x, uint32_t
         *a += (uint64_t)voxdagi_popcount64(mask & ((1ull << (8 * c)) - 1));
         *n = (uint64_t)voxdagi_popcount64(mask >> (8 * c) & 0xFF);
     }
+}
+
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first) {
+    uint64_t a, n;
+    uint32_t low;
+    if (!dag || level > dag->levels || (x | y | z) >> dag->levels) return 0;
+    if (level == dag->levels) {
+        if (!voxdag_lookup(dag, x, y, z, &a)) return 0;
+        n = 1;
+    } else {
+        low = (1u << (dag->levels - level)) - 1;
+        voxdagi_cell_range(dag, level, x & ~low, y & ~low, z & ~low, &a, &n);
+        if (!n) return 0;
+    }
+    if (first) *first = a;
+    return n;
 }
 
 VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]) {

@@ -86,6 +86,7 @@ int vdag_check_output(const char *in, const char *out) {
 
 int vdag_open(const char *path, vdag_file *f) {
     voxdag_error err;
+    voxdag_info info;
     const void *payload;
     size_t size;
     struct stat fs;
@@ -101,12 +102,12 @@ int vdag_open(const char *path, vdag_file *f) {
                               (unsigned long long)err.byte_offset);
         return !vdag_fail("%s: %s (%s)", path, voxdag_status_string(err.status), err.message);
     }
+    voxdag_get_info(f->dag, &info);
+    f->levels = info.levels;
     switch (voxdag_colors(f->dag, &payload, &size)) {
     case VOXDAG_COLORS_RGB8: f->has_colors = 1; break;
     case VOXDAG_COLORS_VOXCOLOR: {
-        voxdag_info info;
         voxcolor_status st = voxcolor_view_init(&f->colors, payload, size, NULL);
-        voxdag_get_info(f->dag, &info);
         if (st != VOXCOLOR_OK || f->colors.count != info.voxels) {
             vdag_close(f);
             return !vdag_fail("%s: corrupt colour section (%s)", path,
@@ -128,6 +129,11 @@ void vdag_close(vdag_file *f) {
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]) {
     if (f->colors.count) voxcolor_view_get(&f->colors, index, rgb);
     else if (!voxdag_color(f->dag, index, rgb)) rgb[0] = rgb[1] = rgb[2] = 255;
+}
+
+void vdag_hit_color(const vdag_file *f, const voxdag_hit *hit, uint8_t rgb[3]) {
+    if (hit->level == f->levels) vdag_voxel_color(f, hit->index, rgb);
+    else if (voxdag_cell_color(f->dag, hit, rgb) <= 0) rgb[0] = rgb[1] = rgb[2] = 255;
 }
 
 int vdag_voxel_box(const voxdag *dag, uint32_t box[6]) {
