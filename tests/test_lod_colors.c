@@ -18,7 +18,7 @@
 
 typedef struct cell_sums {
     uint32_t levels;
-    uint64_t *sum[VOXDAG_MAX_LEVELS + 1]; /* 4 per cell: R, G, B sums and the voxel count */
+    uint64_t *sum[VOXDAG_MAX_LEVELS + 1]; /* 5 per cell: R, G, B sums, the voxel count, the first index */
 } cell_sums;
 
 /* Sums the colours that D gives each full voxel of S into every level's cells. */
@@ -26,7 +26,11 @@ static void sums_make(cell_sums *c, const rscene *s, const voxdag *d) {
     uint32_t q, x, y, z, n = s->n;
     memset(c, 0, sizeof *c);
     c->levels = s->levels;
-    for (q = 0; q <= s->levels; q++) c->sum[q] = (uint64_t *)calloc(4 * ((size_t)1 << (3 * q)), sizeof(uint64_t));
+    for (q = 0; q <= s->levels; q++) {
+        size_t i, cells = (size_t)1 << (3 * q);
+        c->sum[q] = (uint64_t *)calloc(5 * cells, sizeof(uint64_t));
+        for (i = 0; c->sum[q] && i < cells; i++) c->sum[q][5 * i + 4] = UINT64_MAX;
+    }
     for (z = 0; z < n; z++)
         for (y = 0; y < n; y++)
             for (x = 0; x < n; x++) {
@@ -35,8 +39,10 @@ static void sums_make(cell_sums *c, const rscene *s, const voxdag *d) {
                 CHECK(voxdag_color(d, s->rank[rcell(n, x, y, z)], rgb) == 1);
                 for (q = 0; q <= s->levels; q++) {
                     uint32_t sh = s->levels - q;
-                    uint64_t *e = c->sum[q] + 4 * rcell(1u << q, x >> sh, y >> sh, z >> sh);
+                    uint64_t *e = c->sum[q] + 5 * rcell(1u << q, x >> sh, y >> sh, z >> sh);
+                    uint64_t rank = s->rank[rcell(n, x, y, z)];
                     e[0] += rgb[0], e[1] += rgb[1], e[2] += rgb[2], e[3]++;
+                    if (rank < e[4]) e[4] = rank;
                 }
             }
 }
@@ -56,7 +62,8 @@ typedef struct lod_stats {
     double worst;                       /* largest distance to the exact mean */
 } lod_stats;
 
-/* Checks voxdag_cell_color on every cell of every level of D against C.
+/* Checks voxdag_cell_color and voxdag_cell_count on every cell of every
+   level of D against C (the count at a point inside the cell).
    EXACT: every cell must be the rounded mean (raw colours); else cells of
    n > 64 need only be within 0.02. */
 static void check_cells(const voxdag *d, const cell_sums *c, int exact, lod_stats *st) {
@@ -66,7 +73,9 @@ static void check_cells(const voxdag *d, const cell_sums *c, int exact, lod_stat
         for (z = 0; z < side; z++)
             for (y = 0; y < side; y++)
                 for (x = 0; x < side; x++) {
-                    const uint64_t *e = c->sum[q] + 4 * rcell(side, x, y, z);
+                    const uint64_t *e = c->sum[q] + 5 * rcell(side, x, y, z);
+                    uint32_t inside = (x * 7 + y * 3 + z) & ((1u << sh) - 1);
+                    uint64_t first = 12345;
                     voxdag_hit hit;
                     uint8_t got[3] = {0, 0, 0}, want[3];
                     double mean[3];
@@ -76,6 +85,9 @@ static void check_cells(const voxdag *d, const cell_sums *c, int exact, lod_stat
                     hit.level = q;
                     hit.xyz[0] = x << sh, hit.xyz[1] = y << sh, hit.xyz[2] = z << sh;
                     r = voxdag_cell_color(d, &hit, got);
+                    CHECK_MSG(voxdag_cell_count(d, q, hit.xyz[0] + inside, hit.xyz[1], hit.xyz[2] + inside, &first) ==
+                                      e[3] && first == (e[3] ? e[4] : 12345),
+                              "voxdag_cell_count level %u (%u %u %u)", q, x, y, z);
                     if (!e[3]) {
                         CHECK_MSG(r == 0, "empty cell level %u (%u %u %u): %d", q, x, y, z, r);
                         continue;
@@ -204,7 +216,7 @@ static void test_lod_colors_hits(void) {
         o.lod_pixels = 1.0;
         if (voxdag_raycast(d, &ray, &o, &hit) > 0) {
             uint32_t sh = s.levels - hit.level;
-            const uint64_t *e = c.sum[hit.level] + 4 * rcell(1u << hit.level, hit.xyz[0] >> sh, hit.xyz[1] >> sh,
+            const uint64_t *e = c.sum[hit.level] + 5 * rcell(1u << hit.level, hit.xyz[0] >> sh, hit.xyz[1] >> sh,
                                                               hit.xyz[2] >> sh);
             uint8_t got[3], want[3];
             unsigned k;
@@ -252,7 +264,7 @@ static void test_lod_colors_option(void) {
                     memset(&hit, 0, sizeof hit);
                     hit.level = q;
                     hit.xyz[0] = x << sh, hit.xyz[1] = y << sh, hit.xyz[2] = z << sh;
-                    if (!c.sum[q][4 * rcell(side, x, y, z) + 3]) continue;
+                    if (!c.sum[q][5 * rcell(side, x, y, z) + 3]) continue;
                     /* the cell's first voxel in Morton order: the lowest rank in it */
                     for (fz = 0; fz < 1u << sh; fz++)
                         for (fy = 0; fy < 1u << sh; fy++)
@@ -281,6 +293,11 @@ static void test_lod_colors_option(void) {
         CHECK(voxdag_cell_color(d, &hit, rgb) == 0);
         hit.level = 1, hit.xyz[0] = s.n;
         CHECK(voxdag_cell_color(d, &hit, rgb) == 0);
+        /* counts need no colours; outside the grid, past level L or NULL: 0 */
+        CHECK(voxdag_cell_count(none, 0, 0, 0, 0, NULL) == voxdag_cell_count(d, 0, 0, 0, 0, NULL));
+        CHECK(voxdag_cell_count(d, 0, 0, 0, 0, NULL) == info.voxels || info.voxels == 0);
+        CHECK(voxdag_cell_count(d, 1, s.n, 0, 0, NULL) == 0 && voxdag_cell_count(d, 0, 0, UINT32_MAX, 0, NULL) == 0);
+        CHECK(voxdag_cell_count(d, s.levels + 1, 0, 0, 0, NULL) == 0 && voxdag_cell_count(NULL, 0, 0, 0, 0, NULL) == 0);
     }
     /* the builder with the option writes the file it wrote before the section */
     {
