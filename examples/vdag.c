@@ -2,8 +2,8 @@
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--raw-colors] [--color-bits W|auto]
-              [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
-              [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
+              [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-lod-colors]
+              [--no-alpha-test] [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
               [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
@@ -179,7 +179,9 @@ static const struct {
      "  --verify-colors    after compressing, decode every colour and compare it with the\n"
      "                     raw colour; fail when one is off by more than E (default: off)\n"
      "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
-     "                     alpha test, the voxels stay the same\n"},
+     "                     alpha test, the voxels stay the same\n"
+     "  --no-lod-colors    write no level-of-detail colour section (default: write it: the mean\n"
+     "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"},
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
@@ -313,6 +315,7 @@ typedef struct build_args {
     const char *color_option; /* the last colour-compression option given, for the clash with --raw-colors */
     int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
     int verify_colors;      /* --verify-colors */
+    int no_lod_colors;      /* --no-lod-colors */
     double color_error;
     uint32_t color_bits; /* 0: auto */
     voxcolor_effort color_effort;
@@ -914,9 +917,12 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     uint64_t size = 3 * spill->n;
     voxdag *with = NULL;
     voxdag_error err;
+    voxdag_build_opts o;
     double t0 = now_seconds();
     char text[32];
     int rc;
+    memset(&o, 0, sizeof o);
+    o.no_lod_colors = a->no_lod_colors;
     if (!a->quiet && spill->n)
         fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
                 spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
@@ -928,7 +934,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(rgb);
             return vdag_fail("cannot read back the colours");
         }
-        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &with, &err) != VOXDAG_OK;
+        rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &o, &with, &err) != VOXDAG_OK;
         free(rgb);
     } else {
         grow_buf g;
@@ -949,7 +955,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(g.data);
             return 1;
         }
-        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
+        rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &o, &with, &err) != VOXDAG_OK;
         free(g.data);
     }
     if (rc) return vdag_fail("%s", err.message);
@@ -1218,6 +1224,8 @@ static int cmd_build(int argc, char **argv) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
+        } else if (!strcmp(argv[k], "--no-lod-colors")) {
+            a.no_lod_colors = 1;
         } else if (!strcmp(argv[k], "--solid")) {
             a.solid = 1;
         } else if (!strcmp(argv[k], "--no-alpha-test")) {
@@ -1582,7 +1590,7 @@ static int usage(FILE *f) {
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--raw-colors] [--color-bits W|auto]\n"
           "                    [--color-effort smallest|fast] [--verify-colors] [--no-colors]\n"
-          "                    [--no-alpha-test] [--chunk-levels C]\n"
+          "                    [--no-lod-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
           "                    [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats]\n"
           "                    [--quiet]\n"
