@@ -5736,6 +5736,15 @@ static void voxdagi_dag_release(voxdagi_mem *m, voxdag *d) {
     voxdagi_free(m, d, sizeof *d);
 }
 
+/* The header's scene fields of D, for an image rewritten from it. */
+static void voxdagi_scene_of(const voxdag *d, voxdagi_scene *sc) {
+    sc->levels = d->levels;
+    sc->root_transform = d->root_transform;
+    sc->symmetry = d->symmetry;
+    sc->voxels = d->voxels;
+    memcpy(sc->voxel_box, d->voxel_box, sizeof sc->voxel_box);
+}
+
 /* Replaces *PD (an image D owns, allocated from M, opened) by a copy with
    its level-of-detail colour section, placed after the colour section (an
    old one is dropped), when its colours get one; *PD is kept otherwise.
@@ -5776,11 +5785,7 @@ static voxdag_status voxdagi_attach_lod(voxdag **pd, voxdagi_mem *m, voxdag_erro
     for (k = 0; k < lay.count; k++)
         if (lay.size[k]) memcpy(img + lay.offset[k], from[k], (size_t)lay.size[k]);
     voxdagi_free(m, sec, sec_size);
-    sc.levels = d->levels;
-    sc.root_transform = d->root_transform;
-    sc.symmetry = d->symmetry;
-    sc.voxels = d->voxels;
-    memcpy(sc.voxel_box, d->voxel_box, sizeof sc.voxel_box);
+    voxdagi_scene_of(d, &sc);
     voxdagi_layout_seal(img, &lay, &sc);
     n->owned = img;
     n->owned_size = (size_t)lay.total;
@@ -6108,11 +6113,7 @@ VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color
     if (src->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), src->bounds);
     {
         voxdagi_scene sc;
-        sc.levels = src->levels;
-        sc.root_transform = src->root_transform;
-        sc.symmetry = src->symmetry;
-        sc.voxels = src->voxels;
-        memcpy(sc.voxel_box, src->voxel_box, sizeof sc.voxel_box);
+        voxdagi_scene_of(src, &sc);
         voxdagi_layout_seal(img, &lay, &sc);
     }
     d->owned = img;
