@@ -69,7 +69,8 @@
      (voxdag_raycast, voxdag_occluded, voxdag_occluded_opts,
      voxdag_ray_from_hit): test `> 0`. voxdag_color: 1 when it wrote a
      colour, 0 when there is none (no colours, an index past the last
-     voxel, a NULL argument), -1 when the colours cannot be decoded.
+     voxel, a NULL argument), -1 when the colours cannot be decoded;
+     voxdag_cell_color (a hit's level-of-detail cell) the same way.
    - Lookups and counts (voxdag_lookup, voxdag_lookup_many,
      voxdag_for_each_voxel) treat a NULL DAG as an empty scene: 0. They
      keep that shape because -1 would read as "full" in the
@@ -278,6 +279,9 @@ typedef struct voxdag_build_opts {
     voxdag_thread_pool thread_pool; /* run and wait NULL: the built-in pool; both
                                     or neither. Ignored under VOXDAG_NO_THREADS,
                                     which builds on the calling thread only */
+    int no_lod_colors;           /* 1: write no level-of-detail colour section
+                                    (see voxdag_cell_color); 0: a file with
+                                    colours gets one */
     uint32_t zero_end;           /* must be 0 */
 } voxdag_build_opts;
 
@@ -542,10 +546,23 @@ VOXDAG_API voxdag_color_kind voxdag_colors(const voxdag *dag, const void **paylo
 
 /* Makes a copy of SRC whose colour section is replaced by PAYLOAD of KIND
    (VOXDAG_COLORS_NONE removes it). An RGB8 payload must hold 3 bytes per voxel;
-   a voxcolor payload is stored as given. */
+   a voxcolor payload is stored as given. The copy also gets a new
+   level-of-detail colour section (FORMAT.md, LOD_COLORS; see
+   voxdag_cell_color) computed from the new colours, except when there are
+   none, at most 64 voxels, L = 2, or a voxcolor payload that this
+   implementation cannot decode (compiled without voxcolor.h). */
 VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind kind,
                                             const void *payload, size_t size,
                                             voxdag **out, voxdag_error *err);
+
+/* voxdag_with_colors with options: OPTS (NULL: defaults) is read for
+   zero_begin / zero_end (nonzero: VOXDAG_ERR_INVALID_ARGUMENT) and
+   no_lod_colors (1: no level-of-detail colour section); its other fields
+   are ignored. */
+VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color_kind kind,
+                                                 const void *payload, size_t size,
+                                                 const voxdag_build_opts *opts, voxdag **out,
+                                                 voxdag_error *err);
 
 // -- Queries (thread-safe on a shared voxdag; no allocation)
 
@@ -568,6 +585,7 @@ typedef struct voxdag_info {
                                    section this implementation cannot decode */
     int has_bounds;
     double bounds[6];           /* world-space min xyz, max xyz */
+    uint64_t lod_color_bytes;   /* the level-of-detail colour section (0: none) */
 } voxdag_info;
 
 /* Fills *INFO; all zero when DAG is NULL (nothing happens when INFO is NULL). */
@@ -615,6 +633,7 @@ VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, s
    voxdag_info.colors_decodable once after loading to catch that case (the
    DAG is never changed). Thread-safe. */
 VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]);
+
 
 /* Calls FN (may be NULL: counts) for every full voxel in voxel-index order;
    stops early when FN returns nonzero. Returns the number of voxels visited
@@ -671,6 +690,36 @@ typedef struct voxdag_hit {
     uint64_t index;   /* voxel index (a cell's first voxel, in Morton order), when
                          opts->want_index */
 } voxdag_hit;
+
+/* Colour (RGB8) of the cell that HIT (as voxdag_raycast filled it) stopped at:
+   the voxel's own colour when hit->level is L, else the mean colour of the
+   full voxels of the level-of-detail cell at hit->level that holds voxel
+   hit->xyz (a node, a brick or a 2^3 cell of a brick). Those voxels are
+   the colour range [a, a + n) (a: the cell's first voxel index, n: its
+   voxel count), and the cell is found from hit->xyz and hit->level by a
+   descent like voxdag_lookup's, so hit->index is not needed (ray
+   opts.want_index may be 0). Cells of at most 64 voxels (every 2^3 cell
+   and brick) are averaged from the colour section, exactly (the mean
+   rounded to RGB8). Larger cells read one value of the level-of-detail
+   colour section (FORMAT.md, LOD_COLORS): within 0.02 of the exact mean
+   (Euclidean RGB distance / 255; the voxcolor colours' mean for a voxcolor
+   file); files without that section (written before it, or built with
+   no_lod_colors) give such cells the colour of their first voxel, a.
+   Returns 1; 0 (RGB untouched) when the DAG has no colours, the cell is
+   empty or outside the grid, hit->level > L, or an argument is NULL; -1 (and
+   magenta) when the colours cannot be decoded, as voxdag_color.
+   Thread-safe; no allocation. */
+VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]);
+
+/* The voxels of the level-LEVEL cell (a cube 2^(L-LEVEL) voxels a side on
+   that level's grid; LEVEL L is one voxel) that holds voxel (X, Y, Z):
+   returns their count, and sets *FIRST (when FIRST is not NULL) to the
+   index of the cell's first voxel in Morton order (its voxels are the
+   indices [*FIRST, *FIRST + count)). Returns 0 (FIRST untouched) for an
+   empty cell, a point outside the grid, LEVEL > L or a NULL DAG. A descent
+   like voxdag_lookup's; thread-safe; no allocation. */
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first);
 
 /* Finds the first full voxel (or level-of-detail cell) along RAY and fills
    *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched), -1 (HIT untouched)
@@ -753,8 +802,19 @@ enum {
     VOXDAG_SECTION_BRICKS = 3,
     VOXDAG_SECTION_COLORS_RGB8 = 4,
     VOXDAG_SECTION_COLORS_VOXCOLOR = 5,
-    VOXDAG_SECTION_BOUNDS = 6
+    VOXDAG_SECTION_BOUNDS = 6,
+    VOXDAG_SECTION_LOD_COLORS = 7
 };
+
+/* The level-of-detail colour section (FORMAT.md, LOD_COLORS). */
+#define VOXDAG_FILE_LOD_HEADER_SIZE 16
+#define VOXDAG_FILE_LOD_OFF_KIND 0
+#define VOXDAG_FILE_LOD_OFF_SLOT_SHIFT 1
+#define VOXDAG_FILE_LOD_OFF_FIRST_LEVEL 2
+#define VOXDAG_FILE_LOD_OFF_LEVEL_COUNT 3
+#define VOXDAG_FILE_LOD_OFF_RESERVED 4
+#define VOXDAG_FILE_LOD_OFF_SLOTS 8
+#define VOXDAG_FILE_LOD_SLOT_SHIFT 6 /* a slot every 64 voxels */
 
 #ifdef __cplusplus
 }
@@ -4579,8 +4639,14 @@ struct voxdag {
     uint64_t color_size;
     int has_bounds;
     double bounds[6];
+    const uint8_t *lod;           /* the level-of-detail colour section, or NULL */
+    uint64_t lod_size;
+    const uint8_t *lod_slots;     /* its slots: RGB8 (3 bytes each) or a voxcolor stream */
+    uint32_t lod_first, lod_levels; /* levels lod_first .. lod_first + lod_levels - 1 */
+    uint64_t lod_per_level;       /* slots per level: ceil(voxels / 64) */
 #ifdef VOXDAGI_VOXCOLOR
     voxcolor_view color_view; /* the voxcolor colour section, validated */
+    voxcolor_view lod_view;   /* the level-of-detail slots when they are voxcolor */
 #endif
 };
 
@@ -4759,6 +4825,56 @@ static voxdag_status voxdagi_open_colors(voxdag *d, voxdag_error *err) {
                             at + VOXCOLOR_OFF_COUNT, UINT64_MAX);
 #else
     (void)d, (void)err;
+#endif
+    return VOXDAG_OK;
+}
+
+/* Validates the level-of-detail colour section (FORMAT.md, LOD_COLORS)
+   against the header and the colour section, and keeps its slots. */
+static voxdag_status voxdagi_open_lod(voxdag *d, voxdag_error *err) {
+    const uint8_t *p = d->lod;
+    uint64_t at, total, need;
+    unsigned kind;
+    if (!p) return VOXDAG_OK;
+    at = (uint64_t)(p - d->image);
+    if (d->lod_size < VOXDAG_FILE_LOD_HEADER_SIZE)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail colour section shorter than its header", at,
+                            UINT64_MAX);
+    kind = p[VOXDAG_FILE_LOD_OFF_KIND];
+    d->lod_first = p[VOXDAG_FILE_LOD_OFF_FIRST_LEVEL];
+    d->lod_levels = p[VOXDAG_FILE_LOD_OFF_LEVEL_COUNT];
+    d->lod_per_level = voxdagi_le(p + VOXDAG_FILE_LOD_OFF_SLOTS, 8);
+    if (d->color_kind == VOXDAG_COLORS_NONE || kind != (unsigned)d->color_kind)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail colour kind differs from the colour section's",
+                            at + VOXDAG_FILE_LOD_OFF_KIND, UINT64_MAX);
+    if (p[VOXDAG_FILE_LOD_OFF_SLOT_SHIFT] != VOXDAG_FILE_LOD_SLOT_SHIFT || voxdagi_le(p + VOXDAG_FILE_LOD_OFF_RESERVED, 4))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail colour slot shift or reserved field",
+                            at + VOXDAG_FILE_LOD_OFF_SLOT_SHIFT, UINT64_MAX);
+    if (!d->lod_levels || d->lod_first + d->lod_levels + 2 > d->levels)
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail colour levels outside 0..L-3",
+                            at + VOXDAG_FILE_LOD_OFF_FIRST_LEVEL, UINT64_MAX);
+    if (d->lod_per_level != (d->voxels >> VOXDAG_FILE_LOD_SLOT_SHIFT) + ((d->voxels & 63) != 0))
+        return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail slots per level differ from ceil(voxels / 64)",
+                            at + VOXDAG_FILE_LOD_OFF_SLOTS, UINT64_MAX);
+    total = d->lod_per_level * d->lod_levels; /* < 2^57 * 19: no overflow */
+    d->lod_slots = p + VOXDAG_FILE_LOD_HEADER_SIZE;
+    need = d->lod_size - VOXDAG_FILE_LOD_HEADER_SIZE;
+    if (kind == VOXDAG_COLORS_RGB8) {
+        if (need != 3 * total)
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "level-of-detail colour section size", at, UINT64_MAX);
+        return VOXDAG_OK;
+    }
+#ifdef VOXDAGI_VOXCOLOR
+    {
+        voxcolor_error ve;
+        uint64_t s = at + VOXDAG_FILE_LOD_HEADER_SIZE;
+        if (voxcolor_view_init(&d->lod_view, d->lod_slots, (size_t)need, &ve) != VOXCOLOR_OK)
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxcolor level-of-detail colours do not validate",
+                                ve.byte_offset == UINT64_MAX ? s : s + ve.byte_offset, UINT64_MAX);
+        if (d->lod_view.count != total)
+            return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "voxcolor level-of-detail colour count differs from the slots",
+                                s + VOXCOLOR_OFF_COUNT, UINT64_MAX);
+    }
 #endif
     return VOXDAG_OK;
 }
@@ -5310,7 +5426,7 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
         if ((flags & ~VOXDAG_FILE_SECTION_OPTIONAL) || voxdagi_le(e + 28, 4) || (off & 7) || off < end ||
             off > size || sz > size - off || !voxdagi_all_zero(img + end, off - end))
             return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "bad section entry", at, UINT64_MAX);
-        if (type >= 1 && type <= VOXDAG_SECTION_BOUNDS) {
+        if (type >= 1 && type <= VOXDAG_SECTION_LOD_COLORS) {
             if (seen >> type & 1)
                 return voxdagi_fail(err, VOXDAG_ERR_CORRUPT, "duplicate section", at, UINT64_MAX);
             seen |= 1u << type;
@@ -5355,6 +5471,10 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
             d->has_bounds = 1;
             break;
         }
+        case VOXDAG_SECTION_LOD_COLORS:
+            d->lod = p;
+            d->lod_size = sz;
+            break;
         default: break;
         }
     }
@@ -5386,6 +5506,7 @@ static voxdag_status voxdagi_open(voxdag *d, const uint8_t *img, size_t size, in
     if (max_nodes && (node_sum > max_nodes || d->brick_count > max_nodes - node_sum))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "more nodes than max_nodes");
     if (voxdagi_open_colors(d, err) != VOXDAG_OK) return VOXDAG_ERR_CORRUPT;
+    if (voxdagi_open_lod(d, err) != VOXDAG_OK) return VOXDAG_ERR_CORRUPT;
     if (!deep) return VOXDAG_OK;
     st = voxdagi_validate_nodes(d, m, err);
     return st == VOXDAG_OK ? voxdagi_validate_box(d, m, err) : st;
@@ -5450,6 +5571,232 @@ VOXDAG_API voxdag_status voxdag_load_memory(const void *data, size_t size,
     }
     *out = d;
     return voxdagi_ok(err);
+}
+
+// -- Level-of-detail colours (FORMAT.md, LOD_COLORS): averaging and the slots
+
+/* Adds the colours of voxels [A, A + N) to SUM (decodable colours, A + N <=
+   the voxel count), 64 at a time. */
+static void voxdagi_sum_colors(const voxdag *d, uint64_t a, uint64_t n, uint64_t sum[3]) {
+    uint8_t buf[3 * 64];
+    while (n) {
+        size_t k = n < 64 ? (size_t)n : 64, i;
+        const uint8_t *c = buf;
+        if (d->color_kind == VOXDAG_COLORS_RGB8) c = d->color + 3 * a;
+#ifdef VOXDAGI_VOXCOLOR
+        else voxcolor_view_get_range(&d->color_view, a, k, buf);
+#endif
+        for (i = 0; i < 3 * k; i += 3) sum[0] += c[i], sum[1] += c[i + 1], sum[2] += c[i + 2];
+        a += k, n -= k;
+    }
+}
+
+/* SUM / N per channel, rounded to the nearest (N > 0). */
+static void voxdagi_mean_rgb(const uint64_t sum[3], uint64_t n, uint8_t rgb[3]) {
+    unsigned k;
+    for (k = 0; k < 3; k++) rgb[k] = (uint8_t)((sum[k] + n / 2) / n);
+}
+
+/* Whether voxdagi_sum_colors can read D's colours. */
+static int voxdagi_colors_readable(const voxdag *d) {
+#ifdef VOXDAGI_VOXCOLOR
+    return d->color_kind != VOXDAG_COLORS_NONE;
+#else
+    return d->color_kind == VOXDAG_COLORS_RGB8;
+#endif
+}
+
+/* The level-of-detail slots of D (FORMAT.md, LOD_COLORS) for levels 0..L-3,
+   to SLOTS (3 bytes each, level by level, PER_LEVEL a level): slot j of level
+   q is the mean colour of the level-q cell holding voxel 64 j. One walk in
+   voxel order down to level L-3, whose cells sum their colour ranges; each
+   finished cell adds its sums to its parent's. */
+static void voxdagi_lod_means(const voxdag *d, uint8_t *slots, uint64_t per_level) {
+    struct frame {
+        uint64_t at, a, end, sum[3]; /* END: the first voxel after the children done */
+        unsigned mi, next;
+    } stack[VOXDAG_MAX_LEVELS];
+    uint32_t leaf = d->levels - 3;
+    int depth = 0;
+    memset(stack, 0, sizeof stack);
+    stack[0].mi = voxdagi_cube_tables.inv[d->root_transform];
+    while (depth >= 0) {
+        struct frame *f = &stack[depth];
+        uint64_t j, first, last;
+        uint8_t rgb[3];
+        if ((uint32_t)depth == leaf) {
+            uint64_t n = voxdagi_node_count(d, leaf, f->at);
+            voxdagi_sum_colors(d, f->a, n, f->sum);
+            f->end = f->a + n;
+        } else {
+            const uint8_t *rec = d->level[depth].data + f->at;
+            unsigned header = voxdagi_le16(rec);
+            unsigned occ = voxdagi_occupancy[f->mi][voxdagi_presence(header)];
+            while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
+            if (f->next < 8) {
+                unsigned w = f->next++;
+                uint64_t ref = voxdagi_child_ref(d, (uint32_t)depth, rec, header, voxdagi_cube_tables.act[f->mi][w], 1);
+                struct frame *c = &stack[depth + 1];
+                memset(c, 0, sizeof *c);
+                c->at = ref >> 6;
+                c->mi = voxdagi_cube_tables.comp[ref & 63][f->mi];
+                c->a = c->end = f->end;
+                depth++;
+                continue;
+            }
+        }
+        /* the cell [a, end) of level DEPTH is done: its slots, then its parent */
+        voxdagi_mean_rgb(f->sum, f->end - f->a, rgb);
+        first = (f->a + 63) >> 6, last = (f->end + 63) >> 6;
+        for (j = first; j < last; j++) memcpy(slots + 3 * ((uint64_t)depth * per_level + j), rgb, 3);
+        if (depth > 0) {
+            struct frame *pa = &stack[depth - 1];
+            pa->sum[0] += f->sum[0], pa->sum[1] += f->sum[1], pa->sum[2] += f->sum[2];
+            pa->end = f->end;
+        }
+        depth--;
+    }
+}
+
+/* The level-of-detail colour section for D's colours (levels 0..L-3), in
+   *OUT (allocated from M, *OUT_SIZE bytes), or *OUT = NULL when D gets none
+   (no readable colours, L = 2 or at most 64 voxels). Returns 0 when out of
+   memory or the voxcolor encoder fails. */
+static int voxdagi_lod_section(const voxdag *d, voxdagi_mem *m, uint8_t **out, size_t *out_size) {
+    uint64_t per_level, total;
+    size_t cap;
+    uint8_t *slots, *sec;
+    *out = NULL, *out_size = 0;
+    if (!voxdagi_colors_readable(d) || d->levels < 3 || d->voxels <= 64) return 1;
+    per_level = (d->voxels + 63) >> 6;
+    total = per_level * (d->levels - 2);
+    if (total > ((size_t)-1 - VOXDAG_FILE_LOD_HEADER_SIZE) / 4) return 0;
+    slots = (uint8_t *)voxdagi_alloc(m, (size_t)(3 * total));
+    if (!slots) return 0;
+    voxdagi_lod_means(d, slots, per_level);
+    cap = VOXDAG_FILE_LOD_HEADER_SIZE + (size_t)(3 * total);
+#ifdef VOXDAGI_VOXCOLOR
+    if (d->color_kind == VOXDAG_COLORS_VOXCOLOR) {
+        size_t bound = voxcolor_encode_bound((size_t)total);
+        if (!bound || bound > (size_t)-1 - VOXDAG_FILE_LOD_HEADER_SIZE) cap = 0;
+        else cap = VOXDAG_FILE_LOD_HEADER_SIZE + bound;
+    }
+#endif
+    sec = cap ? (uint8_t *)voxdagi_alloc(m, cap) : NULL;
+    if (!sec) {
+        voxdagi_free(m, slots, (size_t)(3 * total));
+        return 0;
+    }
+    memset(sec, 0, VOXDAG_FILE_LOD_HEADER_SIZE);
+    sec[VOXDAG_FILE_LOD_OFF_KIND] = (uint8_t)d->color_kind;
+    sec[VOXDAG_FILE_LOD_OFF_SLOT_SHIFT] = VOXDAG_FILE_LOD_SLOT_SHIFT;
+    sec[VOXDAG_FILE_LOD_OFF_FIRST_LEVEL] = 0;
+    sec[VOXDAG_FILE_LOD_OFF_LEVEL_COUNT] = (uint8_t)(d->levels - 2);
+    voxdagi_put_le(sec + VOXDAG_FILE_LOD_OFF_SLOTS, per_level, 8);
+    *out_size = cap;
+    if (d->color_kind == VOXDAG_COLORS_RGB8) memcpy(sec + VOXDAG_FILE_LOD_HEADER_SIZE, slots, (size_t)(3 * total));
+#ifdef VOXDAGI_VOXCOLOR
+    else {
+        /* 0.016 + the RGB8 rounding of the means (sqrt(3) * 0.5 / 255) < 0.02 */
+        voxcolor_encode_opts vo;
+        size_t len;
+        memset(&vo, 0, sizeof vo);
+        vo.max_error = 0.016;
+        len = voxcolor_encode(sec + VOXDAG_FILE_LOD_HEADER_SIZE, cap - VOXDAG_FILE_LOD_HEADER_SIZE, slots,
+                              (size_t)total, &vo, NULL);
+        *out_size = VOXDAG_FILE_LOD_HEADER_SIZE + len;
+        if (!len) {
+            voxdagi_free(m, sec, cap);
+            sec = NULL;
+        }
+    }
+#endif
+    voxdagi_free(m, slots, (size_t)(3 * total));
+    if (!sec) return 0;
+    /* the section keeps only what it uses; the rest of the encoder's bound goes back */
+    if (*out_size < cap) {
+        uint8_t *fit = (uint8_t *)voxdagi_alloc(m, *out_size);
+        if (fit) {
+            memcpy(fit, sec, *out_size);
+            voxdagi_free(m, sec, cap);
+            sec = fit;
+        } else {
+            voxdagi_free(m, sec, cap);
+            return 0;
+        }
+    }
+    *out = sec;
+    return 1;
+}
+
+/* Frees D's parts through M (which allocated them). */
+static void voxdagi_dag_release(voxdagi_mem *m, voxdag *d) {
+    voxdagi_free(m, d->owned, d->owned_size);
+    voxdagi_free(m, d->level, d->level_count * sizeof *d->level);
+    voxdagi_free(m, d, sizeof *d);
+}
+
+/* The header's scene fields of D, for an image rewritten from it. */
+static void voxdagi_scene_of(const voxdag *d, voxdagi_scene *sc) {
+    sc->levels = d->levels;
+    sc->root_transform = d->root_transform;
+    sc->symmetry = d->symmetry;
+    sc->voxels = d->voxels;
+    memcpy(sc->voxel_box, d->voxel_box, sizeof sc->voxel_box);
+}
+
+/* Replaces *PD (an image D owns, allocated from M, opened) by a copy with
+   its level-of-detail colour section, placed after the colour section (an
+   old one is dropped), when its colours get one; *PD is kept otherwise.
+   Returns VOXDAG_OK or VOXDAG_ERR_OUT_OF_MEMORY (*PD is then unchanged). */
+static voxdag_status voxdagi_attach_lod(voxdag **pd, voxdagi_mem *m, voxdag_error *err) {
+    voxdag *d = *pd, *n = NULL;
+    voxdagi_layout lay;
+    const uint8_t *from[VOXDAG_FILE_MAX_SECTIONS];
+    uint8_t *sec, *img;
+    size_t sec_size;
+    uint32_t count, k;
+    voxdagi_scene sc;
+    voxdag_status st;
+    if (!voxdagi_lod_section(d, m, &sec, &sec_size))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot make the level-of-detail colours");
+    if (!sec) return VOXDAG_OK;
+    memset(&lay, 0, sizeof lay);
+    count = (uint32_t)voxdagi_le(d->image + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
+    for (k = 0; k < count && lay.count + 1 < VOXDAG_FILE_MAX_SECTIONS; k++) {
+        const uint8_t *e = d->image + VOXDAG_FILE_HEADER_SIZE + k * VOXDAG_FILE_SECTION_ENTRY_SIZE;
+        uint32_t type = (uint32_t)voxdagi_le(e, 4);
+        if (type == VOXDAG_SECTION_LOD_COLORS) continue;
+        from[lay.count] = d->image + voxdagi_le(e + 8, 8);
+        voxdagi_layout_add(&lay, type, (uint32_t)voxdagi_le(e + 4, 4), voxdagi_le(e + 16, 8));
+        if (type == VOXDAG_SECTION_COLORS_RGB8 || type == VOXDAG_SECTION_COLORS_VOXCOLOR) {
+            from[lay.count] = sec;
+            voxdagi_layout_add(&lay, VOXDAG_SECTION_LOD_COLORS, VOXDAG_FILE_SECTION_OPTIONAL, sec_size);
+        }
+    }
+    st = voxdagi_new_dag(m, &n);
+    img = st != VOXDAG_OK || !voxdagi_layout_place(&lay) ? NULL : (uint8_t *)voxdagi_alloc(m, (size_t)lay.total);
+    if (!img) {
+        if (n) voxdagi_free(m, n, sizeof *n);
+        voxdagi_free(m, sec, sec_size);
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot allocate the file image");
+    }
+    memset(img, 0, (size_t)lay.total);
+    for (k = 0; k < lay.count; k++)
+        if (lay.size[k]) memcpy(img + lay.offset[k], from[k], (size_t)lay.size[k]);
+    voxdagi_free(m, sec, sec_size);
+    voxdagi_scene_of(d, &sc);
+    voxdagi_layout_seal(img, &lay, &sc);
+    n->owned = img;
+    n->owned_size = (size_t)lay.total;
+    st = voxdagi_open(n, img, n->owned_size, 0, VOXDAG_MAX_LEVELS, 0, m, err);
+    if (st != VOXDAG_OK) {
+        voxdagi_dag_release(m, n);
+        return st;
+    }
+    voxdagi_dag_release(m, d);
+    *pd = n;
+    return VOXDAG_OK;
 }
 
 // -- Finishing a build: encode into a file image
@@ -5586,6 +5933,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &b->mem, err);
+    if (st == VOXDAG_OK && !b->opts.no_lod_colors) st = voxdagi_attach_lod(&d, &b->mem, err);
     if (st != VOXDAG_OK) {
         voxdag_free(d);
         return st;
@@ -5706,6 +6054,13 @@ VOXDAG_API int voxdag_color(const voxdag *dag, uint64_t index, uint8_t rgb[3]) {
 VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind kind,
                                             const void *payload, size_t size, voxdag **out,
                                             voxdag_error *err) {
+    return voxdag_with_colors_opts(src, kind, payload, size, NULL, out, err);
+}
+
+VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color_kind kind,
+                                                 const void *payload, size_t size,
+                                                 const voxdag_build_opts *opts, voxdag **out,
+                                                 voxdag_error *err) {
     static const uint32_t copied[] = {VOXDAG_SECTION_LEVELS, VOXDAG_SECTION_NODES, VOXDAG_SECTION_BRICKS};
     voxdagi_layout lay;
     voxdagi_mem m;
@@ -5718,6 +6073,8 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
     if (!src || !out || (size && !payload) || kind > VOXDAG_COLORS_VOXCOLOR)
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "bad argument");
     *out = NULL;
+    if (opts && (opts->zero_begin || opts->zero_end))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "build options not zero-initialized");
     if (kind == VOXDAG_COLORS_RGB8 && (src->voxels > UINT64_MAX / 3 || size != 3 * src->voxels))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "RGB8 colours need 3 bytes per voxel");
     parts[0] = src->image + VOXDAG_FILE_HEADER_SIZE; /* placeholder, replaced below */
@@ -5756,16 +6113,14 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
     if (src->has_bounds) voxdagi_write_bounds(voxdagi_layout_section(img, &lay, VOXDAG_SECTION_BOUNDS), src->bounds);
     {
         voxdagi_scene sc;
-        sc.levels = src->levels;
-        sc.root_transform = src->root_transform;
-        sc.symmetry = src->symmetry;
-        sc.voxels = src->voxels;
-        memcpy(sc.voxel_box, src->voxel_box, sizeof sc.voxel_box);
+        voxdagi_scene_of(src, &sc);
         voxdagi_layout_seal(img, &lay, &sc);
     }
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &m, err);
+    if (st == VOXDAG_OK && kind != VOXDAG_COLORS_NONE && !(opts && opts->no_lod_colors))
+        st = voxdagi_attach_lod(&d, &m, err);
     voxdagi_mem_destroy(&m);
     if (st != VOXDAG_OK) {
         voxdag_free(d);
@@ -5805,6 +6160,7 @@ VOXDAG_API void voxdag_get_info(const voxdag *dag, voxdag_info *info) {
 #endif
     info->has_bounds = dag->has_bounds;
     memcpy(info->bounds, dag->bounds, sizeof info->bounds);
+    info->lod_color_bytes = dag->lod_size;
 }
 
 /* Traversals carry MI, the transform from world to stored frame (the inverse
@@ -6435,6 +6791,89 @@ VOXDAG_API int voxdag_occluded(const voxdag *dag, const voxdag_ray *ray) {
 
 VOXDAG_API int voxdag_occluded_opts(const voxdag *dag, const voxdag_ray *ray, const voxdag_ray_opts *opts) {
     return dag && ray ? voxdagi_query(dag, ray, opts, NULL) : -1;
+}
+
+/* The cell of level Q (< L) holding voxel (X, Y, Z): its first voxel index
+   *A and its voxel count *N (0 when the cell is empty). A descent as in
+   voxdag_lookup down to the cell's node, or to its brick for Q >= L-2. */
+static void voxdagi_cell_range(const voxdag *d, uint32_t q, uint32_t x, uint32_t y, uint32_t z, uint64_t *a,
+                               uint64_t *n) {
+    uint32_t nlevels = d->levels, brick_level = nlevels - 2, l;
+    unsigned mi = voxdagi_cube_tables.inv[d->root_transform];
+    uint64_t at = 0, idx = 0, mask;
+    *a = 0, *n = 0;
+    if (!d->voxels) return;
+    for (l = 0; l < q && l < brick_level; l++) {
+        const uint8_t *rec = d->level[l].data + at;
+        unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l;
+        unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
+        uint64_t ref = 0;
+        if (!(header >> (2 * voxdagi_cube_tables.act[mi][w]) & 3)) return;
+        idx += voxdagi_preceding(d, l, rec, header, mi, w, &ref);
+        mi = voxdagi_cube_tables.comp[ref & 63][mi];
+        at = ref >> 6;
+    }
+    *a = idx;
+    if (q < brick_level) {
+        *n = voxdagi_node_count(d, q, at);
+        return;
+    }
+    mask = voxdagi_brick_to_world(voxdagi_brick(d, at), mi);
+    if (q == brick_level) {
+        *n = (uint64_t)voxdagi_popcount64(mask);
+        return;
+    }
+    { /* a 2^3 cell: byte c of the brick's world-order mask */
+        unsigned c = (x >> 1 & 1) | (y >> 1 & 1) << 1 | (z >> 1 & 1) << 2;
+        *a += (uint64_t)voxdagi_popcount64(mask & ((1ull << (8 * c)) - 1));
+        *n = (uint64_t)voxdagi_popcount64(mask >> (8 * c) & 0xFF);
+    }
+}
+
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first) {
+    uint64_t a, n;
+    uint32_t low;
+    if (!dag || level > dag->levels || (x | y | z) >> dag->levels) return 0;
+    if (level == dag->levels) {
+        if (!voxdag_lookup(dag, x, y, z, &a)) return 0;
+        n = 1;
+    } else {
+        low = (1u << (dag->levels - level)) - 1;
+        voxdagi_cell_range(dag, level, x & ~low, y & ~low, z & ~low, &a, &n);
+        if (!n) return 0;
+    }
+    if (first) *first = a;
+    return n;
+}
+
+VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]) {
+    uint32_t q, x, y, z, low;
+    uint64_t a, n, sum[3] = {0, 0, 0};
+    if (!dag || !hit || !rgb || dag->color_kind == VOXDAG_COLORS_NONE) return 0;
+    q = hit->level, x = hit->xyz[0], y = hit->xyz[1], z = hit->xyz[2];
+    if (q > dag->levels || (x | y | z) >> dag->levels) return 0;
+    if (!voxdagi_colors_readable(dag)) return voxdag_color(dag, 0, rgb); /* -1 and magenta */
+    if (q == dag->levels) return voxdag_lookup(dag, x, y, z, &a) ? voxdag_color(dag, a, rgb) : 0;
+    low = (1u << (dag->levels - q)) - 1;
+    voxdagi_cell_range(dag, q, x & ~low, y & ~low, z & ~low, &a, &n);
+    if (!n) return 0;
+    if (n <= 64) { /* every 2^3 cell and brick: exact from the colours */
+        voxdagi_sum_colors(dag, a, n, sum);
+        voxdagi_mean_rgb(sum, n, rgb);
+        return 1;
+    }
+    if (dag->lod && q >= dag->lod_first && q - dag->lod_first < dag->lod_levels) {
+        /* the level's slot at the first multiple of 64 in [a, a + n), which
+           exists since n > 64, so the slot is below ceil(voxels / 64) */
+        uint64_t slot = (q - dag->lod_first) * dag->lod_per_level + ((a + 63) >> 6);
+        if (dag->color_kind == VOXDAG_COLORS_RGB8) memcpy(rgb, dag->lod_slots + 3 * slot, 3);
+#ifdef VOXDAGI_VOXCOLOR
+        else voxcolor_view_get(&dag->lod_view, slot, rgb);
+#endif
+        return 1;
+    }
+    return voxdag_color(dag, a, rgb); /* no slot for this level: the first voxel's colour */
 }
 
 VOXDAG_API int voxdag_ray_from_hit(const voxdag *dag, const voxdag_ray *ray, const voxdag_hit *hit,

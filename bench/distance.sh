@@ -24,22 +24,27 @@ CG-57|$C|11|1024|2300 -1500 900|512 61 110|30"
 
 echo "## Pictures at a distance"
 echo
-echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. Level-of-detail cells take the colour of their first voxel in Morton order (no averaged colours yet)."
+echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. A level-of-detail cell is drawn as the voxels it holds: their mean colour (the file's level-of-detail colour section for cells of more than 64 voxels), lit as a voxel staircase from the occupancy of its six neighbouring cells (README, \`vdag render\`). Last two columns: the level-of-detail colour section of the same scene built with \`--color-error 0.02\`, in bytes and as a share of that file's colour section."
 echo
-echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --samples 4 gain (dB) | --lod 1 gain (dB) |"
-echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --samples 4 gain (dB) | --lod 1 gain (dB) | LOD colours (bytes) | share of colours at e_t 0.02 |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     echo "distance: $name" >&2
     if [ "$in" = demo ]; then
         "$vdag" gen demo "$work/demo.xyz" --levels "$L" >/dev/null 2>&1
         "$vdag" build "$work/demo.xyz" "$work/s.vdag" --quiet
+        "$vdag" build "$work/demo.xyz" "$work/e.vdag" --color-error 0.02 --quiet
     else
         [ -s "$data/$in" ] || { echo "distance: $data/$in missing (bench/fetch.sh DATA scenes)" >&2; continue; }
         lv=""; [ "$L" = 0 ] || lv="--levels $L"
         # shellcheck disable=SC2086
         "$vdag" build "$data/$in" "$work/s.vdag" $lv --quiet
+        # shellcheck disable=SC2086
+        "$vdag" build "$data/$in" "$work/e.vdag" $lv --color-error 0.02 --quiet
     fi
     levels=$("$vdag" info "$work/s.vdag" --json | sed -n 's/.*"levels": \([0-9]*\).*/\1/p')
+    lodb=$("$vdag" info "$work/e.vdag" --json | sed -n 's/.*"lod_colors": \([0-9]*\).*/\1/p')
+    colb=$("$vdag" info "$work/e.vdag" --json | sed -n 's/.*"colors": \([0-9]*\).*/\1/p')
     cam=$(echo "$eye $target" | awk -v n="$levels" -v g="$grid" '{ s = 2 ^ n / g; for (i = 1; i <= 6; i++) printf "%g ", $i * s }')
     # shellcheck disable=SC2086
     set -- $cam
@@ -60,7 +65,7 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     shot s16 --samples 16 && p16=$(psnr s16)
     shot l1 --lod 1 && pl1=$(psnr l1)
     shot l2 --lod 2 && pl2=$(psnr l2)
-    awk -v n="$name" -v L="$levels" -v a="$p1" -v b="$p4" -v c="$p16" -v d="$pl1" -v e="$pl2" \
-        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f |\n", n, L, a, b, c, d, e, b - a, d - a }'
+    awk -v n="$name" -v L="$levels" -v a="$p1" -v b="$p4" -v c="$p16" -v d="$pl1" -v e="$pl2" -v lb="$lodb" -v cb="$colb" \
+        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f | %d | %.1f %% |\n", n, L, a, b, c, d, e, b - a, d - a, lb, 100 * lb / cb }'
 done
 echo

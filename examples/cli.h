@@ -10,6 +10,7 @@
 typedef struct vdag_file {
     voxdag *dag;
     int has_colors;         /* RGB8 or voxcolor colours present */
+    unsigned levels;        /* L: the grid is 2^L voxels a side */
     voxcolor_view colors;   /* valid when the colour section is a voxcolor stream */
 } vdag_file;
 
@@ -19,6 +20,11 @@ void vdag_close(vdag_file *f);
 
 /* Colour of voxel INDEX (white when the file has no colours). Thread-safe. */
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]);
+
+/* Colour of what a ray hit: the voxel's (HIT->index, so the ray needs
+   want_index), or at a level-of-detail cell the mean of its voxels
+   (voxdag_cell_color); white when the file has no colours. Thread-safe. */
+void vdag_hit_color(const vdag_file *f, const voxdag_hit *hit, uint8_t rgb[3]);
 
 /* The box of the occupied voxels, BOX = x0 y0 z0 x1 y1 z1 in grid units,
    half-open; all zero when the DAG has no voxel (the file's voxel box).

@@ -26,7 +26,16 @@
      8-bit values: the picture is exactly that larger one's n x n blocks
      averaged.
    - --lod P stops at cells smaller than P pixels (lod_factor = 2 s / H),
-     or P samples with --samples (2 s / (n H)). */
+     or P samples with --samples (2 s / (n H)). Such a cell (level q < L,
+     side 2^(L-q)) is drawn as what it stands for, the voxels it holds: its
+     colour is their mean (voxdag_cell_color), and max(0, n . l) becomes
+     the lighting of a voxel staircase (cell_lit: the occupancy gradient m,
+     m_k = count(cell - e_k) - count(cell + e_k) over the level's cells,
+     gives faces n_k = sign(m_k) e_k areas |m_k|, each seen in proportion
+     to max(0, -d . n_k) for ray direction d: the mean of max(0, n_k . l)
+     with weights |m_k| max(0, -d . n_k); the face's own value when all
+     weights are 0); its shadow ray starts past the cell's own staircase,
+     at t_min = its side. */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -273,6 +282,35 @@ typedef struct render_job {
 
 enum { TILE = 32 };
 
+/* Lighting of a level-of-detail cell that HIT stopped at: its voxels'
+   faces, not the cell's box, as the supersampled full-detail picture sees
+   them. The surface normal m is the gradient of occupancy (the voxel counts
+   of the six neighbouring cells of the hit's level, fewer towards the
+   occupied side); a voxel surface with that normal is a staircase whose
+   faces of axis k have areas in proportion to |m_k|, each seen in
+   proportion to its facing the eye and lit as max(0, n_k . l). Returns that
+   mean, or FACE_LIT (the hit face's) where the cell has no gradient. */
+static double cell_lit(const render_job *job, const voxdag_hit *hit, const double dir[3], double face_lit) {
+    const voxdag *d = job->file->dag;
+    const double *l = job->cam.light;
+    uint32_t q = hit->level, size = 1u << (job->levels - q);
+    double m[3], num = 0, den = 0;
+    int k;
+    for (k = 0; k < 3; k++) {
+        uint32_t lo[3], hi[3];
+        memcpy(lo, hit->xyz, sizeof lo), memcpy(hi, hit->xyz, sizeof hi);
+        lo[k] -= size, hi[k] += size; /* wraps outside the grid: counted empty */
+        m[k] = (double)voxdag_cell_count(d, q, lo[0], lo[1], lo[2], NULL) -
+               (double)voxdag_cell_count(d, q, hi[0], hi[1], hi[2], NULL);
+    }
+    for (k = 0; k < 3; k++) {
+        double n = m[k] < 0 ? -1 : 1, seen = fabs(m[k]) * (-dir[k] * n > 0 ? -dir[k] * n : 0);
+        num += seen * (l[k] * n > 0 ? l[k] * n : 0);
+        den += seen;
+    }
+    return den > 0 ? num / den : face_lit;
+}
+
 /* The colour of the ray through pixel (I, J) of a W x H picture of the view. */
 static void render_sample(const render_job *job, uint32_t i, uint32_t j, double w, double h, uint8_t *out) {
     const camera *c = &job->cam;
@@ -293,13 +331,18 @@ static void render_sample(const render_job *job, uint32_t i, uint32_t j, double 
         memcpy(out, BACKGROUND, 3);
         return;
     }
-    vdag_voxel_color(job->file, hit.index, rgb);
+    vdag_hit_color(job->file, &hit, rgb);
     if (hit.normal[0] | hit.normal[1] | hit.normal[2]) {
         double n[3] = {hit.normal[0], hit.normal[1], hit.normal[2]}, lit = dot3(n, c->light);
+        if (hit.level < job->levels) lit = cell_lit(job, &hit, ray.dir, lit);
         factor = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
         if (job->shadows && lit > 0) {
             voxdag_ray shadow;
-            if (voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow) > 0 &&
+            if (hit.level < job->levels) { /* past the cell's own staircase (lit above) */
+                voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow);
+                shadow.t_min = (double)(1u << (job->levels - hit.level));
+                if (voxdag_occluded(job->file->dag, &shadow) > 0) factor = AMBIENT;
+            } else if (voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow) > 0 &&
                 voxdag_occluded(job->file->dag, &shadow) > 0)
                 factor = AMBIENT;
         }

@@ -2,8 +2,8 @@
 
    vdag build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full]
               [--no-symmetry] [--color-error E] [--raw-colors] [--color-bits W|auto]
-              [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-alpha-test]
-              [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
+              [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-lod-colors]
+              [--no-alpha-test] [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
               [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
@@ -16,10 +16,12 @@
    Progress and diagnostics go to stderr; stdout carries only documented
    output. Exit status 0 on success, 1 with a one-line message otherwise. */
 #define _POSIX_C_SOURCE 200809L
-#define VOXDAG_IMPLEMENTATION
-#include "voxdag.h"
+/* voxcolor.h first: voxdag.h's implementation then decodes voxcolor colours
+   (voxdag_color, and the level-of-detail means voxdag_with_colors writes). */
 #define VOXCOLOR_IMPLEMENTATION
 #include "voxcolor.h"
+#define VOXDAG_IMPLEMENTATION
+#include "voxdag.h"
 
 #include <errno.h>
 #include <math.h>
@@ -84,6 +86,7 @@ int vdag_check_output(const char *in, const char *out) {
 
 int vdag_open(const char *path, vdag_file *f) {
     voxdag_error err;
+    voxdag_info info;
     const void *payload;
     size_t size;
     struct stat fs;
@@ -99,12 +102,12 @@ int vdag_open(const char *path, vdag_file *f) {
                               (unsigned long long)err.byte_offset);
         return !vdag_fail("%s: %s (%s)", path, voxdag_status_string(err.status), err.message);
     }
+    voxdag_get_info(f->dag, &info);
+    f->levels = info.levels;
     switch (voxdag_colors(f->dag, &payload, &size)) {
     case VOXDAG_COLORS_RGB8: f->has_colors = 1; break;
     case VOXDAG_COLORS_VOXCOLOR: {
-        voxdag_info info;
         voxcolor_status st = voxcolor_view_init(&f->colors, payload, size, NULL);
-        voxdag_get_info(f->dag, &info);
         if (st != VOXCOLOR_OK || f->colors.count != info.voxels) {
             vdag_close(f);
             return !vdag_fail("%s: corrupt colour section (%s)", path,
@@ -126,6 +129,11 @@ void vdag_close(vdag_file *f) {
 void vdag_voxel_color(const vdag_file *f, uint64_t index, uint8_t rgb[3]) {
     if (f->colors.count) voxcolor_view_get(&f->colors, index, rgb);
     else if (!voxdag_color(f->dag, index, rgb)) rgb[0] = rgb[1] = rgb[2] = 255;
+}
+
+void vdag_hit_color(const vdag_file *f, const voxdag_hit *hit, uint8_t rgb[3]) {
+    if (hit->level == f->levels) vdag_voxel_color(f, hit->index, rgb);
+    else if (voxdag_cell_color(f->dag, hit, rgb) <= 0) rgb[0] = rgb[1] = rgb[2] = 255;
 }
 
 int vdag_voxel_box(const voxdag *dag, uint32_t box[6]) {
@@ -171,7 +179,9 @@ static const struct {
      "  --verify-colors    after compressing, decode every colour and compare it with the\n"
      "                     raw colour; fail when one is off by more than E (default: off)\n"
      "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
-     "                     alpha test, the voxels stay the same\n"},
+     "                     alpha test, the voxels stay the same\n"
+     "  --no-lod-colors    write no level-of-detail colour section (default: write it: the mean\n"
+     "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"},
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
@@ -305,6 +315,7 @@ typedef struct build_args {
     const char *color_option; /* the last colour-compression option given, for the clash with --raw-colors */
     int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
     int verify_colors;      /* --verify-colors */
+    int no_lod_colors;      /* --no-lod-colors */
     double color_error;
     uint32_t color_bits; /* 0: auto */
     voxcolor_effort color_effort;
@@ -906,9 +917,12 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     uint64_t size = 3 * spill->n;
     voxdag *with = NULL;
     voxdag_error err;
+    voxdag_build_opts o;
     double t0 = now_seconds();
     char text[32];
     int rc;
+    memset(&o, 0, sizeof o);
+    o.no_lod_colors = a->no_lod_colors;
     if (!a->quiet && spill->n)
         fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
                 spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
@@ -920,7 +934,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(rgb);
             return vdag_fail("cannot read back the colours");
         }
-        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &with, &err) != VOXDAG_OK;
+        rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &o, &with, &err) != VOXDAG_OK;
         free(rgb);
     } else {
         grow_buf g;
@@ -941,7 +955,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(g.data);
             return 1;
         }
-        rc = voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &with, &err) != VOXDAG_OK;
+        rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &o, &with, &err) != VOXDAG_OK;
         free(g.data);
     }
     if (rc) return vdag_fail("%s", err.message);
@@ -1210,6 +1224,8 @@ static int cmd_build(int argc, char **argv) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
+        } else if (!strcmp(argv[k], "--no-lod-colors")) {
+            a.no_lod_colors = 1;
         } else if (!strcmp(argv[k], "--solid")) {
             a.solid = 1;
         } else if (!strcmp(argv[k], "--no-alpha-test")) {
@@ -1421,9 +1437,10 @@ static int cmd_info(int argc, char **argv) {
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.nodes[l]);
         printf("], \"bytes_per_level\": [");
         for (l = 0; l + 1 < in.levels; l++) printf("%s%llu", l ? ", " : "", (unsigned long long)in.level_bytes[l]);
-        printf("], \"bytes\": {\"file\": %llu, \"nodes\": %llu, \"bricks\": %llu, \"colors\": %llu}, ",
+        printf("], \"bytes\": {\"file\": %llu, \"nodes\": %llu, \"bricks\": %llu, \"lod_colors\": %llu, \"colors\": %llu}, ",
                (unsigned long long)in.file_bytes, (unsigned long long)in.node_bytes,
-               (unsigned long long)in.brick_bytes, (unsigned long long)in.color_bytes);
+               (unsigned long long)in.brick_bytes, (unsigned long long)in.lod_color_bytes,
+               (unsigned long long)in.color_bytes);
         printf("\"bits_per_voxel\": %.6f, \"color_format\": \"%s\", \"color_bits_per_voxel\": %.6f", geo_bits,
                color_kind_name(in.color_kind), in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
         if (in.has_bounds) /* the grid's world box */
@@ -1443,6 +1460,9 @@ static int cmd_info(int argc, char **argv) {
         printf("colours     %s, %llu bytes (%.3f bits/voxel)\n", color_kind_name(in.color_kind),
                (unsigned long long)in.color_bytes,
                in.voxels ? 8.0 * (double)in.color_bytes / (double)in.voxels : 0.0);
+        if (in.lod_color_bytes) /* the means of level-of-detail cells of more than 64 voxels */
+            printf("lod colours %llu bytes (%.1f %% of the colours)\n", (unsigned long long)in.lod_color_bytes,
+                   100.0 * (double)in.lod_color_bytes / (double)in.color_bytes);
         printf("file        %llu bytes\n", (unsigned long long)in.file_bytes);
         if (in.voxels)
             printf("occupied    voxels (%u, %u, %u) - (%u, %u, %u), grid units, half-open\n", in.voxel_box[0],
@@ -1570,7 +1590,7 @@ static int usage(FILE *f) {
           "  build IN OUT.vdag [--levels L] [--up x|y|z] [--symmetry none|reflect|full] [--no-symmetry]\n"
           "                    [--color-error E] [--raw-colors] [--color-bits W|auto]\n"
           "                    [--color-effort smallest|fast] [--verify-colors] [--no-colors]\n"
-          "                    [--no-alpha-test] [--chunk-levels C]\n"
+          "                    [--no-lod-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
           "                    [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats]\n"
           "                    [--quiet]\n"

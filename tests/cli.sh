@@ -181,6 +181,12 @@ check "build --no-colors" "$VDAG" build "$T/in.xyz" "$T/g.vdag" --levels 5 --no-
 cut -d' ' -f1-3 "$T/expected_export" >"$T/expected_xyz"
 check "--no-colors keeps the voxels, drops the colours" sh -c "'$VDAG' info '$T/g.vdag' | grep -q 'colours *none' &&
     '$VDAG' export-voxels '$T/g.vdag' 2>/dev/null | cut -d' ' -f1-3 | cmp -s - '$T/expected_xyz'"
+"$VDAG" gen demo "$T/demo6.xyz" --levels 6 >/dev/null 2>&1
+check "build --no-lod-colors: the same voxels and colours without the level-of-detail section" sh -c "
+    '$VDAG' build '$T/demo6.xyz' '$T/lod.vdag' --quiet && '$VDAG' build '$T/demo6.xyz' '$T/nolod.vdag' --no-lod-colors --quiet &&
+    '$VDAG' info '$T/lod.vdag' --json | grep -q '\"lod_colors\": [1-9]' &&
+    '$VDAG' info '$T/nolod.vdag' --json | grep -q '\"lod_colors\": 0,' &&
+    '$VDAG' export-voxels '$T/lod.vdag' >'$T/lod.txt' && '$VDAG' export-voxels '$T/nolod.vdag' | cmp -s - '$T/lod.txt'"
 check "thread count does not change the file" sh -c "'$VDAG' build '$T/in.xyz' '$T/t1.vdag' --levels 5 --threads 1 2>/dev/null &&
     '$VDAG' build '$T/in.xyz' '$T/t3.vdag' --levels 5 --threads 3 2>/dev/null && cmp -s '$T/t1.vdag' '$T/a.vdag' && cmp -s '$T/t3.vdag' '$T/a.vdag'"
 

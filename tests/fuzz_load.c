@@ -100,6 +100,13 @@ static int visit(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index)
     require(voxdag_lookup(w->dag, x, y, z, &found) == 1, "a visited voxel is empty to lookup");
     require(found == index, "lookup and for_each_voxel disagree on an index");
     if (w->color) require(voxdag_color(w->dag, index, rgb) == 1, "no colour for a visited voxel");
+    { /* the mean colour of a cell holding the voxel, at a level from the input */
+        voxdag_hit cell;
+        uint32_t q = w->file[w->visited % w->size] % (w->levels + 1), sh = w->levels - q;
+        memset(&cell, 0, sizeof cell);
+        cell.xyz[0] = x >> sh << sh, cell.xyz[1] = y >> sh << sh, cell.xyz[2] = z >> sh << sh, cell.level = q;
+        require(voxdag_cell_color(w->dag, &cell, rgb) == (w->color ? 1 : 0), "a cell's colour");
+    }
     if (w->visited < FUZZ_MAX_AIMED) aim(w, x, y, z);
     w->last_morton = morton;
     w->visited++;

@@ -144,6 +144,11 @@ static void test_offsets_documented(void) {
     CHECK(VOXDAG_FILE_SECTION_ENTRY_SIZE == 32 && VOXDAG_FILE_LEVEL_ENTRY_SIZE == 80);
     CHECK(VOXDAG_FILE_NODE_PADDING == 16 && VOXDAG_FILE_MAX_SECTIONS == 16);
     CHECK(VOXDAG_FILE_ENDIAN_TAG == 0x0A0B0C0Du && VOXDAG_FORMAT_VERSION == 3);
+    /* FORMAT.md's LOD_COLORS table */
+    CHECK(VOXDAG_SECTION_LOD_COLORS == 7 && VOXDAG_FILE_LOD_HEADER_SIZE == 16 && VOXDAG_FILE_LOD_OFF_KIND == 0);
+    CHECK(VOXDAG_FILE_LOD_OFF_SLOT_SHIFT == 1 && VOXDAG_FILE_LOD_OFF_FIRST_LEVEL == 2 &&
+          VOXDAG_FILE_LOD_OFF_LEVEL_COUNT == 3);
+    CHECK(VOXDAG_FILE_LOD_OFF_RESERVED == 4 && VOXDAG_FILE_LOD_OFF_SLOTS == 8 && VOXDAG_FILE_LOD_SLOT_SHIFT == 6);
     /* the helpers of golden.h use the same numbers */
     CHECK(GOLDEN_OFF_SECTION_COUNT == VOXDAG_FILE_OFF_SECTION_COUNT && GOLDEN_OFF_TABLE_CRC == VOXDAG_FILE_OFF_TABLE_CRC);
     CHECK(GOLDEN_OFF_HEADER_CRC == VOXDAG_FILE_OFF_HEADER_CRC && GOLDEN_HEADER_SIZE == VOXDAG_FILE_HEADER_SIZE);
@@ -193,7 +198,7 @@ static void test_header_fields(void) {
         golden_put_le(h + VOXDAG_FILE_OFF_HEADER_CRC, 0, 4);
         CHECK(golden_le(f + VOXDAG_FILE_OFF_HEADER_CRC, 4) == golden_crc32c(h, sizeof h));
         count = (uint32_t)golden_le(f + VOXDAG_FILE_OFF_SECTION_COUNT, 4);
-        CHECK(count == 3u + (kind == GOLDEN_MIRRORED_BLOB ? 2u : 0u));
+        CHECK(count == 3u + (kind == GOLDEN_MIRRORED_BLOB ? 3u : 0u)); /* colours, their level-of-detail means, bounds */
         CHECK(96 + (size_t)count * 32 <= size);
         if (96 + (size_t)count * 32 > size) count = 0;
         CHECK(golden_le(f + VOXDAG_FILE_OFF_TABLE_CRC, 4) == golden_crc32c(f + 96, (size_t)count * 32));
@@ -201,11 +206,12 @@ static void test_header_fields(void) {
             const uint8_t *e = f + 96 + 32 * i;
             uint32_t type = (uint32_t)golden_le(e, 4);
             uint64_t off = golden_le(e + 8, 8), sz = golden_le(e + 16, 8);
-            CHECK(golden_le(e + 4, 4) == 0 && golden_le(e + 28, 4) == 0 && off % 8 == 0);
+            /* the optional flag on LOD_COLORS only, which older readers skip */
+            CHECK(golden_le(e + 4, 4) == (type == VOXDAG_SECTION_LOD_COLORS) && golden_le(e + 28, 4) == 0 && off % 8 == 0);
             CHECK(off <= size && sz <= size - off);
             if (off > size || sz > size - off) continue;
             CHECK(golden_le(e + 24, 4) == golden_crc32c(f + off, (size_t)sz));
-            CHECK(type >= 1 && type <= 6 && !(seen >> type & 1));
+            CHECK(type >= 1 && type <= 7 && !(seen >> type & 1));
             seen |= 1u << (type & 31);
             switch (type) {
             case VOXDAG_SECTION_LEVELS: {
@@ -237,6 +243,18 @@ static void test_header_fields(void) {
             case VOXDAG_SECTION_COLORS_RGB8:
                 CHECK(info.color_kind == VOXDAG_COLORS_RGB8 && sz == info.color_bytes && sz == 3 * info.voxels);
                 break;
+            case VOXDAG_SECTION_LOD_COLORS: { /* levels 0..L-3, ceil(N / 64) RGB8 slots each */
+                uint64_t slots = (info.voxels + 63) / 64;
+                CHECK(sz == info.lod_color_bytes && sz >= VOXDAG_FILE_LOD_HEADER_SIZE);
+                if (sz < VOXDAG_FILE_LOD_HEADER_SIZE) break;
+                CHECK(f[off + VOXDAG_FILE_LOD_OFF_KIND] == VOXDAG_COLORS_RGB8 &&
+                      f[off + VOXDAG_FILE_LOD_OFF_SLOT_SHIFT] == 6 && f[off + VOXDAG_FILE_LOD_OFF_FIRST_LEVEL] == 0 &&
+                      f[off + VOXDAG_FILE_LOD_OFF_LEVEL_COUNT] == info.levels - 2 &&
+                      golden_le(f + off + VOXDAG_FILE_LOD_OFF_RESERVED, 4) == 0 &&
+                      golden_le(f + off + VOXDAG_FILE_LOD_OFF_SLOTS, 8) == slots);
+                CHECK(sz == VOXDAG_FILE_LOD_HEADER_SIZE + 3 * slots * (info.levels - 2));
+                break;
+            }
             case VOXDAG_SECTION_BOUNDS: {
                 unsigned k;
                 CHECK(sz == 48 && info.has_bounds);
@@ -254,6 +272,7 @@ static void test_header_fields(void) {
         CHECK((seen & 0xE) == 0xE); /* levels, nodes, bricks */
         CHECK(!!(seen & 0x10) == (info.color_kind == VOXDAG_COLORS_RGB8));
         CHECK(!!(seen & 0x40) == info.has_bounds);
+        CHECK(!!(seen & 0x80) == (info.lod_color_bytes > 0) && (info.lod_color_bytes > 0) == (info.color_kind != 0));
         if (kind == GOLDEN_ONE_VOXEL) {
             uint64_t index = 7;
             CHECK(voxdag_lookup(d, 9, 20, 3, &index) == 1 && index == 0);

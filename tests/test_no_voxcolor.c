@@ -72,6 +72,15 @@ static void test_undecodable(void) {
         c[0] = c[1] = c[2] = 128;
         CHECK(voxdag_color(loaded, n, c) == 0 && c[0] == 128 && c[1] == 128 && c[2] == 128);
         CHECK(voxdag_color(loaded, 0, NULL) == 0);
+        /* No level-of-detail means from colours this unit cannot decode; a
+           cell's colour fails the same way. */
+        CHECK(info.lod_color_bytes == 0);
+        {
+            voxdag_hit hit;
+            memset(&hit, 0, sizeof hit);
+            c[0] = c[1] = c[2] = 128;
+            CHECK(voxdag_cell_color(loaded, &hit, c) == -1 && c[0] == 255 && c[1] == 0 && c[2] == 255);
+        }
     }
     voxdag_free(loaded);
     voxdag_free(v);

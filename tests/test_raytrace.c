@@ -493,6 +493,47 @@ static void unit3(double *v) {
     v[0] /= n, v[1] /= n, v[2] /= n;
 }
 
+/* Full voxels of cell C (coordinates of level Q, any integers: outside the
+   grid is empty) and the sum of their colours (x, y, z) in SUM. */
+static uint64_t oracle_cell_voxels(const rscene *s, const int64_t c[3], uint32_t q, uint64_t sum[3]) {
+    uint32_t sh = s->levels - q, x, y, z;
+    uint64_t n = 0;
+    sum[0] = sum[1] = sum[2] = 0;
+    if (c[0] < 0 || c[1] < 0 || c[2] < 0 || c[0] >> q || c[1] >> q || c[2] >> q) return 0;
+    for (z = 0; z < 1u << sh; z++)
+        for (y = 0; y < 1u << sh; y++)
+            for (x = 0; x < 1u << sh; x++) {
+                uint32_t p[3];
+                p[0] = ((uint32_t)c[0] << sh) + x, p[1] = ((uint32_t)c[1] << sh) + y, p[2] = ((uint32_t)c[2] << sh) + z;
+                if (s->occ[s->levels][rcell(s->n, p[0], p[1], p[2])])
+                    n++, sum[0] += (uint8_t)p[0], sum[1] += (uint8_t)p[1], sum[2] += (uint8_t)p[2];
+            }
+    return n;
+}
+
+/* The renderer's lighting of a level-of-detail cell (examples/render.c,
+   cell_lit) from brute-force counts: the staircase of faces whose areas
+   follow the occupancy gradient m over the six neighbouring cells. */
+static double reference_cell_lit(const rscene *s, const view *c, const visit *v, uint32_t q, const double dir[3],
+                                 double face_lit) {
+    double m[3], num = 0, den = 0;
+    uint64_t sum[3];
+    int k;
+    for (k = 0; k < 3; k++) {
+        int64_t lo[3], hi[3];
+        int e;
+        for (e = 0; e < 3; e++) lo[e] = hi[e] = v->c[e];
+        lo[k]--, hi[k]++;
+        m[k] = (double)oracle_cell_voxels(s, lo, q, sum) - (double)oracle_cell_voxels(s, hi, q, sum);
+    }
+    for (k = 0; k < 3; k++) {
+        double n = m[k] < 0 ? -1 : 1, seen = fabs(m[k]) * (-dir[k] * n > 0 ? -dir[k] * n : 0);
+        num += seen * (c->light[k] * n > 0 ? c->light[k] * n : 0);
+        den += seen;
+    }
+    return den > 0 ? num / den : face_lit;
+}
+
 static void reference_pixel(const rscene *s, const view *c, double lod, uint32_t i, uint32_t j, uint8_t *out) {
     static const uint8_t background[3] = {205, 218, 235};
     double sx = (2 * (i + 0.5) / c->w - 1) * c->s * c->w / c->h, sy = (1 - 2 * (j + 0.5) / c->h) * c->s;
@@ -509,12 +550,19 @@ static void reference_pixel(const rscene *s, const view *c, double lod, uint32_t
         memcpy(out, background, 3);
         return;
     }
-    oracle_first(s, v.c, q, first);
+    if (q == s->levels) {
+        oracle_first(s, v.c, q, first);
+    } else { /* the mean colour of the cell's voxels */
+        int64_t cell[3] = {v.c[0], v.c[1], v.c[2]};
+        uint64_t sum[3], n = oracle_cell_voxels(s, cell, q, sum);
+        for (k = 0; k < 3; k++) first[k] = (uint32_t)((sum[k] + n / 2) / n);
+    }
     if (v.axis < 3) {
         double n = ray.dir[v.axis] > 0 ? -1 : 1;
         voxdag_ray sh;
         visit sv;
         lit = n * c->light[v.axis];
+        if (q < s->levels) lit = reference_cell_lit(s, c, &v, q, ray.dir, lit);
         factor = 0.3 + (1 - 0.3) * (lit > 0 ? lit : 0);
         memset(&sh, 0, sizeof sh);
         for (k = 0; k < 3; k++) { /* on the hit face: its plane, inside its square */
@@ -524,6 +572,7 @@ static void reference_pixel(const rscene *s, const view *c, double lod, uint32_t
         }
         sh.origin[v.axis] = (double)((v.c[v.axis] + (n > 0)) << (s->levels - q));
         sh.t_max = HUGE_VAL;
+        if (q < s->levels) sh.t_min = (double)(1u << (s->levels - q)); /* past the cell's own staircase */
         if (lit > 0 && oracle_walk(s, &sh, s->levels, stop_full, NULL, &sv)) factor = 0.3;
     }
     for (k = 0; k < 3; k++) { /* the scene's colour of voxel (x, y, z) is (x, y, z) */
@@ -594,8 +643,9 @@ static void test_raytrace_render_image(void) {
            point of the grid (the farthest corner is 156 units from the eye),
            so at --lod 1 no cell qualifies (a 2^3 cell needs more than 2 units
            per pixel) and the picture is the full one; at --lod 2 and 4 cells of 2 and 4
-           voxels take the colour of their first voxel and flatten these thin,
-           coordinate-coloured shells (measured 18-21 dB and 14-20 dB). The
+           voxels take the mean colour of their voxels, lit as staircases, and
+           flatten these thin, coordinate-coloured shells (measured 18-21 dB
+           and 13-20 dB). The
            floors (full identity, then 12 dB) catch a level of detail that
            triggers too early or on empty cells; exactness is the pixel check. */
         for (k = 1; k <= 4; k *= 2) {

@@ -237,6 +237,16 @@ static void nulls(voxdag *d) {
           "with_colors NULL", 0);
     check(voxdag_with_colors(d, (voxdag_color_kind)7, NULL, 0, &out, &err) == VOXDAG_ERR_INVALID_ARGUMENT,
           "with_colors bad kind", 0);
+    {
+        voxdag_build_opts wo;
+        memset(&wo, 0, sizeof wo);
+        wo.zero_end = 1;
+        check(voxdag_with_colors_opts(d, VOXDAG_COLORS_NONE, NULL, 0, &wo, &out, &err) == VOXDAG_ERR_INVALID_ARGUMENT,
+              "with_colors_opts not zero-initialized", 0);
+    }
+    check(voxdag_cell_color(NULL, &hit, c) == 0 && voxdag_cell_color(d, NULL, c) == 0 &&
+              voxdag_cell_color(d, &hit, NULL) == 0,
+          "cell_color NULL", 0);
     check(voxdag_load_file(NULL, NULL, &out, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "load_file NULL", 0);
     check(voxdag_save_file(NULL, "x.vdag", &err) == VOXDAG_ERR_INVALID_ARGUMENT, "save NULL dag", 0);
     check(voxdag_save_file(d, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT, "save NULL path", 0);
