@@ -4,7 +4,8 @@
               [--no-symmetry] [--color-error E] [--raw-colors] [--color-bits W|auto]
               [--color-effort smallest|fast] [--verify-colors] [--no-colors] [--no-lod-colors]
               [--no-alpha-test] [--chunk-levels C] [--threads T] [--max-memory MIB] [--max-texture-pixels N]
-              [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--quiet]
+              [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats] [--timings]
+              [--quiet]
    vdag info FILE [--json]
    vdag validate FILE
    vdag lookup FILE x y z
@@ -181,7 +182,9 @@ static const struct {
      "  --no-colors        drop colours (default: keep them); textures are still read for the\n"
      "                     alpha test, the voxels stay the same\n"
      "  --no-lod-colors    write no level-of-detail colour section (default: write it: the mean\n"
-     "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"},
+     "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"
+     "  --timings          print each phase's wall and CPU seconds at the end (read, voxelize,\n"
+     "                     reduce, encode, colours, colour check, colour attach, save)\n"},
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
@@ -306,6 +309,50 @@ static const char *symmetry_name(voxdag_symmetry s) {
     return s == VOXDAG_SYMMETRY_NONE ? "none" : s == VOXDAG_SYMMETRY_REFLECT ? "reflect" : "full";
 }
 
+/* --timings: wall and CPU seconds of each phase of a build. A phase lasts
+   from its first report to the next phase's; phases that alternate (a mesh
+   is voxelized and reduced chunk by chunk) add up. The CPU seconds are the
+   whole process's, so CPU / wall is the phase's parallelism. */
+enum { PHASES = 12 };
+typedef struct phase_times {
+    const char *name[PHASES];
+    double wall[PHASES], cpu[PHASES];
+    int count, current; /* current: the running phase, -1 none */
+    double wall0, cpu0; /* when it last started */
+} phase_times;
+
+static double cpu_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* Ends the running phase and starts NAME (a string that outlives P; NULL:
+   none). */
+static void phase_enter(phase_times *p, const char *name) {
+    double wall = now_seconds(), cpu = cpu_seconds();
+    int i;
+    if (p->current >= 0) p->wall[p->current] += wall - p->wall0, p->cpu[p->current] += cpu - p->cpu0;
+    p->wall0 = wall, p->cpu0 = cpu, p->current = -1;
+    if (!name) return;
+    for (i = 0; i < p->count && strcmp(p->name[i], name); i++) continue;
+    if (i == PHASES) return; /* more phases than slots: the rest go uncounted */
+    if (i == p->count) p->name[p->count++] = name;
+    p->current = i;
+}
+
+static void phase_print(const phase_times *p) {
+    double wall = 0, cpu = 0;
+    int i;
+    fprintf(stderr, "vdag: timings      wall s    CPU s  CPU/wall\n");
+    for (i = 0; i < p->count; i++) {
+        fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", p->name[i], p->wall[i], p->cpu[i],
+                p->wall[i] > 0 ? p->cpu[i] / p->wall[i] : 0.0);
+        wall += p->wall[i], cpu += p->cpu[i];
+    }
+    fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", "total", wall, cpu, wall > 0 ? cpu / wall : 0.0);
+}
+
 typedef struct build_args {
     const char *in, *out;
     uint32_t levels, threads;
@@ -316,6 +363,8 @@ typedef struct build_args {
     int no_alpha_test;      /* --no-alpha-test: texels of any alpha make voxels */
     int verify_colors;      /* --verify-colors */
     int no_lod_colors;      /* --no-lod-colors */
+    int timings;            /* --timings: print PHASES at the end */
+    phase_times phases;
     double color_error;
     uint32_t color_bits; /* 0: auto */
     voxcolor_effort color_effort;
@@ -343,6 +392,7 @@ typedef struct build_args {
 static void progress(void *user, const char *stage, double fraction) {
     build_args *a = (build_args *)user;
     int percent = (int)(100 * fraction), new_stage = !a->last_stage || strcmp(a->last_stage, stage) != 0;
+    if (a->phases.current < 0 || strcmp(a->phases.name[a->phases.current], stage)) phase_enter(&a->phases, stage);
     if (a->quiet || (!new_stage && a->last_percent == percent)) return;
     if (!a->tty && !new_stage && percent / 25 == a->last_percent / 25) return;
     if (a->tty) fprintf(stderr, "%svdag: %s %3d%% (%.1f s)", a->line_open ? (new_stage ? "\n" : "\r") : "", stage,
@@ -913,7 +963,7 @@ static int verify_spill(color_spill *spill, const grow_buf *g, const build_args 
 /* Reads the spilled colours back and attaches them to *DAG: RGB8, or a
    voxcolor stream when COMPRESS is set (encoded as it is read, so only the
    stream is held). */
-static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) {
+static int attach_colors(voxdag **dag, color_spill *spill, build_args *a) {
     uint64_t size = 3 * spill->n;
     voxdag *with = NULL;
     voxdag_error err;
@@ -926,6 +976,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
     if (!a->quiet && spill->n)
         fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
                 spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
+    phase_enter(&a->phases, "colours");
     rewind(spill->f);
     if (!a->compress) {
         uint8_t *rgb = (uint8_t *)malloc(size ? (size_t)size : 1);
@@ -934,6 +985,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
             free(rgb);
             return vdag_fail("cannot read back the colours");
         }
+        phase_enter(&a->phases, "colour attach"); /* with the level-of-detail means */
         rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_RGB8, rgb, (size_t)size, &o, &with, &err) != VOXDAG_OK;
         free(rgb);
     } else {
@@ -951,10 +1003,14 @@ static int attach_colors(voxdag **dag, color_spill *spill, const build_args *a) 
                     size ? 24.0 * (double)g.size / (double)size : 0.0, a->color_error,
                     a->color_effort == VOXCOLOR_EFFORT_FAST ? "fast" : "smallest", now_seconds() - t0, a->threads,
                     a->threads == 1 ? "" : "s");
-        if (a->verify_colors && verify_spill(spill, &g, a)) {
-            free(g.data);
-            return 1;
+        if (a->verify_colors) {
+            phase_enter(&a->phases, "colour check");
+            if (verify_spill(spill, &g, a)) {
+                free(g.data);
+                return 1;
+            }
         }
+        phase_enter(&a->phases, "colour attach"); /* with the level-of-detail means */
         rc = voxdag_with_colors_opts(*dag, VOXDAG_COLORS_VOXCOLOR, g.data, g.size, &o, &with, &err) != VOXDAG_OK;
         free(g.data);
     }
@@ -1190,6 +1246,8 @@ static int cmd_build(int argc, char **argv) {
     a.spill = &spill;
     a.compress = 1; /* lossless voxcolor (color_error 0) unless --raw-colors */
     a.t0 = t0;
+    a.phases.current = -1;
+    phase_enter(&a.phases, "read");
     a.threads = vdag_cpu_count();
     a.tty = isatty(2);
     for (k = 1; k < argc; k++) {
@@ -1224,6 +1282,8 @@ static int cmd_build(int argc, char **argv) {
             a.quiet = 1;
         } else if (!strcmp(argv[k], "--no-colors")) {
             a.no_colors = 1;
+        } else if (!strcmp(argv[k], "--timings")) {
+            a.timings = 1;
         } else if (!strcmp(argv[k], "--no-lod-colors")) {
             a.no_lod_colors = 1;
         } else if (!strcmp(argv[k], "--solid")) {
@@ -1398,8 +1458,11 @@ static int finish_build(build_args *a, voxdag_builder *b, int failed, voxdag_err
         fprintf(stderr, "vdag: warning: %s gave no voxels (its triangles or points lie outside the grid, "
                         "or are degenerate)\n", a->in);
     errno = 0;
+    phase_enter(&a->phases, "save");
     rc = save_file(dag, a->out, tmp, sizeof tmp, err) != VOXDAG_OK;
     voxdag_free(dag);
+    phase_enter(&a->phases, NULL);
+    if (a->timings) phase_print(&a->phases);
     if (rc && err->os_error == EEXIST)
         return vdag_fail("%s: %s is in the way (taken again while the save removed a stale one)", a->out, tmp);
     if (rc && err->os_error) return vdag_fail("%s: %s (%s)", a->out, err->message, strerror(err->os_error));
@@ -1593,7 +1656,7 @@ static int usage(FILE *f) {
           "                    [--no-lod-colors] [--no-alpha-test] [--chunk-levels C]\n"
           "                    [--threads T] [--max-memory MIB] [--max-texture-pixels N]\n"
           "                    [--max-vox-voxels N] [--vox-model N] [--allow-empty] [--force] [--stats]\n"
-          "                    [--quiet]\n"
+          "                    [--timings] [--quiet]\n"
           "  info FILE [--json]\n"
           "  validate FILE\n"
           "  lookup FILE x y z         (grid units)\n"
