@@ -72,7 +72,7 @@
      voxel, a NULL argument), -1 when the colours cannot be decoded;
      voxdag_cell_color (a hit's level-of-detail cell) the same way.
    - Lookups and counts (voxdag_lookup, voxdag_lookup_many,
-     voxdag_for_each_voxel) treat a NULL DAG as an empty scene: 0. They
+     voxdag_cell_count, voxdag_cell_count_many, voxdag_for_each_voxel) treat a NULL DAG as an empty scene: 0. They
      keep that shape because -1 would read as "full" in the
      `if (voxdag_lookup(...))` that existing code writes.
 
@@ -617,6 +617,27 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
 VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, size_t count, uint8_t *full,
                                        uint64_t *index);
 
+/* The voxels of the level-LEVEL cell (a cube 2^(L-LEVEL) voxels a side on
+   that level's grid; LEVEL L is one voxel) that holds voxel (X, Y, Z):
+   returns their count, and sets *FIRST (when FIRST is not NULL) to the
+   index of the cell's first voxel in Morton order (its voxels are the
+   indices [*FIRST, *FIRST + count)). Returns 0 (FIRST untouched) for an
+   empty cell, a point outside the grid, LEVEL > L or a NULL DAG. A descent
+   like voxdag_lookup's; thread-safe; no allocation. */
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first);
+
+/* Many voxdag_cell_count calls at one LEVEL, as voxdag_lookup_many does
+   lookups: the cell of point i (XYZ[3 i .. 3 i + 2]) holds COUNT_OUT[i]
+   voxels (when COUNT_OUT is not NULL; 0 when empty or outside the grid)
+   and starts at voxel index FIRST[i] (when FIRST is not NULL; written only
+   for non-empty cells). Returns the voxels of all the cells (a cell named
+   twice counts twice); 0 for a NULL DAG or XYZ, or LEVEL > L. Nearby
+   points share the upper part of their descent. Thread-safe; no
+   allocation. */
+VOXDAG_API uint64_t voxdag_cell_count_many(const voxdag *dag, uint32_t level, const uint32_t *xyz, size_t count,
+                                           uint64_t *count_out, uint64_t *first);
+
 /* Colour (RGB8) of voxel INDEX, whatever the colour section's kind: raw RGB8,
    or a voxcolor stream when the implementation was compiled with voxcolor.h
    (include voxcolor.h before the unit that defines VOXDAG_IMPLEMENTATION, or
@@ -710,16 +731,6 @@ typedef struct voxdag_hit {
    magenta) when the colours cannot be decoded, as voxdag_color.
    Thread-safe; no allocation. */
 VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]);
-
-/* The voxels of the level-LEVEL cell (a cube 2^(L-LEVEL) voxels a side on
-   that level's grid; LEVEL L is one voxel) that holds voxel (X, Y, Z):
-   returns their count, and sets *FIRST (when FIRST is not NULL) to the
-   index of the cell's first voxel in Morton order (its voxels are the
-   indices [*FIRST, *FIRST + count)). Returns 0 (FIRST untouched) for an
-   empty cell, a point outside the grid, LEVEL > L or a NULL DAG. A descent
-   like voxdag_lookup's; thread-safe; no allocation. */
-VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
-                                      uint64_t *first);
 
 /* Finds the first full voxel (or level-of-detail cell) along RAY and fills
    *HIT. Returns 1 on a hit, 0 on a miss (HIT untouched), -1 (HIT untouched)
@@ -6214,32 +6225,34 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     return 1;
 }
 
-/* The path of the previous point is kept per node level (its node, the
-   transform into it and the index of its first voxel); the next point
-   starts at the deepest node both paths share: below the highest bit in
-   which their coordinates differ, and no deeper than the previous point
-   got. */
-VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, size_t count, uint8_t *full,
-                                       uint64_t *index) {
-    uint64_t at[VOXDAG_MAX_LEVELS], idx[VOXDAG_MAX_LEVELS], mask = 0, found = 0;
+/* The cells of level Q holding points XYZ[0 .. COUNT): for each, its voxel
+   count (into COUNT_OUT, or FULL as 0/1 when Q = L, each when not NULL) and
+   first voxel index (into FIRST, when not NULL and the cell is not empty).
+   Returns the sum of the counts. The path of the previous point is kept per
+   node level (its node, the transform into it and the index of its first
+   voxel); the next point starts at the deepest node both paths share: below
+   the highest bit in which their coordinates differ, and no deeper than the
+   previous point got. */
+static uint64_t voxdagi_cells_many(const voxdag *dag, uint32_t q, const uint32_t *xyz, size_t count, uint8_t *full,
+                                   uint64_t *count_out, uint64_t *first) {
+    uint64_t at[VOXDAG_MAX_LEVELS], idx[VOXDAG_MAX_LEVELS], mask = 0, total = 0;
     unsigned mi[VOXDAG_MAX_LEVELS];
-    uint32_t nlevels, brick_level, reached = 1, prev[3] = {0, 0, 0}; /* reached: levels of the path known */
+    uint32_t nlevels, brick_level, stop, reached = 1, prev[3] = {0, 0, 0}; /* reached: levels of the path known */
     int have_mask = 0; /* MASK: the brick at the end of the path, in world order */
     size_t i;
-    if (!dag || !xyz) return 0;
-    nlevels = dag->levels, brick_level = nlevels - 2;
+    if (!dag || !xyz || q > dag->levels) return 0;
+    nlevels = dag->levels, brick_level = nlevels - 2, stop = q < brick_level ? q : brick_level;
     at[0] = 0, idx[0] = 0, mi[0] = voxdagi_cube_tables.inv[dag->root_transform];
     for (i = 0; i < count; i++) {
         uint32_t x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2], diff, l, shared;
-        unsigned p;
-        int is_full = 0;
+        uint64_t n = 0, a;
         if (!dag->voxels || (x | y | z) >> nlevels) goto answer;
         diff = (x ^ prev[0]) | (y ^ prev[1]) | (z ^ prev[2]);
         shared = diff ? nlevels - voxdagi_bit_length(diff) : nlevels; /* levels choosing the same octant */
         l = shared < reached - 1 ? shared : reached - 1;
         prev[0] = x, prev[1] = y, prev[2] = z;
         if (l < brick_level) have_mask = 0;
-        for (; l < brick_level; l++) {
+        for (; l < stop; l++) {
             const uint8_t *rec = dag->level[l].data + at[l];
             unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l, w, v;
             uint64_t ref = 0, before = 0;
@@ -6247,22 +6260,51 @@ VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, s
             v = voxdagi_cube_tables.act[mi[l]][w];
             reached = l + 1;
             if (!(header >> (2 * v) & 3)) goto answer;
-            if (index) before = voxdagi_preceding(dag, l, rec, header, mi[l], w, &ref);
+            if (first) before = voxdagi_preceding(dag, l, rec, header, mi[l], w, &ref);
             else ref = voxdagi_child_ref(dag, l, rec, header, v, 1);
             mi[l + 1] = voxdagi_cube_tables.comp[ref & 63][mi[l]];
             at[l + 1] = ref >> 6;
             idx[l + 1] = idx[l] + before;
         }
-        if (!have_mask) mask = voxdagi_brick_to_world(voxdagi_brick(dag, at[brick_level]), mi[brick_level]);
-        have_mask = 1, reached = brick_level + 1;
-        p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3));
-        is_full = (int)(mask >> p & 1);
-        if (is_full && index) index[i] = idx[brick_level] + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
+        a = idx[stop], reached = stop + 1; /* the path now ends at level STOP's node */
+        if (q < brick_level) {
+            n = voxdagi_node_count(dag, q, at[q]);
+        } else {
+            unsigned low = 3 * (nlevels - q); /* Morton bits inside the cell: 6 (the brick), 3 or 0 */
+            unsigned p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3)) >> low << low;
+            uint64_t cell = low == 6 ? ~0ull : ((1ull << (1u << low)) - 1) << p; /* 8 bits or 1 from P */
+            if (!have_mask) mask = voxdagi_brick_to_world(voxdagi_brick(dag, at[brick_level]), mi[brick_level]);
+            have_mask = 1;
+            n = (uint64_t)voxdagi_popcount64(mask & cell);
+            a += (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
+        }
+        if (n && first) first[i] = a;
     answer:
-        found += (uint64_t)is_full;
-        if (full) full[i] = (uint8_t)is_full;
+        total += n;
+        if (count_out) count_out[i] = n;
+        if (full) full[i] = (uint8_t)n;
     }
-    return found;
+    return total;
+}
+
+VOXDAG_API uint64_t voxdag_lookup_many(const voxdag *dag, const uint32_t *xyz, size_t count, uint8_t *full,
+                                       uint64_t *index) {
+    return dag ? voxdagi_cells_many(dag, dag->levels, xyz, count, full, NULL, index) : 0;
+}
+
+VOXDAG_API uint64_t voxdag_cell_count_many(const voxdag *dag, uint32_t level, const uint32_t *xyz, size_t count,
+                                           uint64_t *count_out, uint64_t *first) {
+    return voxdagi_cells_many(dag, level, xyz, count, NULL, count_out, first);
+}
+
+VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
+                                      uint64_t *first) {
+    uint32_t p[3];
+    uint64_t a = 0, n;
+    p[0] = x, p[1] = y, p[2] = z;
+    n = voxdagi_cells_many(dag, level, p, 1, NULL, NULL, first ? &a : NULL);
+    if (n && first) *first = a;
+    return n;
 }
 
 /* Depth-first walk in world Morton order with an explicit stack. */
@@ -6793,72 +6835,15 @@ VOXDAG_API int voxdag_occluded_opts(const voxdag *dag, const voxdag_ray *ray, co
     return dag && ray ? voxdagi_query(dag, ray, opts, NULL) : -1;
 }
 
-/* The cell of level Q (< L) holding voxel (X, Y, Z): its first voxel index
-   *A and its voxel count *N (0 when the cell is empty). A descent as in
-   voxdag_lookup down to the cell's node, or to its brick for Q >= L-2. */
-static void voxdagi_cell_range(const voxdag *d, uint32_t q, uint32_t x, uint32_t y, uint32_t z, uint64_t *a,
-                               uint64_t *n) {
-    uint32_t nlevels = d->levels, brick_level = nlevels - 2, l;
-    unsigned mi = voxdagi_cube_tables.inv[d->root_transform];
-    uint64_t at = 0, idx = 0, mask;
-    *a = 0, *n = 0;
-    if (!d->voxels) return;
-    for (l = 0; l < q && l < brick_level; l++) {
-        const uint8_t *rec = d->level[l].data + at;
-        unsigned header = voxdagi_le16(rec), sh = nlevels - 1 - l;
-        unsigned w = (x >> sh & 1) | (y >> sh & 1) << 1 | (z >> sh & 1) << 2;
-        uint64_t ref = 0;
-        if (!(header >> (2 * voxdagi_cube_tables.act[mi][w]) & 3)) return;
-        idx += voxdagi_preceding(d, l, rec, header, mi, w, &ref);
-        mi = voxdagi_cube_tables.comp[ref & 63][mi];
-        at = ref >> 6;
-    }
-    *a = idx;
-    if (q < brick_level) {
-        *n = voxdagi_node_count(d, q, at);
-        return;
-    }
-    mask = voxdagi_brick_to_world(voxdagi_brick(d, at), mi);
-    if (q == brick_level) {
-        *n = (uint64_t)voxdagi_popcount64(mask);
-        return;
-    }
-    { /* a 2^3 cell: byte c of the brick's world-order mask */
-        unsigned c = (x >> 1 & 1) | (y >> 1 & 1) << 1 | (z >> 1 & 1) << 2;
-        *a += (uint64_t)voxdagi_popcount64(mask & ((1ull << (8 * c)) - 1));
-        *n = (uint64_t)voxdagi_popcount64(mask >> (8 * c) & 0xFF);
-    }
-}
-
-VOXDAG_API uint64_t voxdag_cell_count(const voxdag *dag, uint32_t level, uint32_t x, uint32_t y, uint32_t z,
-                                      uint64_t *first) {
-    uint64_t a, n;
-    uint32_t low;
-    if (!dag || level > dag->levels || (x | y | z) >> dag->levels) return 0;
-    if (level == dag->levels) {
-        if (!voxdag_lookup(dag, x, y, z, &a)) return 0;
-        n = 1;
-    } else {
-        low = (1u << (dag->levels - level)) - 1;
-        voxdagi_cell_range(dag, level, x & ~low, y & ~low, z & ~low, &a, &n);
-        if (!n) return 0;
-    }
-    if (first) *first = a;
-    return n;
-}
-
 VOXDAG_API int voxdag_cell_color(const voxdag *dag, const voxdag_hit *hit, uint8_t rgb[3]) {
-    uint32_t q, x, y, z, low;
-    uint64_t a, n, sum[3] = {0, 0, 0};
+    uint32_t q;
+    uint64_t a = 0, n, sum[3] = {0, 0, 0};
     if (!dag || !hit || !rgb || dag->color_kind == VOXDAG_COLORS_NONE) return 0;
-    q = hit->level, x = hit->xyz[0], y = hit->xyz[1], z = hit->xyz[2];
-    if (q > dag->levels || (x | y | z) >> dag->levels) return 0;
+    q = hit->level;
+    if (q > dag->levels || (hit->xyz[0] | hit->xyz[1] | hit->xyz[2]) >> dag->levels) return 0;
     if (!voxdagi_colors_readable(dag)) return voxdag_color(dag, 0, rgb); /* -1 and magenta */
-    if (q == dag->levels) return voxdag_lookup(dag, x, y, z, &a) ? voxdag_color(dag, a, rgb) : 0;
-    low = (1u << (dag->levels - q)) - 1;
-    voxdagi_cell_range(dag, q, x & ~low, y & ~low, z & ~low, &a, &n);
-    if (!n) return 0;
-    if (n <= 64) { /* every 2^3 cell and brick: exact from the colours */
+    if (!(n = voxdagi_cells_many(dag, q, hit->xyz, 1, NULL, NULL, &a))) return 0;
+    if (n <= 64) { /* a voxel, every 2^3 cell and brick: exact from the colours */
         voxdagi_sum_colors(dag, a, n, sum);
         voxdagi_mean_rgb(sum, n, rgb);
         return 1;

@@ -293,16 +293,16 @@ enum { TILE = 32 };
 static double cell_lit(const render_job *job, const voxdag_hit *hit, const double dir[3], double face_lit) {
     const voxdag *d = job->file->dag;
     const double *l = job->cam.light;
-    uint32_t q = hit->level, size = 1u << (job->levels - q);
+    uint32_t size = 1u << (job->levels - hit->level), side[6][3];
+    uint64_t count[6];
     double m[3], num = 0, den = 0;
     int k;
-    for (k = 0; k < 3; k++) {
-        uint32_t lo[3], hi[3];
-        memcpy(lo, hit->xyz, sizeof lo), memcpy(hi, hit->xyz, sizeof hi);
-        lo[k] -= size, hi[k] += size; /* wraps outside the grid: counted empty */
-        m[k] = (double)voxdag_cell_count(d, q, lo[0], lo[1], lo[2], NULL) -
-               (double)voxdag_cell_count(d, q, hi[0], hi[1], hi[2], NULL);
+    for (k = 0; k < 3; k++) { /* the neighbours below and above along axis k */
+        memcpy(side[2 * k], hit->xyz, sizeof side[0]), memcpy(side[2 * k + 1], hit->xyz, sizeof side[0]);
+        side[2 * k][k] -= size, side[2 * k + 1][k] += size; /* wraps outside the grid: counted empty */
     }
+    voxdag_cell_count_many(d, hit->level, side[0], 6, count, NULL);
+    for (k = 0; k < 3; k++) m[k] = (double)count[2 * k] - (double)count[2 * k + 1];
     for (k = 0; k < 3; k++) {
         double n = m[k] < 0 ? -1 : 1, seen = fabs(m[k]) * (-dir[k] * n > 0 ? -dir[k] * n : 0);
         num += seen * (l[k] * n > 0 ? l[k] * n : 0);

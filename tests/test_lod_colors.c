@@ -70,6 +70,49 @@ static void check_cells(const voxdag *d, const cell_sums *c, int exact, lod_stat
     uint32_t q, levels = c->levels;
     for (q = 0; q <= levels; q++) {
         uint32_t side = 1u << q, x, y, z, sh = levels - q;
+        { /* voxdag_cell_count_many over the level's cells in a shuffled order, with points
+             outside the grid among them */
+            size_t n = (size_t)side * side * side, i, bad = 0;
+            uint32_t *xyz = (uint32_t *)malloc(3 * sizeof(uint32_t) * (n + 2));
+            uint64_t *count = (uint64_t *)malloc(sizeof(uint64_t) * (n + 2)), *first = (uint64_t *)malloc(sizeof(uint64_t) * (n + 2));
+            uint64_t sum = 0, got;
+            uint32_t rng = 12345u + q;
+            if (!xyz || !count || !first) {
+                CHECK(0);
+            } else {
+                for (i = 0; i < n + 2; i++) {
+                    size_t j = i < n ? i : 0;
+                    uint32_t inside = (uint32_t)(j * 2654435761u) & ((1u << sh) - 1);
+                    xyz[3 * i] = ((uint32_t)(j % side) << sh) + inside;
+                    xyz[3 * i + 1] = ((uint32_t)(j / side % side) << sh) + (inside >> 1);
+                    xyz[3 * i + 2] = ((uint32_t)(j / side / side) << sh);
+                    if (i == n) xyz[3 * i] = 1u << levels; /* outside */
+                    if (i == n + 1) xyz[3 * i + 2] = UINT32_MAX;
+                }
+                for (i = n; i > 1; i--) { /* shuffle the cells (not the two outside points) */
+                    size_t j;
+                    uint32_t t[3];
+                    rng = rng * 1664525u + 1013904223u;
+                    j = (size_t)(rng >> 8) % i;
+                    memcpy(t, xyz + 3 * (i - 1), sizeof t), memcpy(xyz + 3 * (i - 1), xyz + 3 * j, sizeof t);
+                    memcpy(xyz + 3 * j, t, sizeof t);
+                }
+                got = voxdag_cell_count_many(d, q, xyz, n + 2, count, first);
+                for (i = 0; i < n + 2; i++) {
+                    const uint64_t *e;
+                    if (i >= n) {
+                        bad += count[i] != 0;
+                        continue;
+                    }
+                    e = c->sum[q] + 5 * rcell(side, xyz[3 * i] >> sh, xyz[3 * i + 1] >> sh, xyz[3 * i + 2] >> sh);
+                    bad += count[i] != e[3] || (e[3] && first[i] != e[4]);
+                    sum += e[3];
+                }
+                CHECK_MSG(bad == 0 && got == sum, "voxdag_cell_count_many level %u: %zu of %zu cells wrong", q, bad,
+                          n + 2);
+            }
+            free(xyz), free(count), free(first);
+        }
         for (z = 0; z < side; z++)
             for (y = 0; y < side; y++)
                 for (x = 0; x < side; x++) {
