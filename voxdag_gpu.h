@@ -1,9 +1,11 @@
 /* voxdag_gpu.h - voxdag traversal for GLSL, HLSL and C from one text.      version 0.1.0
 
-   Point lookups, ray casts (closest hit and any hit, with level of detail)
-   and colours on the bytes of a .vdag file (FORMAT.md) as they are: one
-   storage buffer holding the file image, zero-padded to a multiple of 4
-   bytes. No tables, no per-file constants, no shader extension: every 64-bit
+   Point lookups, ray casts (closest hit and any hit, with level of detail),
+   colours, and cells (voxdag_gpu_cell: a level-of-detail cell's voxel count
+   and first index; voxdag_gpu_cell_color: its voxels' mean colour, from the
+   colours or the file's level-of-detail colours, FORMAT.md LOD_COLORS) on
+   the bytes of a .vdag file (FORMAT.md) as they are: one storage buffer
+   holding the file image, zero-padded to a multiple of 4 bytes. No tables, no per-file constants, no shader extension: every 64-bit
    quantity is a pair of 32-bit words, so it runs on any Vulkan 1.1 device.
    Validation stays on the CPU: upload only images that voxdag_load_memory
    (voxdag.h) accepted; on other bytes the functions still terminate, but
@@ -37,6 +39,8 @@
        r.lod = 0.0; r.flags = VOXDAG_GPU_WANT_INDEX;
        voxdag_gpu_hit h = voxdag_gpu_raycast(0u, f, r);
        if (h.hit != 0u) { uint rgb = voxdag_gpu_color(0u, f, h.index_lo, h.index_hi); ... }
+       // with r.lod > 0.0, a hit may be a cell (h.level < f.levels): its mean colour
+       uint mean = voxdag_gpu_cell_color(0u, f, h);  // a voxel's own colour at level L
 
    PRECISION. Rays are traced in float32 with operations whose rounding is
    fixed (add, subtract, multiply, compare, int to float of integers below
@@ -52,7 +56,9 @@
    voxdag_raycast's exact double-precision answers a hit is the same voxel,
    normal and index except at near-ties: where two planes' t differ by about
    float32 rounding at the grid's scale (2^-24 relative: at 65536^3 about
-   0.004 voxel near the far side).
+   0.004 voxel near the far side). Cells and colours are integers only:
+   voxdag_gpu_cell and voxdag_gpu_cell_color give voxdag_cell_count's and
+   voxdag_cell_color's answers exactly.
 
    C mode rounds every float operation to float as a GPU does: it sets
    #pragma STDC FP_CONTRACT OFF (clang), keeps products that feed a sum
@@ -197,6 +203,7 @@ typedef struct voxdag_gpu_file voxdag_gpu_file;
 typedef struct voxdag_gpu_ray voxdag_gpu_ray;
 typedef struct voxdag_gpu_hit voxdag_gpu_hit;
 typedef struct voxdag_gpu_lookup_result voxdag_gpu_lookup_result;
+typedef struct voxdag_gpu_cell_result voxdag_gpu_cell_result;
 typedef struct voxdag_gpu_frustum voxdag_gpu_frustum;
 #endif
 
@@ -230,6 +237,11 @@ struct voxdag_gpu_file {
     voxdag_gpu_u32 bricks;      /* BRICKS */
     voxdag_gpu_u32 colors;      /* and the colour section's payload */
     voxdag_gpu_u32 color_kind;  /* VOXDAG_GPU_COLORS_* */
+    /* the level-of-detail colours (FORMAT.md, LOD_COLORS): where the slots
+       start (after the section's header), their kind (VOXDAG_GPU_COLORS_*;
+       NONE: no section), the first level covered q0, the level count K and
+       the slots per level S */
+    voxdag_gpu_u32 lod_slots, lod_kind, lod_first, lod_levels, lod_per_level_lo, lod_per_level_hi;
     voxdag_gpu_u32 voxels_lo, voxels_hi;
     voxdag_gpu_u32 box_lo_x, box_lo_y, box_lo_z, box_hi_x, box_hi_y, box_hi_z; /* half-open */
 };
@@ -255,6 +267,13 @@ struct voxdag_gpu_hit {
 struct voxdag_gpu_lookup_result {
     voxdag_gpu_u32 found;
     voxdag_gpu_u32 index_lo, index_hi;
+};
+
+/* A cell's voxels, as voxdag_cell_count: their count and the first one's
+   index (both 0 for an empty cell); its colours are [first, first + count). */
+struct voxdag_gpu_cell_result {
+    voxdag_gpu_u32 count_lo, count_hi;
+    voxdag_gpu_u32 first_lo, first_hi;
 };
 
 // -- Byte and bit-field reads
@@ -383,6 +402,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_file voxdag_gpu_open(voxdag_gpu_buf buf, voxdag_gpu_u
     voxdag_gpu_u32 n, k, ok;
     f.base = base;
     f.level_table = 0u, f.nodes = 0u, f.bricks = 0u, f.colors = 0u, f.color_kind = 0u;
+    f.lod_slots = 0u, f.lod_kind = 0u, f.lod_first = 0u, f.lod_levels = 0u, f.lod_per_level_lo = 0u, f.lod_per_level_hi = 0u;
     f.box_lo_x = voxdag_gpui_word(buf, (base >> 2) + 14u), f.box_lo_y = voxdag_gpui_word(buf, (base >> 2) + 15u);
     f.box_lo_z = voxdag_gpui_word(buf, (base >> 2) + 16u), f.box_hi_x = voxdag_gpui_word(buf, (base >> 2) + 17u);
     f.box_hi_y = voxdag_gpui_word(buf, (base >> 2) + 18u), f.box_hi_z = voxdag_gpui_word(buf, (base >> 2) + 19u);
@@ -403,6 +423,11 @@ VOXDAG_GPU_FUNC voxdag_gpu_file voxdag_gpu_open(voxdag_gpu_buf buf, voxdag_gpu_u
         if (type == 3u) f.bricks = at;
         if (type == 4u) f.colors = at, f.color_kind = VOXDAG_GPU_COLORS_RGB8;
         if (type == 5u) f.colors = at, f.color_kind = VOXDAG_GPU_COLORS_VOXCOLOR;
+        if (type == 7u) { /* kind, slot shift, q0, K; S at byte 8 */
+            voxdag_gpu_u32 head = voxdag_gpui_word(buf, at >> 2);
+            f.lod_slots = at + 16u, f.lod_kind = head & 0xFFu, f.lod_first = head >> 16 & 0xFFu, f.lod_levels = head >> 24;
+            f.lod_per_level_lo = voxdag_gpui_word(buf, (at >> 2) + 2u), f.lod_per_level_hi = voxdag_gpui_word(buf, (at >> 2) + 3u);
+        }
     }
     if (ok == 0u || f.bricks == 0u) f.levels = 0u;
     return f;
@@ -623,8 +648,9 @@ VOXDAG_GPU_FUNC voxdag_gpui_mask voxdag_gpui_preceding(voxdag_gpu_buf buf, voxda
     return sum;
 }
 
-/* Voxels of world-order brick mask M before Morton position P. */
+/* Voxels of world-order brick mask M before Morton position P (<= 64). */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_before(voxdag_gpui_mask m, voxdag_gpu_u32 p) {
+    if (p >= 64u) return voxdag_gpui_popcount(m.lo) + voxdag_gpui_popcount(m.hi);
     if (p >= 32u) return voxdag_gpui_popcount(m.lo) + voxdag_gpui_popcount(m.hi & ((1u << (p - 32u)) - 1u));
     return voxdag_gpui_popcount(m.lo & ((1u << p) - 1u));
 }
@@ -634,19 +660,24 @@ VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_brick_pos(voxdag_gpu_u32 x, voxdag_gp
     return (x & 1u) | (y & 1u) << 1 | (z & 1u) << 2 | (x & 2u) << 2 | (y & 2u) << 3 | (z & 2u) << 4;
 }
 
-// -- Point lookup
+// -- Cells and point lookup
 
-VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 x,
-                                                           voxdag_gpu_u32 y, voxdag_gpu_u32 z) {
-    voxdag_gpu_lookup_result r;
-    voxdag_gpui_mask idx, m;
-    voxdag_gpu_u32 l, at = 0u, mi = f.root_inverse, p;
-    r.found = 0u, r.index_lo = 0u, r.index_hi = 0u;
+/* The voxels of the level-Q cell (a cube 2^(L-Q) voxels a side; Q = L: one
+   voxel) holding voxel (X, Y, Z), as voxdag_cell_count: a descent as
+   voxdag_lookup's down to the cell's record, or into its brick for
+   Q >= L-2. Count 0 for an empty cell, a point outside the grid or Q > L. */
+VOXDAG_GPU_FUNC voxdag_gpu_cell_result voxdag_gpu_cell(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 q,
+                                                       voxdag_gpu_u32 x, voxdag_gpu_u32 y, voxdag_gpu_u32 z) {
+    voxdag_gpu_cell_result r;
+    voxdag_gpui_mask idx, n;
+    voxdag_gpu_u32 l, at = 0u, mi = f.root_inverse;
+    r.count_lo = 0u, r.count_hi = 0u, r.first_lo = 0u, r.first_hi = 0u;
     idx.lo = 0u, idx.hi = 0u;
-    if (f.levels == 0u || (f.voxels_lo | f.voxels_hi) == 0u || ((x | y | z) >> f.levels) != 0u) return r;
-    for (l = 0u; l + 2u < f.levels; l++) {
+    if (f.levels == 0u || (f.voxels_lo | f.voxels_hi) == 0u || q > f.levels || ((x | y | z) >> f.levels) != 0u) return r;
+    for (l = 0u; l < q && l + 2u < f.levels; l++) {
         voxdag_gpu_u32 sh = f.levels - 1u - l, w = (x >> sh & 1u) | (y >> sh & 1u) << 1 | (z >> sh & 1u) << 2;
         voxdag_gpu_u32 header = voxdag_gpui_u16(buf, voxdag_gpui_level_data(buf, f, l) + at), s = voxdag_gpui_act(mi, w);
+        voxdag_gpui_mask m;
         voxdag_gpui_ref ref;
         if ((header >> (2u * s) & 3u) == 0u) return r;
         m = voxdag_gpui_preceding(buf, f, l, at, header, mi, w);
@@ -655,11 +686,25 @@ VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, v
         mi = voxdag_gpui_compose(ref.inverse, mi);
         at = ref.at;
     }
-    m = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
-    p = voxdag_gpui_brick_pos(x, y, z);
-    if (((p < 32u ? m.lo >> p : m.hi >> (p - 32u)) & 1u) == 0u) return r;
-    idx = voxdag_gpui_add64(idx, voxdag_gpui_before(m, p), 0u);
-    r.found = 1u, r.index_lo = idx.lo, r.index_hi = idx.hi;
+    if (q + 2u < f.levels) {
+        n = voxdag_gpui_count(buf, f, q, at);
+    } else { /* in the brick: the cell's 8^(L-Q) Morton positions from P */
+        voxdag_gpui_mask m = voxdag_gpui_brick_to_world(voxdag_gpui_brick(buf, f, at), mi);
+        voxdag_gpu_u32 size = 1u << (3u * (f.levels - q)), p = voxdag_gpui_brick_pos(x, y, z) & (64u - size);
+        idx = voxdag_gpui_add64(idx, voxdag_gpui_before(m, p), 0u);
+        n.lo = voxdag_gpui_before(m, p + size) - voxdag_gpui_before(m, p), n.hi = 0u;
+    }
+    if ((n.lo | n.hi) == 0u) return r;
+    r.count_lo = n.lo, r.count_hi = n.hi, r.first_lo = idx.lo, r.first_hi = idx.hi;
+    return r;
+}
+
+/* Whether voxel (X, Y, Z) is full, and its index. */
+VOXDAG_GPU_FUNC voxdag_gpu_lookup_result voxdag_gpu_lookup(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 x,
+                                                           voxdag_gpu_u32 y, voxdag_gpu_u32 z) {
+    voxdag_gpu_cell_result c = voxdag_gpu_cell(buf, f, f.levels, x, y, z);
+    voxdag_gpu_lookup_result r;
+    r.found = c.count_lo, r.index_lo = c.first_lo, r.index_hi = c.first_hi;
     return r;
 }
 
@@ -1108,16 +1153,56 @@ VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_voxcolor(voxdag_gpu_buf buf, voxdag_g
     return r;
 }
 
+/* Colour INDEX of RGB8 colours at byte AT (below 4 GiB: INDEX_HI is 0). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpui_rgb8(voxdag_gpu_buf buf, voxdag_gpu_u32 at, voxdag_gpu_u32 index_lo) {
+    at += 3u * index_lo;
+    return voxdag_gpui_byte(buf, at) | voxdag_gpui_byte(buf, at + 1u) << 8 | voxdag_gpui_byte(buf, at + 2u) << 16;
+}
+
 /* The colour of voxel INDEX as 0x00BBGGRR, or VOXDAG_GPU_NO_COLOR when the
    file has none (INDEX must be below the voxel count). */
 VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_color(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 index_lo,
                                                 voxdag_gpu_u32 index_hi) {
-    if (f.color_kind == VOXDAG_GPU_COLORS_RGB8) {
-        voxdag_gpu_u32 at = f.colors + 3u * index_lo; /* below 4 GiB: INDEX_HI is 0 */
-        return voxdag_gpui_byte(buf, at) | voxdag_gpui_byte(buf, at + 1u) << 8 | voxdag_gpui_byte(buf, at + 2u) << 16;
-    }
+    if (f.color_kind == VOXDAG_GPU_COLORS_RGB8) return voxdag_gpui_rgb8(buf, f.colors, index_lo);
     if (f.color_kind == VOXDAG_GPU_COLORS_VOXCOLOR) return voxdag_gpui_voxcolor(buf, f.colors, index_lo, index_hi);
     return VOXDAG_GPU_NO_COLOR;
+}
+
+/* The colour of the cell hit H stopped at, as voxdag_cell_color, from
+   h.level and h.x, h.y, h.z alone (WANT_INDEX is not needed): a voxel's
+   own colour; the mean of the n <= 64 voxels of a smaller cell, decoded
+   here (per channel (sum + n / 2) / n); for a larger cell its slot of the
+   level-of-detail colours (FORMAT.md, LOD_COLORS), or its first voxel's
+   colour where the file has none for its level. 0x00BBGGRR, or
+   VOXDAG_GPU_NO_COLOR when the file has no colours, H is a miss or its
+   cell is empty. The same bits as voxdag_cell_color (integers only). */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 voxdag_gpu_cell_color(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_hit h) {
+    voxdag_gpu_cell_result c;
+    voxdag_gpui_mask slot;
+    voxdag_gpu_u32 k;
+    if (f.color_kind == VOXDAG_GPU_COLORS_NONE || h.hit == 0u) return VOXDAG_GPU_NO_COLOR;
+    c = voxdag_gpu_cell(buf, f, h.level, h.x, h.y, h.z);
+    if ((c.count_lo | c.count_hi) == 0u) return VOXDAG_GPU_NO_COLOR;
+    if (c.count_hi == 0u && c.count_lo <= 64u) { /* every 2^3 cell and brick: exact */
+        voxdag_gpu_u32 r = 0u, g = 0u, b = 0u, n = c.count_lo;
+        for (k = 0u; k < n; k++) {
+            voxdag_gpui_mask i;
+            voxdag_gpu_u32 rgb;
+            i.lo = c.first_lo, i.hi = c.first_hi;
+            i = voxdag_gpui_add64(i, k, 0u);
+            rgb = voxdag_gpu_color(buf, f, i.lo, i.hi);
+            r += rgb & 0xFFu, g += rgb >> 8 & 0xFFu, b += rgb >> 16;
+        }
+        return (r + n / 2u) / n | (g + n / 2u) / n << 8 | (b + n / 2u) / n << 16;
+    }
+    if (f.lod_kind == VOXDAG_GPU_COLORS_NONE || h.level < f.lod_first || h.level - f.lod_first >= f.lod_levels)
+        return voxdag_gpu_color(buf, f, c.first_lo, c.first_hi);
+    /* slot (q - q0) S + ceil(first / 64) */
+    slot.lo = c.first_lo >> 6 | c.first_hi << 26, slot.hi = c.first_hi >> 6;
+    slot = voxdag_gpui_add64(slot, (c.first_lo & 63u) != 0u ? 1u : 0u, 0u);
+    for (k = f.lod_first; k < h.level; k++) slot = voxdag_gpui_add64(slot, f.lod_per_level_lo, f.lod_per_level_hi);
+    if (f.lod_kind == VOXDAG_GPU_COLORS_RGB8) return voxdag_gpui_rgb8(buf, f.lod_slots, slot.lo);
+    return voxdag_gpui_voxcolor(buf, f.lod_slots, slot.lo, slot.hi);
 }
 
 #endif /* VOXDAG_GPU_H */

@@ -22,7 +22,8 @@ typedef enum vdag_gpu_mode {
     VDAG_GPU_OCCLUDED, /* in 10 words a ray, out 1 */
     VDAG_GPU_LOOKUPS,  /* in 3 words a voxel, out 4 */
     VDAG_GPU_RENDER,   /* out one 0x00BBGGRR word a pixel (in: BEAM's depths with beam_start) */
-    VDAG_GPU_BEAM      /* out one depth (float bits) per 8x8 block of pixels */
+    VDAG_GPU_BEAM,     /* out one depth (float bits) per 8x8 block of pixels */
+    VDAG_GPU_CELLS     /* in 4 words a cell (level x y z), out 5: count, first index, colour */
 } vdag_gpu_mode;
 
 typedef struct vdag_gpu_work {

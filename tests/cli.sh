@@ -865,6 +865,14 @@ check "render --samples 4: at least 4 dB nearer the 8x8-supersampled picture (--
     p4=\$(idiff -a '$T/aa64.png' '$T/aa4.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
     echo \"render --samples: PSNR against --samples 64: 1 sample \$p1 dB, 4 samples \$p4 dB\" >&2
     awk -v a=\"\$p1\" -v b=\"\$p4\" 'BEGIN { exit !(a > 20 && b >= a + 4) }'"
+check "render --gpu-emulate --lod 2: the CPU's level-of-detail picture in float32 (mean colours, staircase lighting, shadows; PSNR >= 40 dB against it; demo, far view)" sh -c "
+    for k in cpu gpu-emulate; do
+        '$VDAG' render '$T/aa.vdag' '$T/lod_'\$k.png --size 200x125 --eye 650 -450 375 --target 128 128 50 --fov 30 \\
+            --shadows --lod 2 \$([ \$k = cpu ] || echo --gpu-emulate) --quiet || exit 1
+    done
+    p=\$(idiff -a '$T/lod_cpu.png' '$T/lod_gpu-emulate.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
+    echo \"render --lod 2: the GPU kernel's picture against the CPU renderer's: PSNR \$p dB\" >&2
+    awk -v p=\"\$p\" 'BEGIN { exit !(p >= 40) }'"
 
 # -- vdag rays --gpu / vdag render --gpu on the machine's Vulkan device
 # (lavapipe without a GPU): the same answers and pixels as the kernel's C

@@ -100,4 +100,17 @@ static inline voxdag *with_voxcolor(const voxdag *d, double e, unsigned s) {
     return v;
 }
 
+/* D's colours again, without the level-of-detail colour section. */
+static inline voxdag *without_lod_colors(const voxdag *d) {
+    voxdag_build_opts o;
+    const void *payload;
+    size_t size;
+    voxdag_color_kind kind = voxdag_colors(d, &payload, &size);
+    voxdag *out = NULL;
+    memset(&o, 0, sizeof o);
+    o.no_lod_colors = 1;
+    CHECK(voxdag_with_colors_opts(d, kind, payload, size, &o, &out, NULL) == VOXDAG_OK);
+    return out;
+}
+
 #endif

@@ -6,7 +6,9 @@
    an answer that differs is accepted only when the exact answer of a ray
    moved by a few float32 roundings at the grid's scale (EPS below) is the
    same, and such answers are counted and bounded. The same rays run on
-   Vulkan in tests/test_vk.c, against this C build bit for bit. */
+   Vulkan in tests/test_gpu_vk.c, against this C build bit for bit. Cells
+   (voxdag_gpu_cell) and their colours (voxdag_gpu_cell_color) are
+   integers: they equal voxdag_cell_count and voxdag_cell_color exactly. */
 #include "test.h"
 #include "voxdag.h"
 #include "voxcolor.h"
@@ -69,7 +71,7 @@ static void test_gpu_transforms(void) {
 // -- Queries of one loaded file
 
 typedef struct gpu_stats {
-    uint64_t rays, hits, lod_hits, near_ties, lookups, colors, private_levels;
+    uint64_t rays, hits, lod_hits, near_ties, lookups, colors, private_levels, lod_hit_colors;
     double worst_t; /* largest |t - exact t| * |dir|, grid units */
 } gpu_stats;
 
@@ -82,6 +84,10 @@ static voxdag_gpu_buf gpu_buffer(const voxdag *d) {
 }
 
 /* One ray, with and without level of detail, and as a shadow query. */
+static uint32_t packed_rgb(const uint8_t rgb[3]) {
+    return (uint32_t)rgb[0] | (uint32_t)rgb[1] << 8 | (uint32_t)rgb[2] << 16;
+}
+
 static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, const voxdag_ray *ray, double lod,
                       gpu_stats *st) {
     voxdag_info info;
@@ -101,6 +107,13 @@ static void check_ray(const voxdag *d, voxdag_gpu_buf buf, voxdag_gpu_file f, co
             voxdag_raycast(d, ray, &o, &h);
             st->worst_t = fmax(st->worst_t, fabs(g.t - h.t) * m);
             CHECK_MSG(fabs(g.t - h.t) * m <= eps, "t %.9g, exact %.17g", g.t, h.t);
+            if (g.level < info.levels) { /* the cell's colour, as voxdag_cell_color gives the exact hit */
+                uint8_t rgb[3];
+                uint32_t got = voxdag_gpu_cell_color(buf, f, g);
+                if (voxdag_cell_color(d, &h, rgb) == 1) CHECK(got == packed_rgb(rgb));
+                else CHECK(got == VOXDAG_GPU_NO_COLOR);
+                st->lod_hit_colors++;
+            }
         }
     } else {
         int tie = near_tie(d, ray, lod, &g, eps);
@@ -174,7 +187,7 @@ static void check_file(const voxdag *d, const rscene *s, uint64_t seed, uint32_t
         uint32_t got = voxdag_gpu_color(buf, f, (uint32_t)i, (uint32_t)(i >> 32));
         st->colors++;
         if (voxdag_color(d, i, want))
-            CHECK_MSG(got == ((uint32_t)want[0] | (uint32_t)want[1] << 8 | (uint32_t)want[2] << 16),
+            CHECK_MSG(got == packed_rgb(want),
                       "colour %llu: %06x, want %02x%02x%02x", (unsigned long long)i, got, want[2], want[1], want[0]);
         else
             CHECK(got == VOXDAG_GPU_NO_COLOR);
@@ -188,11 +201,11 @@ static void check_file(const voxdag *d, const rscene *s, uint64_t seed, uint32_t
 }
 
 static void report(const char *what, const gpu_stats *st) {
-    fprintf(stderr, "  %s: %llu rays (%llu hits, %llu LOD hits), %llu near-ties, worst t error %.3g voxel; "
-            "%llu lookups, %llu colours; %llu levels with private children\n", what,
+    fprintf(stderr, "  %s: %llu rays (%llu hits, %llu LOD hits, %llu of them coloured as cells), %llu near-ties, "
+            "worst t error %.3g voxel; %llu lookups, %llu colours; %llu levels with private children\n", what,
             (unsigned long long)st->rays, (unsigned long long)st->hits, (unsigned long long)st->lod_hits,
-            (unsigned long long)st->near_ties, st->worst_t, (unsigned long long)st->lookups,
-            (unsigned long long)st->colors, (unsigned long long)st->private_levels);
+            (unsigned long long)st->lod_hit_colors, (unsigned long long)st->near_ties, st->worst_t,
+            (unsigned long long)st->lookups, (unsigned long long)st->colors, (unsigned long long)st->private_levels);
 }
 
 static void test_gpu_scenes(void) {
@@ -221,6 +234,116 @@ static void test_gpu_scenes(void) {
     CHECK(st.rays > 40000 && st.hits > st.rays / 4 && st.lod_hits > 1000);
     CHECK(st.private_levels > 20);
     CHECK(st.near_ties * 200 <= st.rays); /* at most 0.5 % */
+}
+
+// -- Cells and their colours
+
+typedef struct cell_stats {
+    uint64_t cells, full, large, slots, files, files_with_slots;
+} cell_stats;
+
+/* Every level's cells of D (all of them below 4096 a level, else a
+   sample), each asked at a random point inside it: voxdag_gpu_cell against
+   voxdag_cell_count, voxdag_gpu_cell_color against voxdag_cell_color. */
+static void check_cells(const voxdag *d, uint64_t seed, cell_stats *st) {
+    voxdag_gpu_buf buf = gpu_buffer(d);
+    voxdag_gpu_file f = voxdag_gpu_open(buf, 0);
+    voxdag_gpu_hit gh;
+    voxdag_info info;
+    uint64_t r = seed;
+    uint32_t q;
+    voxdag_get_info(d, &info);
+    CHECK(f.lod_kind == (info.lod_color_bytes ? (uint32_t)info.color_kind : VOXDAG_GPU_COLORS_NONE));
+    if (f.lod_kind != VOXDAG_GPU_COLORS_NONE) /* as the writers fill it */
+        CHECK(f.lod_first == 0 && f.lod_levels + 2 == info.levels &&
+              ((uint64_t)f.lod_per_level_hi << 32 | f.lod_per_level_lo) == (info.voxels + 63) / 64);
+    st->files++, st->files_with_slots += f.lod_kind != VOXDAG_GPU_COLORS_NONE;
+    memset(&gh, 0, sizeof gh);
+    for (q = 0; q <= info.levels; q++) {
+        uint64_t cells = (uint64_t)1 << (3 * q), i;
+        uint32_t side = 1u << (info.levels - q);
+        for (i = 0; i < (cells <= 4096 ? cells : 4096); i++) {
+            uint32_t c[3], p[3], k, got;
+            uint64_t first = 0, n;
+            voxdag_gpu_cell_result g;
+            voxdag_hit h;
+            uint8_t rgb[3];
+            int rc;
+            if (cells <= 4096) voxdag_morton_decode(i, &c[0], &c[1], &c[2]);
+            else for (k = 0; k < 3; k++) c[k] = test_rand_below(&r, 1u << q);
+            for (k = 0; k < 3; k++) p[k] = c[k] * side + test_rand_below(&r, side);
+            n = voxdag_cell_count(d, q, p[0], p[1], p[2], &first);
+            g = voxdag_gpu_cell(buf, f, q, p[0], p[1], p[2]);
+            CHECK_MSG(((uint64_t)g.count_hi << 32 | g.count_lo) == n && ((uint64_t)g.first_hi << 32 | g.first_lo) == first,
+                      "level %u (%u %u %u): count %u first %u, want %llu %llu", q, p[0], p[1], p[2], g.count_lo,
+                      g.first_lo, (unsigned long long)n, (unsigned long long)first);
+            memset(&h, 0, sizeof h);
+            h.level = q, h.xyz[0] = p[0], h.xyz[1] = p[1], h.xyz[2] = p[2];
+            gh.hit = 1, gh.level = q, gh.x = p[0], gh.y = p[1], gh.z = p[2];
+            rc = voxdag_cell_color(d, &h, rgb);
+            got = voxdag_gpu_cell_color(buf, f, gh);
+            CHECK_MSG(rc == 1 ? got == packed_rgb(rgb) : rc == 0 && got == VOXDAG_GPU_NO_COLOR,
+                      "level %u (%u %u %u), n %llu: colour %06x, want %d %02x%02x%02x", q, p[0], p[1], p[2],
+                      (unsigned long long)n, got, rc, rgb[2], rgb[1], rgb[0]);
+            st->cells++, st->full += n > 0, st->large += n > 64;
+            st->slots += n > 64 && f.lod_kind != VOXDAG_GPU_COLORS_NONE && info.color_kind != VOXDAG_COLORS_NONE;
+        }
+    }
+    /* outside the grid, past level L, a miss */
+    CHECK(voxdag_gpu_cell(buf, f, info.levels + 1, 0, 0, 0).count_lo == 0);
+    CHECK(voxdag_gpu_cell(buf, f, 0, 1u << info.levels, 0, 0).count_lo == 0);
+    gh.hit = 0, gh.level = 0, gh.x = 0, gh.y = 0, gh.z = 0;
+    CHECK(voxdag_gpu_cell_color(buf, f, gh) == VOXDAG_GPU_NO_COLOR);
+}
+
+/* Random scenes, L = 2..7, every symmetry group: raw colours and voxcolor
+   ones (lossless and lossy), each with its level-of-detail colours and
+   without them; the golden files; and a file written before the section. */
+static void test_gpu_cells(void) {
+    cell_stats st;
+    uint32_t levels;
+    int kind, k;
+    memset(&st, 0, sizeof st);
+    for (levels = 2; levels <= 7; levels++)
+        for (kind = 0; kind < RS_COUNT; kind++) {
+            rscene s;
+            uint64_t seed = 0xCE11 + (uint64_t)kind * 100 + levels;
+            voxdag *d = rscene_make(&s, kind, levels, (int)(levels + (uint32_t)kind) % 3, seed);
+            voxdag *v = d ? with_voxcolor(d, kind & 1 ? 0.0 : 0.05, levels & 1 ? 10 : 4 + levels) : NULL;
+            for (k = 0; d && v && k < 4; k++) {
+                const voxdag *src = k & 1 ? v : d;
+                voxdag *bare = NULL;
+                if (k < 2) {
+                    check_cells(src, seed + (uint64_t)k, &st);
+                } else { /* the same colours without the section */
+                    bare = without_lod_colors(src);
+                    if (bare) check_cells(bare, seed + (uint64_t)k, &st);
+                    voxdag_free(bare);
+                }
+            }
+            voxdag_free(v);
+            voxdag_free(d);
+            rscene_free(&s);
+        }
+    for (k = 0; k < GOLDEN_COUNT; k++) {
+        voxdag *d = NULL;
+        CHECK(golden_build(k, NULL, &d) == VOXDAG_OK);
+        if (d) check_cells(d, 0xCE0 + (uint64_t)k, &st);
+        voxdag_free(d);
+    }
+    {
+        char path[4096];
+        voxdag *d = NULL;
+        snprintf(path, sizeof path, "%s/lod/mirrored_blob_l5_before_lod.vdag", test_data_dir());
+        CHECK(voxdag_load_file(path, NULL, &d, NULL) == VOXDAG_OK);
+        if (d) check_cells(d, 0xCE1, &st);
+        voxdag_free(d);
+    }
+    fprintf(stderr, "  %llu files (%llu with level-of-detail colours): %llu cells of every level (%llu full, %llu of "
+            "more than 64 voxels, %llu of them read from a slot)\n", (unsigned long long)st.files,
+            (unsigned long long)st.files_with_slots, (unsigned long long)st.cells, (unsigned long long)st.full,
+            (unsigned long long)st.large, (unsigned long long)st.slots);
+    CHECK(st.files_with_slots > 50 && st.slots > 1000 && st.full > 10000);
 }
 
 /* The golden files, and one placed at an offset inside a larger buffer. */
@@ -432,6 +555,7 @@ static void test_gpu_beam(void) {
 const test_case test_gpu_cases[] = {
     {"gpu/transforms: the 48 symmetries as FORMAT.md defines them", test_gpu_transforms},
     {"gpu/scenes: lookups, colours and rays against brute force and the library", test_gpu_scenes},
+    {"gpu/cells: cells and their colours against voxdag_cell_count and voxdag_cell_color", test_gpu_cells},
     {"gpu/golden: the golden files, at offset 0 and inside a larger buffer", test_gpu_golden},
     {"gpu/large: voxelized scenes at L = 9 and 11", test_gpu_large},
     {"gpu/domain: non-finite and tiny inputs", test_gpu_domain},

@@ -5,7 +5,10 @@
    dense scenes of every symmetry group, with private children, both colour
    kinds and L = 2..7, rays (random, along axes, through edges and corners,
    windows, level of detail), shadow rays, lookups with indices and colours,
-   and pictures. An answer that differs from the library's exact one must
+   cells of every level with their counts and mean colours (files with and
+   without level-of-detail colours; the same bits as voxdag_cell_count and
+   voxdag_cell_color), and pictures (with level-of-detail cells lit as
+   their voxels' staircase). An answer that differs from the library's exact one must
    be a counted near-tie (tests/gpu_oracle.h). When Vulkan cannot be opened
    this fails, unless VOXDAG_TEST_SKIP lists "gpu". Prints "N passed, N failed". */
 #include "test.h"
@@ -20,7 +23,7 @@ int test_current_failed, test_full;
 const char *test_data_dir(void) { return "tests/data"; }
 
 typedef struct vk_stats {
-    uint64_t rays, hits, lod_hits, near_ties, occluded, lookups, pixels, runs, beam_blocks;
+    uint64_t rays, hits, lod_hits, near_ties, occluded, lookups, cells, full_cells, slot_cells, pixels, runs, beam_blocks;
 } vk_stats;
 
 /* Runs W on the device and on the emulation; 1 when both ran and gave the
@@ -72,7 +75,7 @@ static void check_file(vdag_gpu *gpu, vdag_gpu *emu, const voxdag *d, const rsce
     vdag_gpu_work w;
     char err[256] = "";
     uint64_t r = seed;
-    uint32_t n, i, cells, *in, *out;
+    uint32_t n, i, q, cells, *in, *out;
     voxdag_ray *rays;
     double *lods;
     voxdag_get_info(d, &info);
@@ -101,11 +104,15 @@ static void check_file(vdag_gpu *gpu, vdag_gpu *emu, const voxdag *d, const rsce
             st->near_ties++;
             CHECK(near_tie_opts(d, &rays[i], lods[i], EXCLUSIVE(i), &h, near_tie_eps(info.levels, rays[i].origin)));
         }
-        if (h.hit) {
+        if (h.hit) { /* a voxel's colour, or a level-of-detail cell's mean */
             uint8_t rgb[3];
             uint64_t index = (uint64_t)h.index_hi << 32 | h.index_lo;
             uint32_t want = 0xFFFFFF;
-            if (voxdag_color(d, index, rgb) == 1) want = rgb[0] | (uint32_t)rgb[1] << 8 | (uint32_t)rgb[2] << 16;
+            voxdag_hit cell;
+            memset(&cell, 0, sizeof cell);
+            cell.level = h.level, cell.xyz[0] = h.x, cell.xyz[1] = h.y, cell.xyz[2] = h.z;
+            if (h.level == info.levels ? voxdag_color(d, index, rgb) == 1 : voxdag_cell_color(d, &cell, rgb) == 1)
+                want = rgb[0] | (uint32_t)rgb[1] << 8 | (uint32_t)rgb[2] << 16;
             CHECK(out[12 * i + 11] == want);
         }
     }
@@ -145,7 +152,40 @@ static void check_file(vdag_gpu *gpu, vdag_gpu *emu, const voxdag *d, const rsce
         if (s) CHECK(found == s->occ[info.levels][rcell(s->n, in[3 * i], in[3 * i + 1], in[3 * i + 2])]);
         if (found) CHECK(((uint64_t)out[4 * i + 2] << 32 | out[4 * i + 1]) == index);
     }
-    /* a picture with shadows and level of detail */
+    /* cells of every level (all of a level below 4096, else a sample), each
+       asked at a random point inside it */
+    free(in), free(out);
+    in = (uint32_t *)malloc(4 * sizeof *in * 4096 * (info.levels + 1));
+    out = (uint32_t *)malloc(5 * sizeof *out * 4096 * (info.levels + 1));
+    for (q = 0, cells = 0; q <= info.levels; q++) {
+        uint32_t side = 1u << (info.levels - q), k, c[3];
+        for (i = 0; i < (q <= 4 ? 1u << (3 * q) : 4096u); i++, cells++) {
+            if (q <= 4) voxdag_morton_decode(i, &c[0], &c[1], &c[2]);
+            else for (k = 0; k < 3; k++) c[k] = test_rand_below(&r, 1u << q);
+            in[4 * cells] = q;
+            for (k = 0; k < 3; k++) in[4 * cells + 1 + k] = c[k] * side + test_rand_below(&r, side);
+        }
+    }
+    memset(&w, 0, sizeof w);
+    w.mode = VDAG_GPU_CELLS, w.count = cells;
+    st->runs++;
+    CHECK_MSG(run_both(gpu, emu, &w, in, 4 * (size_t)cells, out, 5 * (size_t)cells, "cells"), "cells: device and C differ");
+    for (i = 0; i < cells; i++) {
+        uint64_t first = 0, count = voxdag_cell_count(d, in[4 * i], in[4 * i + 1], in[4 * i + 2], in[4 * i + 3], &first);
+        uint32_t want = VOXDAG_GPU_NO_COLOR;
+        uint8_t rgb[3];
+        voxdag_hit cell;
+        memset(&cell, 0, sizeof cell);
+        cell.level = in[4 * i], cell.xyz[0] = in[4 * i + 1], cell.xyz[1] = in[4 * i + 2], cell.xyz[2] = in[4 * i + 3];
+        if (voxdag_cell_color(d, &cell, rgb) == 1) want = rgb[0] | (uint32_t)rgb[1] << 8 | (uint32_t)rgb[2] << 16;
+        st->cells++, st->full_cells += count > 0, st->slot_cells += count > 64 && info.lod_color_bytes > 0;
+        CHECK(((uint64_t)out[5 * i + 1] << 32 | out[5 * i]) == count);
+        CHECK(((uint64_t)out[5 * i + 3] << 32 | out[5 * i + 2]) == (count ? first : 0));
+        CHECK_MSG(out[5 * i + 4] == want, "cell level %u (%u %u %u): %08x, want %08x", cell.level, cell.xyz[0],
+                  cell.xyz[1], cell.xyz[2], out[5 * i + 4], want);
+    }
+    /* pictures with shadows and level of detail: a little, then much (cells
+       lit as their staircase, shadow rays started past it) */
     memset(&w, 0, sizeof w);
     w.mode = VDAG_GPU_RENDER, w.width = 48, w.height = 32, w.count = 48 * 32, w.shadows = 1;
     w.eye[0] = -0.7f * (float)(1u << info.levels), w.eye[1] = 1.9f * (float)(1u << info.levels), w.eye[2] = 1.3f * (float)(1u << info.levels);
@@ -174,6 +214,12 @@ static void check_file(vdag_gpu *gpu, vdag_gpu *emu, const voxdag *d, const rsce
             for (i = 0; i < 24; i++) st->beam_blocks += depths[i] != 0u; /* a depth above 0 */
         }
     }
+    if (info.levels > 2) {
+        w.lod = 0.03f;
+        st->runs++, st->pixels += w.count;
+        CHECK_MSG(run_both(gpu, emu, &w, NULL, 0, out, w.count, "render, level of detail"),
+                  "render with level of detail: device and C differ");
+    }
     free(in), free(out), free(rays), free(lods);
 }
 
@@ -200,14 +246,14 @@ static void run_target(vdag_gpu_target target, const char *name) {
         if (d) check_file(gpu, emu, d, NULL, 0x7A1 + (uint64_t)k, 400, &st);
         voxdag_free(d);
     }
-    /* dense scenes: each symmetry group, L = 3..7, some with voxcolor colours */
+    /* dense scenes: each symmetry group, L = 3..7, with voxcolor colours or none at level of detail */
     for (levels = 3, kind = RS_SPARSE, sym = 0; levels <= 7; levels++, kind = kind + 1 < RS_COUNT ? kind + 1 : RS_SPARSE, sym = (sym + 1) % 3) {
         rscene s;
         voxdag *d = rscene_make(&s, kind, levels, sym, 0x7B0 + levels);
         if (d) {
             check_file(gpu, emu, d, &s, 0x7C0 + levels, 1000, &st);
-            if (levels % 2) {
-                voxdag *v = with_voxcolor(d, levels == 5 ? 0.0 : 0.06, levels == 5 ? 10 : 6);
+            { /* odd L: voxcolor colours; even: the raw ones without level-of-detail colours */
+                voxdag *v = levels % 2 ? with_voxcolor(d, levels == 5 ? 0.0 : 0.06, levels == 5 ? 10 : 6) : without_lod_colors(d);
                 if (v) check_file(gpu, emu, v, &s, 0x7D0 + levels, 300, &st);
                 voxdag_free(v);
             }
@@ -216,11 +262,14 @@ static void run_target(vdag_gpu_target target, const char *name) {
         rscene_free(&s);
     }
     fprintf(stderr, "  %s: %llu runs; %llu rays (%llu hits, %llu LOD hits), %llu shadow rays, %llu near-ties; "
-            "%llu lookups; %llu pixels; %llu beam blocks starting later\n", name, (unsigned long long)st.runs, (unsigned long long)st.rays,
+            "%llu lookups; %llu cells (%llu full, %llu read from a level-of-detail slot); %llu pixels; "
+            "%llu beam blocks starting later\n", name, (unsigned long long)st.runs, (unsigned long long)st.rays,
             (unsigned long long)st.hits, (unsigned long long)st.lod_hits, (unsigned long long)st.occluded,
-            (unsigned long long)st.near_ties, (unsigned long long)st.lookups, (unsigned long long)st.pixels,
+            (unsigned long long)st.near_ties, (unsigned long long)st.lookups, (unsigned long long)st.cells,
+            (unsigned long long)st.full_cells, (unsigned long long)st.slot_cells, (unsigned long long)st.pixels,
             (unsigned long long)st.beam_blocks);
     CHECK(st.hits > 1000 && st.lod_hits > 100 && st.near_ties * 200 <= st.rays && st.beam_blocks > 100);
+    CHECK(st.full_cells > 5000 && st.slot_cells > 500);
     vdag_gpu_close(gpu);
     vdag_gpu_close(emu);
     voxdag_free(first);

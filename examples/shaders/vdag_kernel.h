@@ -19,12 +19,16 @@
                            in 1 per 8x8 block (row-major): BEAM's depth
      VDAG_KERNEL_BEAM      out 1 per 8x8 block of pixels: a depth before which none of
                            the block's rays meets a voxel (voxdag_gpu_frustum_depth)
-   rgb is 0x00BBGGRR, white for a file without colours.
+     VDAG_KERNEL_CELLS     in 4: level x y z; out 5: count_lo count_hi first_lo first_hi
+                           (voxdag_gpu_cell) rgb (voxdag_gpu_cell_color, as it returns)
+   rgb is 0x00BBGGRR (a level-of-detail hit's: its cell's mean colour),
+   white for a file without colours.
 
-   The picture model is examples/render.c's in float32, with two
-   differences: directions are f + sx r + sy u unnormalized (t is then the
-   depth along the view axis), and level of detail compares a cell with the
-   pixel size at that depth. */
+   The picture model is examples/render.c's in float32, level-of-detail
+   cells included (their mean colour, their staircase's lighting, the
+   shadow ray started past it), with two differences: directions are f +
+   sx r + sy u unnormalized (t is then the depth along the view axis), and
+   level of detail compares a cell with the pixel size at that depth. */
 #ifndef VDAG_KERNEL_H
 #define VDAG_KERNEL_H
 
@@ -33,6 +37,7 @@
 #define VDAG_KERNEL_LOOKUPS 2u
 #define VDAG_KERNEL_RENDER 3u
 #define VDAG_KERNEL_BEAM 4u
+#define VDAG_KERNEL_CELLS 5u
 #define VDAG_KERNEL_SHADOWS 1u    /* vdag_kernel_params.flags */
 #define VDAG_KERNEL_BEAM_START 2u /* RENDER: each ray starts at its block's BEAM depth (the input) */
 #define VDAG_KERNEL_BACKGROUND 0x00EBDACDu /* (205, 218, 235) */
@@ -51,10 +56,85 @@ struct vdag_kernel_params {
 typedef struct vdag_kernel_params vdag_kernel_params;
 #endif
 
-VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_rgb(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_u32 lo,
-                                               voxdag_gpu_u32 hi) {
-    voxdag_gpu_u32 c = voxdag_gpu_color(buf, f, lo, hi);
+/* Colour C as drawn: white for a file without colours. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_rgb(voxdag_gpu_u32 c) {
     return c == VOXDAG_GPU_NO_COLOR ? 0x00FFFFFFu : c;
+}
+
+/* The colour of hit H (with its index): a voxel's, or a level-of-detail
+   cell's mean. */
+VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_hit_rgb(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_hit h) {
+    return vdag_kernel_rgb(h.level == f.levels ? voxdag_gpu_color(buf, f, h.index_lo, h.index_hi) : voxdag_gpu_cell_color(buf, f, h));
+}
+
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_abs(voxdag_gpu_f32 x) {
+    return x < 0.0f ? -x : x;
+}
+
+/* Voxel count LO + 2^32 HI as a float, the same bits everywhere: 16-bit
+   pieces convert exactly, and each sum rounds once. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_count(voxdag_gpu_u32 lo, voxdag_gpu_u32 hi) {
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 h = voxdag_gpui_add(voxdag_gpui_mul_apart(VOXDAG_GPU_F32(hi >> 16), 65536.0f), VOXDAG_GPU_F32(hi & 0xFFFFu));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 l = voxdag_gpui_add(voxdag_gpui_mul_apart(VOXDAG_GPU_F32(lo >> 16), 65536.0f), VOXDAG_GPU_F32(lo & 0xFFFFu));
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 v = voxdag_gpui_add(voxdag_gpui_mul_apart(h, 4294967296.0f), l);
+    return v;
+}
+
+/* Axis K's component of the occupancy gradient at the level-of-detail
+   cell of H (side SIDE): the voxels of the neighbouring cell below along
+   K less those of the one above (outside the grid: none). */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_gradient(voxdag_gpu_buf buf, voxdag_gpu_file f, voxdag_gpu_hit h,
+                                                    voxdag_gpu_u32 side, voxdag_gpu_u32 k) {
+    voxdag_gpu_u32 sx = k == 0u ? side : 0u, sy = k == 1u ? side : 0u, sz = k == 2u ? side : 0u;
+    voxdag_gpu_cell_result below = voxdag_gpu_cell(buf, f, h.level, h.x - sx, h.y - sy, h.z - sz);
+    voxdag_gpu_cell_result above = voxdag_gpu_cell(buf, f, h.level, h.x + sx, h.y + sy, h.z + sz);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 m =
+        voxdag_gpui_sub(vdag_kernel_count(below.count_lo, below.count_hi), vdag_kernel_count(above.count_lo, above.count_hi));
+    return m;
+}
+
+/* The staircase's faces of one axis, whose gradient component is M (their
+   normal is sign(M) along the axis): their weight seen along direction
+   component D, |M| SCALE max(0, -D sign(M)), and their lighting by light
+   component L, max(0, L sign(M)). */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_seen(voxdag_gpu_f32 m, voxdag_gpu_f32 scale, voxdag_gpu_f32 d) {
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 facing = m < 0.0f ? d : -d;
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 seen = voxdag_gpui_mul_apart(voxdag_gpui_mul(vdag_kernel_abs(m), scale), facing);
+    return facing > 0.0f ? seen : 0.0f;
+}
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_lit_by(voxdag_gpu_f32 m, voxdag_gpu_f32 l) {
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 lit = m < 0.0f ? -l : l;
+    return lit > 0.0f ? lit : 0.0f;
+}
+
+/* The lighting of the level-of-detail cell that H stopped at, seen along
+   (DX, DY, DZ): examples/render.c's cell_lit in float32, its voxels'
+   staircase from the occupancy gradient m of the six neighbouring cells,
+   faces of axis k weighted by |m_k| max(0, -d . n_k) and lit by
+   max(0, n_k . l); FACE_LIT where none is seen. m is scaled by a power of
+   two (exactly) into [1, 2) at its largest, and the weighted mean divides
+   by the header's reciprocal: the same bits everywhere. */
+VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_cell_lit(voxdag_gpu_buf buf, voxdag_gpu_file f, vdag_kernel_params p,
+                                                    voxdag_gpu_hit h, voxdag_gpu_f32 dx, voxdag_gpu_f32 dy,
+                                                    voxdag_gpu_f32 dz, voxdag_gpu_f32 face_lit) {
+    voxdag_gpu_u32 side = 1u << (f.levels - h.level);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 mx = vdag_kernel_gradient(buf, f, h, side, 0u);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 my = vdag_kernel_gradient(buf, f, h, side, 1u);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 mz = vdag_kernel_gradient(buf, f, h, side, 2u);
+    VOXDAG_GPU_PRECISE voxdag_gpu_f32 top, scale, wx, wy, wz, num, den;
+    top = vdag_kernel_abs(mx);
+    top = vdag_kernel_abs(my) > top ? vdag_kernel_abs(my) : top;
+    top = vdag_kernel_abs(mz) > top ? vdag_kernel_abs(mz) : top;
+    if (!(top > 0.0f)) return face_lit;
+    scale = VOXDAG_GPU_BITS_FLOAT(0x7F000000u - (VOXDAG_GPU_FLOAT_BITS(top) & 0x7F800000u)); /* 2^-e for top's exponent e */
+    wx = vdag_kernel_seen(mx, scale, dx), wy = vdag_kernel_seen(my, scale, dy), wz = vdag_kernel_seen(mz, scale, dz);
+    den = voxdag_gpui_add(voxdag_gpui_add(wx, wy), wz);
+    num = voxdag_gpui_add(voxdag_gpui_add(voxdag_gpui_mul_apart(wx, vdag_kernel_lit_by(mx, p.l_x)),
+                                          voxdag_gpui_mul_apart(wy, vdag_kernel_lit_by(my, p.l_y))),
+                          voxdag_gpui_mul_apart(wz, vdag_kernel_lit_by(mz, p.l_z)));
+    if (!(den > 2.3283064e-10f)) return face_lit; /* below 2^-32: nothing seen (and the reciprocal's domain) */
+    num = voxdag_gpui_mul(num, voxdag_gpui_recip(den));
+    return num;
 }
 
 /* Channel C of RGB times FACTOR, rounded and clamped. */
@@ -126,13 +206,15 @@ VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_pixel(voxdag_gpu_buf buf, voxdag_gpu_
     ray.t_min = t_min, ray.t_max = 0.0f, ray.lod = p.lod, ray.flags = VOXDAG_GPU_WANT_INDEX;
     h = voxdag_gpu_raycast(buf, f, ray);
     if (h.hit == 0u) return VDAG_KERNEL_BACKGROUND;
-    rgb = vdag_kernel_rgb(buf, f, h.index_lo, h.index_hi);
+    rgb = vdag_kernel_hit_rgb(buf, f, h);
     if (h.nx != 0 || h.ny != 0 || h.nz != 0) {
         lit = h.nx != 0 ? VOXDAG_GPU_F32(h.nx) * p.l_x : h.ny != 0 ? VOXDAG_GPU_F32(h.ny) * p.l_y : VOXDAG_GPU_F32(h.nz) * p.l_z;
+        if (h.level < f.levels) lit = vdag_kernel_cell_lit(buf, f, p, h, dx, dy, dz, lit);
         factor = lit > 0.0f ? voxdag_gpui_add(p.ambient, voxdag_gpui_mul_apart(voxdag_gpui_sub(1.0f, p.ambient), lit)) : p.ambient;
         if ((p.flags & VDAG_KERNEL_SHADOWS) != 0u && lit > 0.0f) {
             /* from the hit point, exactly on the face plane (then it starts in
-               the neighbouring voxel), towards the light */
+               the neighbouring voxel), towards the light; from a
+               level-of-detail cell, past its own staircase (lit above) */
             voxdag_gpu_ray s;
             voxdag_gpu_u32 side = 1u << (f.levels - h.level);
             sox = voxdag_gpui_add(ray.ox, voxdag_gpui_mul_apart(h.t, dx));
@@ -142,7 +224,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_u32 vdag_kernel_pixel(voxdag_gpu_buf buf, voxdag_gpu_
             s.oy = h.ny != 0 ? VOXDAG_GPU_F32(h.y + (h.ny > 0 ? side : 0u)) : soy;
             s.oz = h.nz != 0 ? VOXDAG_GPU_F32(h.z + (h.nz > 0 ? side : 0u)) : soz;
             s.dx = p.l_x, s.dy = p.l_y, s.dz = p.l_z;
-            s.t_min = 0.0f, s.t_max = 0.0f, s.lod = 0.0f, s.flags = 0u;
+            s.t_min = h.level < f.levels ? VOXDAG_GPU_F32(side) : 0.0f, s.t_max = 0.0f, s.lod = 0.0f, s.flags = 0u;
             if (voxdag_gpu_occluded(buf, f, s) != 0u) factor = p.ambient;
         }
     }
@@ -180,14 +262,14 @@ VOXDAG_GPU_FUNC void vdag_kernel_run(voxdag_gpu_buf buf, vdag_kernel_io io, vdag
         VDAG_KERNEL_OUT(io, 12u * i + 8u, h.level);
         VDAG_KERNEL_OUT(io, 12u * i + 9u, h.index_lo);
         VDAG_KERNEL_OUT(io, 12u * i + 10u, h.index_hi);
-        VDAG_KERNEL_OUT(io, 12u * i + 11u, h.hit != 0u ? vdag_kernel_rgb(buf, f, h.index_lo, h.index_hi) : 0u);
+        VDAG_KERNEL_OUT(io, 12u * i + 11u, h.hit != 0u ? vdag_kernel_hit_rgb(buf, f, h) : 0u);
     } else if (p.mode == VDAG_KERNEL_LOOKUPS) {
         voxdag_gpu_lookup_result l =
             voxdag_gpu_lookup(buf, f, VDAG_KERNEL_IN(io, 3u * i), VDAG_KERNEL_IN(io, 3u * i + 1u), VDAG_KERNEL_IN(io, 3u * i + 2u));
         VDAG_KERNEL_OUT(io, 4u * i, l.found);
         VDAG_KERNEL_OUT(io, 4u * i + 1u, l.index_lo);
         VDAG_KERNEL_OUT(io, 4u * i + 2u, l.index_hi);
-        VDAG_KERNEL_OUT(io, 4u * i + 3u, l.found != 0u ? vdag_kernel_rgb(buf, f, l.index_lo, l.index_hi) : 0u);
+        VDAG_KERNEL_OUT(io, 4u * i + 3u, l.found != 0u ? vdag_kernel_rgb(voxdag_gpu_color(buf, f, l.index_lo, l.index_hi)) : 0u);
     } else if (p.mode == VDAG_KERNEL_RENDER) {
         voxdag_gpu_u32 x = i % p.width, y = i / p.width;
         voxdag_gpu_f32 t_min = 0.0f;
@@ -196,6 +278,18 @@ VOXDAG_GPU_FUNC void vdag_kernel_run(voxdag_gpu_buf buf, vdag_kernel_io io, vdag
         VDAG_KERNEL_OUT(io, i, vdag_kernel_pixel(buf, f, p, x, y, t_min));
     } else if (p.mode == VDAG_KERNEL_BEAM) {
         VDAG_KERNEL_OUT(io, i, VOXDAG_GPU_FLOAT_BITS(voxdag_gpu_frustum_depth(buf, f, vdag_kernel_frustum(p, i))));
+    } else if (p.mode == VDAG_KERNEL_CELLS) {
+        voxdag_gpu_hit h;
+        voxdag_gpu_cell_result c;
+        h.hit = 1u, h.t = 0.0f, h.nx = 0, h.ny = 0, h.nz = 0, h.index_lo = 0u, h.index_hi = 0u;
+        h.level = VDAG_KERNEL_IN(io, 4u * i), h.x = VDAG_KERNEL_IN(io, 4u * i + 1u);
+        h.y = VDAG_KERNEL_IN(io, 4u * i + 2u), h.z = VDAG_KERNEL_IN(io, 4u * i + 3u);
+        c = voxdag_gpu_cell(buf, f, h.level, h.x, h.y, h.z);
+        VDAG_KERNEL_OUT(io, 5u * i, c.count_lo);
+        VDAG_KERNEL_OUT(io, 5u * i + 1u, c.count_hi);
+        VDAG_KERNEL_OUT(io, 5u * i + 2u, c.first_lo);
+        VDAG_KERNEL_OUT(io, 5u * i + 3u, c.first_hi);
+        VDAG_KERNEL_OUT(io, 5u * i + 4u, voxdag_gpu_cell_color(buf, f, h));
     }
 }
 #endif
