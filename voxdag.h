@@ -699,23 +699,23 @@ VOXDAG_API int voxdag_occluded_opts(const voxdag *dag, const voxdag_ray *ray, co
    returns (1 or 0) and HITS[i] what it fills (untouched on a miss), bit for
    bit. Returns the number of hits; -1 (nothing written) when DAG is NULL,
    OPTS is invalid, or COUNT > 0 and RAYS, HITS or RESULT is NULL. Coherent
-   rays are faster: without level of detail, each run of up to 16
-   consecutive rays with t_min >= 0 and directions within a narrow cone (a
-   4 x 4 tile of primary rays, for example) is first checked as one beam
+   rays are faster: without level of detail, each run of up to 64
+   consecutive rays with t_min >= 0 and directions within a narrow cone (an
+   8 x 8 tile of primary rays, for example) is first checked as one beam
    against the DAG's nodes, and each ray then starts where that beam shows
-   nothing full before it. Thread-safe on a shared DAG; no allocation; stack
-   use bounded by VOXDAG_MAX_LEVELS. */
+   nothing full before it; other rays cost about what single calls do.
+   Thread-safe on a shared DAG; no allocation; stack use bounded by
+   VOXDAG_MAX_LEVELS. */
 VOXDAG_API int64_t voxdag_raycast_many(const voxdag *dag, const voxdag_ray *rays, size_t count,
                                        const voxdag_ray_opts *opts, voxdag_hit *hits, uint8_t *result);
 
 /* Many voxdag_occluded_opts calls at once: OCCLUDED[i] is what
    voxdag_occluded_opts(DAG, &RAYS[i], OPTS) returns (1 or 0). Returns the
    number of occluded rays; -1 (nothing written) when DAG is NULL, OPTS is
-   invalid, or COUNT > 0 and RAYS or OCCLUDED is NULL. Runs of up to 16
-   coherent rays (nearby origins, directions within a narrow cone: the
-   shadow rays of a tile of pixels towards one light) are checked as one
-   beam first, and each ray then stops where that beam shows nothing full
-   beyond. Thread-safe on a shared DAG; no allocation. */
+   invalid, or COUNT > 0 and RAYS or OCCLUDED is NULL. Coherent rays that
+   start away from surfaces (lines of sight from one eye) gain as in
+   voxdag_raycast_many; rays that leave a surface (shadow rays) cost about
+   what single calls do. Thread-safe on a shared DAG; no allocation. */
 VOXDAG_API int64_t voxdag_occluded_many(const voxdag *dag, const voxdag_ray *rays, size_t count,
                                         const voxdag_ray_opts *opts, uint8_t *occluded);
 
@@ -6512,20 +6512,20 @@ VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *w
 
 // -- Ray batches
 //
-// A run of coherent rays (a packet) is first checked as one beam: the space
-// the packet sweeps (every origin within r0 of a centre o, every unit
-// direction within angle a of an axis: a cone from o widened by r0) is
-// walked down the DAG once, and the full 2^3 cells of bricks it meets give
-// each ray a range outside which the ray meets nothing full. A ray then
-// traces only that range, which gives the same answer bit for bit: the
-// traversal's t are plane t's, the same whatever cell a trace starts from,
-// so a trace started at t_s in front of every full cell walks the cells
-// that the whole ray walks from t_s on, and a trace that stops beyond every
-// full cell misses nothing. Margins far above rounding (1e-6 voxel plus 1e-9
-// of the distance) keep the bounds safe; without level of detail only, since
-// a level-of-detail stop depends on where a trace enters a cell.
+// A run of coherent rays (a packet) is first checked as one beam (SSVDAG
+// 6's beam optimization, made exact): the space the packet sweeps (every
+// origin within r0 of a centre o, every unit direction within angle a of an
+// axis: a cone from o widened by r0) is walked down the DAG once, and the
+// nearest full 2^3 cell of a brick it meets gives each ray a distance t_s
+// before which it meets nothing full. A ray then traces from t_s, which
+// gives the same answer bit for bit: the traversal's t are plane t's, the
+// same whatever cell a trace starts from, so a trace started at t_s in
+// front of every full cell walks the cells that the whole ray walks from
+// t_s on. Margins far above rounding (1e-6 voxel plus 1e-9 of the distance)
+// keep the bound safe; without level of detail only, since a
+// level-of-detail stop depends on where a trace enters a cell.
 
-enum { VOXDAGI_PACKET = 16, VOXDAGI_BEAM_VISITS = 48 * VOXDAGI_PACKET };
+enum { VOXDAGI_PACKET = 64, VOXDAGI_BEAM_VISITS = 16 * VOXDAGI_PACKET };
 
 typedef struct voxdagi_beam {
     double o[3], axis[3]; /* the centre of the origins, the unit mean direction */
@@ -6581,56 +6581,55 @@ static int voxdagi_beam_make(const voxdag_ray *rays, size_t n, voxdagi_beam *b) 
 }
 
 /* The sphere of centre C and radius RAD against beam B: 0 when it lies
-   outside the swept space, else 1 with *NEAR and *FAR, bounds on the
-   distance from B's centre to its points. The distance from a point to
-   the cone's surface line in their common plane is at most its distance
-   to the cone (s along the axis, p across it): p cos a - s sin a. */
-static int voxdagi_beam_meets(const voxdagi_beam *b, const double c[3], double rad, double *near, double *far) {
+   outside the swept space, else 1 with *NEAR, a lower bound on the
+   distance from B's centre to its points. The distance from a point to the
+   cone's surface line in their common plane is at most its distance to
+   the cone (s along the axis, p across it): p cos a - s sin a. */
+static int voxdagi_beam_meets(const voxdagi_beam *b, const double c[3], double rad, double *near) {
     double v[3], dv, reach;
     unsigned k;
     for (k = 0; k < 3; k++) v[k] = c[k] - b->o[k];
     dv = sqrt(voxdagi_dot3(v, v));
     rad += 1e-6 + 1e-9 * dv;
     reach = rad + b->r0;
-    *near = dv - rad, *far = dv + rad;
+    *near = dv - rad;
     return dv <= reach || voxdagi_cross_len(v, b->axis) * b->cos_a - voxdagi_dot3(v, b->axis) * b->sin_a <= reach;
 }
 
-/* The nearest (FAR 0) or farthest (FAR 1) distance bound from beam B's
-   centre over the full 2^3 cells of bricks that B meets: HUGE_VAL (FAR 0)
-   or -HUGE_VAL (FAR 1) when it meets none. Returns 0 when the walk would
-   cost more than tracing the rays one by one (VOXDAGI_BEAM_VISITS nodes).
-   A depth-first walk, children nearest first (farthest for FAR) so that
-   the bound found early prunes the rest. */
-static int voxdagi_beam_bound(const voxdag *d, const voxdagi_beam *b, int far, double *bound) {
+/* A lower bound on the distance from beam B's centre to the full 2^3
+   cells of bricks that B meets: HUGE_VAL when it meets none. Returns 0 when
+   the walk would cost more than it saves (VOXDAGI_BEAM_VISITS nodes), or
+   as soon as a full cell lies within r0 (no ray would start later). A
+   depth-first walk, children nearest first, so that the bound found early
+   prunes the rest. */
+static int voxdagi_beam_bound(const voxdag *d, const voxdagi_beam *b, double *bound) {
     struct item {
         uint64_t at;
         uint32_t xyz[3], l;
         unsigned mi;
     } stack[7 * VOXDAG_MAX_LEVELS + 1];
     const uint32_t nlevels = d->levels, brick_level = nlevels - 2;
-    unsigned first = 0, k, visits = 0; /* first: the octant nearest along the axis (farthest for FAR) */
+    unsigned first = 0, k, visits = 0; /* first: the octant nearest along the axis */
     size_t n = 1; /* items on the stack: at most 7 per level and the root */
-    double best = far ? -HUGE_VAL : HUGE_VAL;
-    for (k = 0; k < 3; k++) first |= (unsigned)((b->axis[k] < 0) != (far != 0)) << k;
+    double best = HUGE_VAL;
+    for (k = 0; k < 3; k++) first |= (unsigned)(b->axis[k] < 0) << k;
     stack[0].at = 0, stack[0].l = 0, stack[0].mi = voxdagi_cube_tables.inv[d->root_transform];
     stack[0].xyz[0] = stack[0].xyz[1] = stack[0].xyz[2] = 0;
     while (n > 0) {
         struct item it = stack[--n];
-        double size = (double)(1u << (nlevels - it.l)), c[3], lo, hi;
+        double size = (double)(1u << (nlevels - it.l)), c[3], near;
         if (++visits > VOXDAGI_BEAM_VISITS) return 0;
         for (k = 0; k < 3; k++) c[k] = it.xyz[k] + size / 2;
-        if (!voxdagi_beam_meets(b, c, size * 0.8660254037844387, &lo, &hi) || (far ? hi <= best : lo >= best))
-            continue;
+        if (!voxdagi_beam_meets(b, c, size * 0.8660254037844387, &near) || near >= best) continue;
         if (it.l == brick_level) { /* its 2^3 cells: one byte of the mask each */
             uint64_t mask = voxdagi_brick_to_world(voxdagi_brick(d, it.at), it.mi);
             for (k = 0; k < 8; k++) {
                 c[0] = it.xyz[0] + (k & 1 ? 3 : 1), c[1] = it.xyz[1] + (k & 2 ? 3 : 1);
                 c[2] = it.xyz[2] + (k & 4 ? 3 : 1);
-                if ((mask >> 8 * k & 0xFF) && voxdagi_beam_meets(b, c, 1.7320508075688774, &lo, &hi) &&
-                    (far ? hi > best : lo < best))
-                    best = far ? hi : lo;
+                if ((mask >> 8 * k & 0xFF) && voxdagi_beam_meets(b, c, 1.7320508075688774, &near) && near < best)
+                    best = near;
             }
+            if (best <= b->r0) return 0; /* a full cell within reach of an origin: no ray gains */
         } else {
             const uint8_t *rec = d->level[it.l].data + it.at;
             unsigned header = voxdagi_le16(rec), occ = voxdagi_occupancy[it.mi][voxdagi_presence(header)], j;
@@ -6652,34 +6651,43 @@ static int voxdagi_beam_bound(const voxdag *d, const voxdagi_beam *b, int far, d
     return 1;
 }
 
-/* Narrows RAY to what beam B with distance BOUND (voxdagi_beam_bound, FAR
-   as there) leaves it: t_min raised to where it is still nearer than any
-   full cell (FAR 0), or t_max lowered, closed (*OPEN 0), to where it is
-   past every full cell (FAR 1). Returns 0 when the ray can meet nothing. */
-static int voxdagi_beam_narrow(const voxdagi_beam *b, double bound, int far, voxdag_ray *ray, int *open) {
-    double len = sqrt(voxdagi_dot3(ray->dir, ray->dir)), t, t_max;
-    if (far ? bound == -HUGE_VAL : bound == HUGE_VAL) return 0;
-    if (!far) {
-        t = (bound - b->r0) / len * (1 - 1e-9);
-        if (t > ray->t_min) ray->t_min = t;
-        return 1;
-    }
-    t = (bound + b->r0) / len * (1 + 1e-9);
-    t_max = *open ? ray->t_max : ray->t_max == 0 ? HUGE_VAL : ray->t_max;
-    if (t < t_max) ray->t_max = t, *open = 0;
+/* Raises RAY's t_min to where it is still nearer than any full cell that
+   beam B meets, by BOUND (voxdagi_beam_bound). Returns 0 when the ray
+   meets nothing full. */
+static int voxdagi_beam_narrow(const voxdagi_beam *b, double bound, voxdag_ray *ray) {
+    double t = (bound - b->r0) / sqrt(voxdagi_dot3(ray->dir, ray->dir)) * (1 - 1e-9);
+    if (bound == HUGE_VAL) return 0;
+    if (t > ray->t_min) ray->t_min = t;
     return 1;
+}
+
+/* Whether any of the 2^3 voxels nearest RAY's origin is full: a ray that
+   leaves a surface (a shadow or reflection ray) cannot start later, so its
+   packet is traced without a beam. */
+static int voxdagi_starts_at_surface(const voxdag *d, const voxdag_ray *ray) {
+    uint32_t xyz[24], k, j;
+    for (j = 0; j < 8; j++)
+        for (k = 0; k < 3; k++) {
+            double v = floor(ray->origin[k] - 0.5) + (double)(j >> k & 1);
+            xyz[3 * j + k] = v >= 0 && v < 4294967295.0 ? (uint32_t)v : UINT32_MAX; /* outside: empty */
+        }
+    return voxdag_lookup_many(d, xyz, 8, NULL, NULL) > 0;
 }
 
 /* Both batch queries (HITS NULL: any hit), OPTS checked: packets of
    consecutive rays that may join one, each narrowed by its beam, and the
-   rays that may not traced alone. */
+   rays that may not traced alone. A packet that starts at a surface gets
+   no beam, and a beam that narrows none of its rays (incoherent rays) is
+   not tried again for the next 1, 2, 4 ... 64 packets, so that such
+   batches cost about what single calls do. */
 static int64_t voxdagi_query_many(const voxdag *d, const voxdag_ray *rays, size_t count, const voxdag_ray_opts *opts,
                                   voxdag_hit *hits, uint8_t *result) {
     uint64_t steps = 0;
     int64_t found = 0;
     size_t i = 0, n, j;
+    unsigned skip = 0, backoff = 1; /* packets left without a beam; the next such run */
     double lod;
-    int want_index = opts && opts->want_index, far = hits == NULL, ok;
+    int want_index = opts && opts->want_index, open = opts && opts->t_max_exclusive, ok;
 #ifdef VOXDAGI_X87
     unsigned cw = voxdagi_x87_begin();
 #endif
@@ -6687,18 +6695,23 @@ static int64_t voxdagi_query_many(const voxdag *d, const voxdag_ray *rays, size_
     while (ok && i < count) {
         voxdagi_beam b;
         double bound = 0;
-        int beam;
+        int beam = 0, tried = 0, narrowed = 0;
         for (n = 0; i + n < count && n < VOXDAGI_PACKET && lod == 0 && d->voxels && voxdagi_beam_ray(&rays[i + n]);) n++;
-        beam = n > 0 && voxdagi_beam_make(rays + i, n, &b) && voxdagi_beam_bound(d, &b, far, &bound);
+        if (n > 0 && skip > 0) skip--;
+        else if (n > 0 && !voxdagi_starts_at_surface(d, &rays[i]))
+            tried = 1, beam = voxdagi_beam_make(rays + i, n, &b) && voxdagi_beam_bound(d, &b, &bound);
         if (n == 0) n = 1;
         for (j = i; j < i + n; j++) {
             voxdag_ray ray = rays[j];
-            int open = opts && opts->t_max_exclusive, got = 0;
-            if (!beam || voxdagi_beam_narrow(&b, bound, far, &ray, &open))
-                got = voxdagi_trace(d, &ray, lod, want_index, open, hits ? &hits[j] : NULL, &steps);
+            int got = 0, meets = !beam || voxdagi_beam_narrow(&b, bound, &ray);
+            narrowed += !meets || ray.t_min != rays[j].t_min;
+            if (meets && hits) got = voxdagi_trace(d, &ray, lod, want_index, open, &hits[j], &steps);
+            else if (meets) got = voxdagi_trace(d, &ray, lod, 0, open, NULL, &steps); /* any hit: a lighter copy */
             result[j] = (uint8_t)got;
             found += got;
         }
+        if (tried && narrowed) backoff = 1;
+        else if (tried) skip = backoff, backoff = backoff < 64 ? 2 * backoff : 64;
         i += n;
     }
 #ifdef VOXDAGI_X87

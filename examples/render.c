@@ -271,7 +271,7 @@ typedef struct render_job {
     pthread_mutex_t lock;
 } render_job;
 
-enum { TILE = 32, BLOCK = 4, BLOCK_RAYS = BLOCK * BLOCK * 64 }; /* 64: --samples at most 8 x 8 */
+enum { TILE = 32, BLOCK = 8, BLOCK_RAYS = BLOCK * BLOCK * 64 }; /* 64: --samples at most 8 x 8 */
 
 /* The rays of a block of BLOCK x BLOCK pixels and their answers, traced
    together (voxdag_raycast_many, then voxdag_occluded_many for the shadow

@@ -435,11 +435,12 @@ static void test_lookup_many(void) {
    rays from lattice points (ties through edges and corners, origins on
    faces), rays leaving the hits of a tile towards one light (shadow rays),
    random rays, and rays that no packet may take (NaN and zero directions,
-   t_min < 0, rays missing the grid), mixed into one another. */
+   t_min < 0, rays missing the grid), mixed into one another; half the
+   groups are 8 x 8, the library's packet. */
 static void make_batch(const voxdag *d, uint32_t n, uint64_t *r, voxdag_ray *rays, size_t count) {
     size_t i = 0, k;
     while (i < count) {
-        uint32_t shape = test_rand_below(r, 6), side = 1 + test_rand_below(r, 8), a, b;
+        uint32_t shape = test_rand_below(r, 6), side = test_rand_below(r, 2) ? 8 : 1 + test_rand_below(r, 8), a, b;
         double eye[3], f[3], u[3], v[3], pixel = rand_in(r, 1e-4, 0.1), dir[3];
         voxdag_ray base = make_ray(r, n);
         for (k = 0; k < 3; k++) {
