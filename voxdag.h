@@ -6581,18 +6581,18 @@ static int voxdagi_beam_make(const voxdag_ray *rays, size_t n, voxdagi_beam *b) 
 }
 
 /* The sphere of centre C and radius RAD against beam B: 0 when it lies
-   outside the swept space, else 1 with *NEAR, a lower bound on the
+   outside the swept space, else 1 with *LOWER, a lower bound on the
    distance from B's centre to its points. The distance from a point to the
    cone's surface line in their common plane is at most its distance to
    the cone (s along the axis, p across it): p cos a - s sin a. */
-static int voxdagi_beam_meets(const voxdagi_beam *b, const double c[3], double rad, double *near) {
+static int voxdagi_beam_meets(const voxdagi_beam *b, const double c[3], double rad, double *lower) {
     double v[3], dv, reach;
     unsigned k;
     for (k = 0; k < 3; k++) v[k] = c[k] - b->o[k];
     dv = sqrt(voxdagi_dot3(v, v));
     rad += 1e-6 + 1e-9 * dv;
     reach = rad + b->r0;
-    *near = dv - rad;
+    *lower = dv - rad;
     return dv <= reach || voxdagi_cross_len(v, b->axis) * b->cos_a - voxdagi_dot3(v, b->axis) * b->sin_a <= reach;
 }
 
@@ -6617,17 +6617,17 @@ static int voxdagi_beam_bound(const voxdag *d, const voxdagi_beam *b, double *bo
     stack[0].xyz[0] = stack[0].xyz[1] = stack[0].xyz[2] = 0;
     while (n > 0) {
         struct item it = stack[--n];
-        double size = (double)(1u << (nlevels - it.l)), c[3], near;
+        double size = (double)(1u << (nlevels - it.l)), c[3], lower;
         if (++visits > VOXDAGI_BEAM_VISITS) return 0;
         for (k = 0; k < 3; k++) c[k] = it.xyz[k] + size / 2;
-        if (!voxdagi_beam_meets(b, c, size * 0.8660254037844387, &near) || near >= best) continue;
+        if (!voxdagi_beam_meets(b, c, size * 0.8660254037844387, &lower) || lower >= best) continue;
         if (it.l == brick_level) { /* its 2^3 cells: one byte of the mask each */
             uint64_t mask = voxdagi_brick_to_world(voxdagi_brick(d, it.at), it.mi);
             for (k = 0; k < 8; k++) {
                 c[0] = it.xyz[0] + (k & 1 ? 3 : 1), c[1] = it.xyz[1] + (k & 2 ? 3 : 1);
                 c[2] = it.xyz[2] + (k & 4 ? 3 : 1);
-                if ((mask >> 8 * k & 0xFF) && voxdagi_beam_meets(b, c, 1.7320508075688774, &near) && near < best)
-                    best = near;
+                if ((mask >> 8 * k & 0xFF) && voxdagi_beam_meets(b, c, 1.7320508075688774, &lower) && lower < best)
+                    best = lower;
             }
             if (best <= b->r0) return 0; /* a full cell within reach of an origin: no ray gains */
         } else {
