@@ -35,7 +35,10 @@
 typedef struct rays {
     size_t n;
     double eye[3], *dir; /* 3 per ray, normalized */
+    uint32_t *order;     /* the ray indices in 8 x 8 tiles, tile rows top to bottom (batches, packets) */
 } rays;
+
+enum { TILE = 8, CHUNK = 256 }; /* a batch call: 4 tiles */
 
 static void make_rays(const bscene *s, uint32_t size, rays *r) {
     double lo[3] = {1e30, 1e30, 1e30}, hi[3] = {-1e30, -1e30, -1e30}, c[3], rad = 0, f[3] = {-0.6, -1.0, -0.8};
@@ -65,6 +68,14 @@ static void make_rays(const bscene *s, uint32_t size, rays *r) {
             len = sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
             for (k = 0; k < 3; k++) d[k] /= len;
         }
+    r->order = (uint32_t *)bench_xmalloc(r->n * sizeof(uint32_t));
+    i = 0;
+    for (y = 0; y < size; y += TILE)
+        for (x = 0; x < size; x += TILE) {
+            uint32_t a, b;
+            for (b = y; b < y + TILE && b < size; b++)
+                for (a = x; a < x + TILE && a < size; a++) r->order[i++] = b * size + a;
+        }
 }
 
 // -- Timed runs over all rays, split across threads by interleaved rows
@@ -75,16 +86,89 @@ typedef struct run {
     const bench_v2 *v2;
     const bench_peer *peer;
     const void *embree; /* an RTCScene */
+    unsigned packet;    /* voxdag: 0 one call per ray, else voxdag_raycast_many on CHUNK rays in tile order;
+                           Embree: 1 rtcIntersect1, 8 or 16 rtcIntersect8/16 on 8 x 1 and 8 x 2 parts of tiles */
     uint32_t *hit_xyz; /* 3 per ray; UINT32_MAX = miss */
     uint64_t *hit_index; /* voxdag and version 2: the hit voxel's index, when not NULL */
     unsigned thread, threads;
     size_t hits;
 } run;
 
+/* voxdag_raycast_many on chunks of CHUNK rays in tile order, chunks
+   interleaved between threads. */
+static void run_batches(run *w) {
+    voxdag_ray chunk[CHUNK];
+    voxdag_hit hits[CHUNK];
+    uint8_t got[CHUNK];
+    size_t c, j, m;
+    for (c = (size_t)w->thread * CHUNK; c < w->r->n; c += (size_t)w->threads * CHUNK) {
+        m = w->r->n - c < CHUNK ? w->r->n - c : CHUNK;
+        for (j = 0; j < m; j++) {
+            memcpy(chunk[j].origin, w->r->eye, sizeof chunk[j].origin);
+            memcpy(chunk[j].dir, w->r->dir + 3 * (size_t)w->r->order[c + j], sizeof chunk[j].dir);
+            chunk[j].t_min = 0, chunk[j].t_max = HUGE_VAL;
+        }
+        voxdag_raycast_many(w->dag, chunk, m, NULL, hits, got);
+        for (j = 0; j < m; j++) {
+            uint32_t *out = w->hit_xyz + 3 * (size_t)w->r->order[c + j];
+            if (got[j]) memcpy(out, hits[j].xyz, sizeof hits[j].xyz);
+            else out[0] = out[1] = out[2] = UINT32_MAX;
+            w->hits += got[j];
+        }
+    }
+}
+
+#ifdef BENCH_EMBREE
+/* Embree's packets of N rays (RTCRayHitN) on tiles in tile order, packets
+   interleaved between threads; hits are marked as in run_worker. */
+#define EMBREE_PACKETS(N)                                                                                         \
+    static void run_embree##N(run *w) {                                                                           \
+        struct RTCIntersectContext ctx;                                                                           \
+        struct RTCRayHit##N rh;                                                                                   \
+        int valid[N];                                                                                             \
+        size_t c, j, m;                                                                                           \
+        rtcInitIntersectContext(&ctx);                                                                            \
+        ctx.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;                                                          \
+        for (c = (size_t)w->thread * N; c < w->r->n; c += (size_t)w->threads * N) {                               \
+            m = w->r->n - c < N ? w->r->n - c : N;                                                                \
+            memset(&rh, 0, sizeof rh);                                                                            \
+            for (j = 0; j < N; j++) {                                                                             \
+                const double *d = w->r->dir + 3 * (size_t)w->r->order[c + (j < m ? j : 0)];                       \
+                valid[j] = j < m ? -1 : 0;                                                                        \
+                rh.ray.org_x[j] = (float)w->r->eye[0], rh.ray.org_y[j] = (float)w->r->eye[1];                     \
+                rh.ray.org_z[j] = (float)w->r->eye[2];                                                            \
+                rh.ray.dir_x[j] = (float)d[0], rh.ray.dir_y[j] = (float)d[1], rh.ray.dir_z[j] = (float)d[2];      \
+                rh.ray.tnear[j] = 0, rh.ray.tfar[j] = INFINITY, rh.ray.mask[j] = ~0u;                             \
+                rh.hit.geomID[j] = RTC_INVALID_GEOMETRY_ID;                                                       \
+            }                                                                                                     \
+            rtcIntersect##N(valid, (RTCScene)(uintptr_t)w->embree, &ctx, &rh);                                    \
+            for (j = 0; j < m; j++) {                                                                             \
+                uint32_t *out = w->hit_xyz + 3 * (size_t)w->r->order[c + j];                                      \
+                int got = rh.hit.geomID[j] != RTC_INVALID_GEOMETRY_ID;                                            \
+                out[0] = out[1] = out[2] = got ? 0 : UINT32_MAX;                                                  \
+                w->hits += (size_t)got;                                                                           \
+            }                                                                                                     \
+        }                                                                                                         \
+    }
+EMBREE_PACKETS(8)
+EMBREE_PACKETS(16)
+#endif
+
 static void *run_worker(void *arg) {
     run *w = (run *)arg;
     size_t i;
     w->hits = 0;
+    if (w->packet && w->dag) {
+        run_batches(w);
+        return NULL;
+    }
+#ifdef BENCH_EMBREE
+    if (w->packet == 8 || w->packet == 16) {
+        if (w->packet == 8) run_embree8(w);
+        else run_embree16(w);
+        return NULL;
+    }
+#endif
     for (i = w->thread; i < w->r->n; i += w->threads) {
         uint32_t *out = w->hit_xyz + 3 * i;
         int got;
@@ -142,8 +226,8 @@ typedef struct speed {
 } speed;
 
 /* Best of 3 runs; fills HIT_XYZ. */
-static speed timed(const rays *r, const voxdag *dag, const bench_v2 *v2, const bench_peer *peer, const void *embree,
-                   unsigned threads, uint32_t *hit_xyz, size_t *hits) {
+static speed timed_packets(const rays *r, const voxdag *dag, const bench_v2 *v2, const bench_peer *peer,
+                           const void *embree, unsigned packet, unsigned threads, uint32_t *hit_xyz, size_t *hits) {
     speed best = {0, 0};
     int rep;
     for (rep = 0; rep < 3; rep++) {
@@ -154,7 +238,7 @@ static speed timed(const rays *r, const voxdag *dag, const bench_v2 *v2, const b
         *hits = 0;
         for (t = 0; t < threads; t++) {
             w[t].r = r, w[t].dag = dag, w[t].v2 = v2, w[t].peer = peer, w[t].embree = embree;
-            w[t].hit_xyz = hit_xyz, w[t].hit_index = NULL;
+            w[t].hit_xyz = hit_xyz, w[t].hit_index = NULL, w[t].packet = packet;
             w[t].thread = t, w[t].threads = threads;
             if (threads == 1) run_worker(&w[0]);
             else pthread_create(&tid[t], NULL, run_worker, &w[t]);
@@ -169,6 +253,12 @@ static speed timed(const rays *r, const voxdag *dag, const bench_v2 *v2, const b
         if (cpu > 0 && r->n / cpu > best.cpu) best.cpu = (double)r->n / cpu;
     }
     return best;
+}
+
+/* One call per ray (rtcIntersect1 for Embree). */
+static speed timed(const rays *r, const voxdag *dag, const bench_v2 *v2, const bench_peer *peer, const void *embree,
+                   unsigned threads, uint32_t *hit_xyz, size_t *hits) {
+    return timed_packets(r, dag, v2, peer, embree, 0, threads, hit_xyz, hits);
 }
 
 // -- Scenes: the DAG, the voxels (for NanoVDB), the source triangles (for Embree)
@@ -225,6 +315,47 @@ static RTCScene embree_scene(RTCDevice dev, const bmesh *s) {
     return sc;
 }
 #endif
+
+// -- Batches: primary rays through voxdag_raycast_many, shadow rays through voxdag_occluded_many
+
+static const double LIGHT[3] = {0.5, 0.3, 0.8}; /* towards the light, as vdag render's default */
+
+/* Shadow rays towards LIGHT from the lit hits of R's rays (voxdag_ray_from_hit),
+   in tile order, as a renderer casts them; *N: how many. */
+static voxdag_ray *shadow_rays(const rays *r, const voxdag *dag, size_t *n) {
+    voxdag_ray *out = (voxdag_ray *)bench_xmalloc((r->n + 1) * sizeof *out), ray;
+    voxdag_hit hit;
+    size_t i;
+    *n = 0;
+    memset(&ray, 0, sizeof ray);
+    memcpy(ray.origin, r->eye, sizeof ray.origin);
+    ray.t_max = HUGE_VAL;
+    for (i = 0; i < r->n; i++) {
+        memcpy(ray.dir, r->dir + 3 * (size_t)r->order[i], sizeof ray.dir);
+        if (voxdag_raycast(dag, &ray, NULL, &hit) == 1 && voxdag_ray_from_hit(dag, &ray, &hit, LIGHT, &out[*n]) > 0)
+            ++*n;
+    }
+    return out;
+}
+
+/* Shadow rays per CPU-second, best of 3, one thread: voxdag_occluded per
+   ray (BATCH 0) or voxdag_occluded_many on CHUNK rays at a time; OCC: the
+   answers. */
+static double timed_shadows(const voxdag *dag, const voxdag_ray *shadow, size_t n, int batch, uint8_t *occ) {
+    double best = 0;
+    int rep;
+    for (rep = 0; rep < 3; rep++) {
+        double c0 = cpu_seconds(), cpu;
+        size_t i;
+        for (i = 0; i < n; i += batch ? CHUNK : 1) {
+            if (batch) voxdag_occluded_many(dag, shadow + i, n - i < CHUNK ? n - i : CHUNK, NULL, occ + i);
+            else occ[i] = (uint8_t)voxdag_occluded(dag, &shadow[i]);
+        }
+        cpu = cpu_seconds() - c0;
+        if (cpu > 0 && n / cpu > best) best = (double)n / cpu;
+    }
+    return best;
+}
 
 // -- Format version 3 against version 2: the same rays and points
 
@@ -343,7 +474,7 @@ int main(int argc, char **argv) {
     unsigned threads;
     long cpus = sysconf(_SC_NPROCESSORS_ONLN);
     size_t k;
-    char path[512], versions[4096] = "";
+    char path[512], versions[4096] = "", batches[4096] = "";
     static const struct {
         const char *file;
         uint32_t L;
@@ -382,8 +513,14 @@ int main(int argc, char **argv) {
         voxdag_info info;
         rays r;
         uint32_t *mine;
-        size_t hits;
-        speed mine_speed[2];
+        size_t hits, batch_hits, shadow_n, ray_i, same_batch = 0, same_shadows = 0;
+        speed mine_speed[2], single = {0, 0}, batch = {0, 0}, t, embree_best = {0, 0};
+        const char *embree_call = "";
+        uint32_t *batch_xyz;
+        voxdag_ray *shadows;
+        uint8_t *occ1, *occ2;
+        double shadow1 = 0, shadow2 = 0, u;
+        int rep;
         if (quick ? plan[k].full_only : plan[k].L == 10) continue;
         memset(&s, 0, sizeof s);
         snprintf(path, sizeof path, "%s/%s", dir, plan[k].file);
@@ -405,6 +542,22 @@ int main(int argc, char **argv) {
         row(s.v.name, s.v.levels, s.v.n, "voxdag", (info.node_bytes + info.brick_bytes) / 1e6, hits, r.n,
             mine_speed[0], mine_speed[1], NULL, -1);
         fflush(stdout);
+        /* batch against one call per ray, in turn (best of 9 each), so that a
+           change in the machine's load moves both */
+        batch_xyz = (uint32_t *)bench_xmalloc(3 * r.n * sizeof(uint32_t));
+        for (rep = 0; rep < 3; rep++) {
+            if ((t = timed(&r, s.dag, NULL, NULL, NULL, 1, mine, &hits)).cpu > single.cpu) single = t;
+            if ((t = timed_packets(&r, s.dag, NULL, NULL, NULL, 1, 1, batch_xyz, &batch_hits)).cpu > batch.cpu) batch = t;
+        }
+        for (ray_i = 0; ray_i < r.n; ray_i++)
+            same_batch += !memcmp(mine + 3 * ray_i, batch_xyz + 3 * ray_i, 3 * sizeof(uint32_t));
+        shadows = shadow_rays(&r, s.dag, &shadow_n);
+        occ1 = (uint8_t *)bench_xmalloc(shadow_n + 1), occ2 = (uint8_t *)bench_xmalloc(shadow_n + 1);
+        for (rep = 0; rep < 3; rep++) {
+            if ((u = timed_shadows(s.dag, shadows, shadow_n, 0, occ1)) > shadow1) shadow1 = u;
+            if ((u = timed_shadows(s.dag, shadows, shadow_n, 1, occ2)) > shadow2) shadow2 = u;
+        }
+        for (ray_i = 0; ray_i < shadow_n; ray_i++) same_shadows += occ1[ray_i] == occ2[ray_i];
 #ifdef BENCH_NANOVDB
         {
             size_t bytes, same = 0, j, peer_hits;
@@ -429,6 +582,11 @@ int main(int argc, char **argv) {
             es = embree_scene(dev, &s.mesh);
             one = timed(&r, NULL, NULL, NULL, es, 1, theirs, &peer_hits);
             all = timed(&r, NULL, NULL, NULL, es, threads, theirs, &peer_hits);
+            embree_best = one, embree_call = "rtcIntersect1";
+            if ((t = timed_packets(&r, NULL, NULL, NULL, es, 8, 1, theirs, &peer_hits)).cpu > embree_best.cpu)
+                embree_best = t, embree_call = "rtcIntersect8";
+            if ((t = timed_packets(&r, NULL, NULL, NULL, es, 16, 1, theirs, &peer_hits)).cpu > embree_best.cpu)
+                embree_best = t, embree_call = "rtcIntersect16";
             row(s.v.name, s.v.levels, s.v.n, "Embree (triangles)", embree_bytes / 1e6, peer_hits, r.n, one, all,
                 mine_speed, -1);
             rtcReleaseScene(es);
@@ -436,7 +594,21 @@ int main(int argc, char **argv) {
         }
 #endif
         fflush(stdout);
+        {
+            size_t len = strlen(batches);
+            char embree_cols[128] = "| | | ";
+            if (embree_best.cpu > 0)
+                snprintf(embree_cols, sizeof embree_cols, "| %.2f (`%s`) | %.2f | **%.2f** ", embree_best.cpu * 1e-6,
+                         embree_call, single.cpu / embree_best.cpu, batch.cpu / embree_best.cpu);
+            snprintf(batches + len, sizeof batches - len,
+                     "| %s | %u | %.2f | %.2f | **%.2f** %s| %zu | %.2f | %.2f | **%.2f** | %s |\n", s.v.name,
+                     s.v.levels, single.cpu * 1e-6, batch.cpu * 1e-6, batch.cpu / single.cpu, embree_cols, shadow_n,
+                     shadow1 * 1e-6, shadow2 * 1e-6, shadow2 / shadow1,
+                     same_batch == r.n && same_shadows == shadow_n ? "yes" : "**no**");
+        }
+        free(batch_xyz), free(shadows), free(occ1), free(occ2);
         versions_row(&s, &r, threads, versions + strlen(versions), sizeof versions - strlen(versions));
+        free(r.order);
         free(mine);
         free(r.dir);
         bmesh_free(&s.mesh);
@@ -448,6 +620,18 @@ int main(int argc, char **argv) {
            "process CPU time (getrusage), less sensitive than wall-clock time to other jobs on a shared machine. "
            "Speed-up: voxdag's rays per CPU-second divided by the peer's. Mesh voxels come from "
            "`voxdag_builder_add_mesh` (exact conservative voxelization, the grid fitted to the bounding box).\n");
+    printf("\n### Ray batches (1 thread, rays per CPU-second)\n\n"
+           "| scene | L | voxdag_raycast Mrays/CPU-s | voxdag_raycast_many Mrays/CPU-s | batch / single "
+           "| Embree at its best Mrays/CPU-s | single / Embree | batch / Embree | shadow rays "
+           "| voxdag_occluded Mrays/CPU-s | voxdag_occluded_many Mrays/CPU-s | batch / single | same answers |\n"
+           "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n%s\n"
+           "The primary rays above; batches of %d rays in 8 x 8 tiles (`voxdag_raycast_many`), one call per ray and "
+           "the batches timed in turn (best of 9 each). Embree at its best: the fastest of `rtcIntersect1` and its "
+           "packets of 8 (8 x 1 in a tile) and 16 (8 x 2, coherent flag), one thread. Shadow rays: from the lit "
+           "hits towards (0.5, 0.3, 0.8) through `voxdag_ray_from_hit`, in tile order, `voxdag_occluded` per ray "
+           "against `voxdag_occluded_many` on %d rays at a time, in turn (best of 9 each). Same: the batch calls "
+           "give every ray's hit voxel and every shadow ray's answer of the single calls, checked in this run.\n",
+           batches, (int)CHUNK, (int)CHUNK);
     if (versions[0])
         printf("\n### Format version 3 against version 2 (same voxels, rays and points; 1 thread)\n\n"
                "| scene | L | voxels | v3 Mrays/CPU-s | v2 Mrays/CPU-s | v3 / v2 rays | lookup points | v3 M lookups/CPU-s "

@@ -280,7 +280,7 @@ typedef struct render_job {
     pthread_mutex_t lock;
 } render_job;
 
-enum { TILE = 32 };
+enum { TILE = 32, BLOCK = 8, BLOCK_RAYS = BLOCK * BLOCK * 64 }; /* 64: --samples at most 8 x 8 */
 
 /* Lighting of a level-of-detail cell that HIT stopped at: its voxels'
    faces, not the cell's box, as the supersampled full-detail picture sees
@@ -311,76 +311,107 @@ static double cell_lit(const render_job *job, const voxdag_hit *hit, const doubl
     return den > 0 ? num / den : face_lit;
 }
 
-/* The colour of the ray through pixel (I, J) of a W x H picture of the view. */
-static void render_sample(const render_job *job, uint32_t i, uint32_t j, double w, double h, uint8_t *out) {
-    const camera *c = &job->cam;
+/* The rays of a block of BLOCK x BLOCK pixels and their answers, traced
+   together (voxdag_raycast_many, then voxdag_occluded_many for the shadow
+   rays of the lit faces), in BLOCK x BLOCK tiles of samples so that
+   neighbouring rays go together. */
+typedef struct ray_block {
+    voxdag_ray rays[BLOCK_RAYS], shadows[BLOCK_RAYS];
+    voxdag_hit hits[BLOCK_RAYS];
+    uint8_t got[BLOCK_RAYS], occluded[BLOCK_RAYS];
+    uint32_t x[BLOCK_RAYS], y[BLOCK_RAYS]; /* the sample's pixel in the block */
+    uint32_t shadow_of[BLOCK_RAYS];       /* the ray whose hit casts shadow ray k */
+    double factor[BLOCK_RAYS];
+} ray_block;
+
+/* The ray through pixel (I, J) of a W x H picture of the view. */
+static void sample_ray(const camera *c, uint32_t i, uint32_t j, double w, double h, voxdag_ray *ray) {
     double sx = (2 * (i + 0.5) / w - 1) * c->s * w / h, sy = (1 - 2 * (j + 0.5) / h) * c->s;
-    voxdag_ray ray;
-    voxdag_hit hit;
-    uint8_t rgb[3];
-    double factor = 1;
     int k;
-    memset(&ray, 0, sizeof ray);
+    memset(ray, 0, sizeof *ray);
     for (k = 0; k < 3; k++) {
-        ray.origin[k] = c->eye[k];
-        ray.dir[k] = c->f[k] + sx * c->r[k] + sy * c->u[k];
+        ray->origin[k] = c->eye[k];
+        ray->dir[k] = c->f[k] + sx * c->r[k] + sy * c->u[k];
     }
-    normalize3(ray.dir);
-    ray.t_max = HUGE_VAL;
-    if (!voxdag_raycast(job->file->dag, &ray, &job->opts, &hit)) {
-        memcpy(out, BACKGROUND, 3);
-        return;
-    }
-    vdag_hit_color(job->file, &hit, rgb);
-    if (hit.normal[0] | hit.normal[1] | hit.normal[2]) {
-        double n[3] = {hit.normal[0], hit.normal[1], hit.normal[2]}, lit = dot3(n, c->light);
-        if (hit.level < job->levels) lit = cell_lit(job, &hit, ray.dir, lit);
-        factor = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
-        if (job->shadows && lit > 0) {
-            voxdag_ray shadow;
-            if (hit.level < job->levels) { /* past the cell's own staircase (lit above) */
-                voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow);
-                shadow.t_min = (double)(1u << (job->levels - hit.level));
-                if (voxdag_occluded(job->file->dag, &shadow) > 0) factor = AMBIENT;
-            } else if (voxdag_ray_from_hit(job->file->dag, &ray, &hit, c->light, &shadow) > 0 &&
-                voxdag_occluded(job->file->dag, &shadow) > 0)
-                factor = AMBIENT;
-        }
-    }
-    for (k = 0; k < 3; k++) {
-        double v = rgb[k] * factor + 0.5;
-        out[k] = (uint8_t)(v > 255 ? 255 : v);
-    }
+    normalize3(ray->dir);
+    ray->t_max = HUGE_VAL;
 }
 
-static void render_pixel(const render_job *job, uint32_t i, uint32_t j, uint8_t *out) {
-    uint32_t n = job->side, a, b, k, sum[3] = {0, 0, 0};
-    uint8_t rgb[3];
-    if (n == 1) {
-        render_sample(job, i, j, job->cam.w, job->cam.h, out);
-        return;
-    }
-    for (b = 0; b < n; b++)
-        for (a = 0; a < n; a++) {
-            render_sample(job, n * i + a, n * j + b, (double)n * job->cam.w, (double)n * job->cam.h, rgb);
-            for (k = 0; k < 3; k++) sum[k] += rgb[k];
+/* The pixels [X0, X0 + BLOCK) x [Y0, Y0 + BLOCK) (those inside the picture):
+   each averages its side x side samples of the view at side W x side H. */
+static void render_block(const render_job *job, uint32_t x0, uint32_t y0, ray_block *b) {
+    const camera *c = &job->cam;
+    const voxdag *dag = job->file->dag;
+    uint32_t n = job->side, tx, ty, a, k, count = 0, shadows = 0, sum[BLOCK][BLOCK][3];
+    memset(sum, 0, sizeof sum);
+    for (ty = 0; ty < n; ty++) /* samples in tiles of BLOCK x BLOCK */
+        for (tx = 0; tx < n; tx++)
+            for (k = 0; k < BLOCK * BLOCK; k++) {
+                uint32_t i = n * x0 + BLOCK * tx + k % BLOCK, j = n * y0 + BLOCK * ty + k / BLOCK;
+                if (i / n >= c->w || j / n >= c->h) continue;
+                sample_ray(c, i, j, (double)n * c->w, (double)n * c->h, &b->rays[count]);
+                b->x[count] = i / n - x0, b->y[count] = j / n - y0;
+                count++;
+            }
+    voxdag_raycast_many(dag, b->rays, count, &job->opts, b->hits, b->got);
+    for (k = 0; k < count; k++) { /* shading; shadow rays from the lit faces */
+        const voxdag_hit *hit = &b->hits[k];
+        b->factor[k] = 1;
+        if (!b->got[k] || !(hit->normal[0] | hit->normal[1] | hit->normal[2])) continue;
+        {
+            double nv[3] = {hit->normal[0], hit->normal[1], hit->normal[2]}, lit = dot3(nv, c->light);
+            voxdag_ray *shadow = &b->shadows[shadows];
+            if (hit->level < job->levels) lit = cell_lit(job, hit, b->rays[k].dir, lit);
+            b->factor[k] = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
+            if (!job->shadows || !(lit > 0)) continue;
+            if (hit->level < job->levels) { /* past the cell's own staircase (lit above) */
+                voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow);
+                shadow->t_min = (double)(1u << (job->levels - hit->level));
+                b->shadow_of[shadows++] = k;
+            } else if (voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow) > 0) {
+                b->shadow_of[shadows++] = k;
+            }
         }
-    for (k = 0; k < 3; k++) out[k] = (uint8_t)((sum[k] + n * n / 2) / (n * n));
+    }
+    voxdag_occluded_many(dag, b->shadows, shadows, NULL, b->occluded);
+    for (k = 0; k < shadows; k++)
+        if (b->occluded[k]) b->factor[b->shadow_of[k]] = AMBIENT;
+    for (k = 0; k < count; k++) {
+        uint8_t rgb[3];
+        if (!b->got[k]) {
+            memcpy(rgb, BACKGROUND, 3);
+        } else {
+            vdag_hit_color(job->file, &b->hits[k], rgb);
+            for (a = 0; a < 3; a++) {
+                double v = rgb[a] * b->factor[k] + 0.5;
+                rgb[a] = (uint8_t)(v > 255 ? 255 : v);
+            }
+        }
+        for (a = 0; a < 3; a++) sum[b->y[k]][b->x[k]][a] += rgb[a];
+    }
+    for (ty = y0; ty < y0 + BLOCK && ty < c->h; ty++)
+        for (tx = x0; tx < x0 + BLOCK && tx < c->w; tx++)
+            for (a = 0; a < 3; a++)
+                job->rgb[3 * ((size_t)ty * c->w + tx) + a] = (uint8_t)((sum[ty - y0][tx - x0][a] + n * n / 2) / (n * n));
 }
 
 static void *render_worker(void *arg) {
     render_job *job = (render_job *)arg;
+    ray_block *block = (ray_block *)malloc(sizeof *block);
+    if (!block) {
+        fprintf(stderr, "render: out of memory\n");
+        exit(1);
+    }
     for (;;) {
         uint32_t tile, x0, y0, x, y;
         int percent;
         pthread_mutex_lock(&job->lock);
         tile = job->next++;
         pthread_mutex_unlock(&job->lock);
-        if (tile >= job->tiles) return NULL;
+        if (tile >= job->tiles) break;
         x0 = tile % job->tiles_x * TILE, y0 = tile / job->tiles_x * TILE;
-        for (y = y0; y < y0 + TILE && y < job->cam.h; y++)
-            for (x = x0; x < x0 + TILE && x < job->cam.w; x++)
-                render_pixel(job, x, y, job->rgb + 3 * ((size_t)y * job->cam.w + x));
+        for (y = y0; y < y0 + TILE && y < job->cam.h; y += BLOCK)
+            for (x = x0; x < x0 + TILE && x < job->cam.w; x += BLOCK) render_block(job, x, y, block);
         pthread_mutex_lock(&job->lock);
         percent = (int)(100.0 * ++job->done / job->tiles);
         if (job->tty && percent / 10 != job->last_percent / 10) { /* in place, on a terminal only */
@@ -389,6 +420,8 @@ static void *render_worker(void *arg) {
         }
         pthread_mutex_unlock(&job->lock);
     }
+    free(block);
+    return NULL;
 }
 
 /* Seconds on CLOCK (CLOCK_MONOTONIC: wall; CLOCK_PROCESS_CPUTIME_ID: the

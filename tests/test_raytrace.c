@@ -428,6 +428,184 @@ static void test_lookup_many(void) {
     free(xyz), free(index), free(index2), free(full), free(full2);
 }
 
+// -- Ray batches
+
+/* A batch of N rays of one of several shapes: tiles of nearby rays from one
+   eye (a camera's, with pixels from far below a voxel to wide), parallel
+   rays from lattice points (ties through edges and corners, origins on
+   faces), rays leaving the hits of a tile towards one light (shadow rays),
+   random rays, and rays that no packet may take (NaN and zero directions,
+   t_min < 0, rays missing the grid), mixed into one another; half the
+   groups are 8 x 8, the library's packet. */
+static void make_batch(const voxdag *d, uint32_t n, uint64_t *r, voxdag_ray *rays, size_t count) {
+    size_t i = 0, k;
+    while (i < count) {
+        uint32_t shape = test_rand_below(r, 6), side = test_rand_below(r, 2) ? 8 : 1 + test_rand_below(r, 8), a, b;
+        double eye[3], f[3], u[3], v[3], pixel = rand_in(r, 1e-4, 0.1), dir[3];
+        voxdag_ray base = make_ray(r, n);
+        for (k = 0; k < 3; k++) {
+            eye[k] = rand_in(r, -2.0 * n, 3.0 * n);
+            f[k] = rand_in(r, 0, n) - eye[k];
+            u[k] = rand_in(r, -1, 1), v[k] = rand_in(r, -1, 1);
+            dir[k] = (double)test_rand_below(r, 5) - 2;
+        }
+        for (b = 0; b < side && i < count; b++)
+            for (a = 0; a < side && i < count; a++, i++) {
+                voxdag_ray *ray = &rays[i];
+                *ray = base;
+                switch (shape) {
+                case 0: /* a tile of primary rays */
+                case 1:
+                    for (k = 0; k < 3; k++) {
+                        ray->origin[k] = eye[k];
+                        ray->dir[k] = f[k] + n * pixel * (a * u[k] + b * v[k]);
+                    }
+                    if (shape == 1) ray->t_min = rand_in(r, 0, 2), ray->t_max = test_rand_below(r, 2) ? 0 : rand_in(r, 0, 3);
+                    break;
+                case 2: /* parallel rays from lattice points */
+                    for (k = 0; k < 3; k++) {
+                        ray->origin[k] = (double)test_rand_below(r, n + 3) - 1;
+                        ray->dir[k] = dir[k];
+                    }
+                    break;
+                case 3: { /* shadow rays from the hits of a tile, towards one light */
+                    voxdag_ray primary = *ray;
+                    voxdag_hit h;
+                    for (k = 0; k < 3; k++) {
+                        primary.origin[k] = eye[k];
+                        primary.dir[k] = f[k] + n * pixel * (a * u[k] + b * v[k]);
+                    }
+                    primary.t_min = 0, primary.t_max = HUGE_VAL;
+                    if (voxdag_raycast(d, &primary, NULL, &h) == 1) voxdag_ray_from_hit(d, &primary, &h, u, ray);
+                    if (test_rand_below(r, 4) == 0) ray->t_max = rand_in(r, 0, 2);
+                    break;
+                }
+                case 4: break; /* random */
+                default:       /* rays no packet may take, or that miss */
+                    switch (test_rand_below(r, 5)) {
+                    case 0: ray->dir[test_rand_below(r, 3)] = NAN; break;
+                    case 1: ray->dir[0] = ray->dir[1] = ray->dir[2] = 0; break;
+                    case 2: ray->t_min = -rand_in(r, 0, (double)n); break;
+                    case 3: ray->origin[test_rand_below(r, 3)] = HUGE_VAL; break;
+                    default: /* away from the grid */
+                        for (k = 0; k < 3; k++) ray->origin[k] = -2.0 * n, ray->dir[k] = -rand_in(r, 0.1, 1);
+                    }
+                }
+            }
+    }
+}
+
+typedef struct batch_stats {
+    uint64_t rays, hits, occluded, lod_hits, open_cut; /* open_cut: hits that t_max_exclusive removes */
+} batch_stats;
+
+/* The batch calls against one call per ray, under OPTS (NULL too): the same
+   results, the same hit fields, misses' hits untouched. */
+static void check_batch(const voxdag *d, uint32_t levels, const voxdag_ray *rays, size_t count,
+                        const voxdag_ray_opts *opts, batch_stats *st) {
+    voxdag_hit *hits = (voxdag_hit *)malloc((count + 1) * sizeof *hits), one, untouched;
+    uint8_t *result = (uint8_t *)malloc(count + 1), *occ = (uint8_t *)malloc(count + 1);
+    int64_t want_hits = 0, want_occ = 0;
+    size_t i;
+    memset(&untouched, 0xEE, sizeof untouched);
+    for (i = 0; i < count; i++) hits[i] = untouched;
+    memset(result, 7, count), memset(occ, 7, count);
+    for (i = 0; i < count; i++) {
+        want_hits += voxdag_raycast(d, &rays[i], opts, &one) == 1;
+        want_occ += voxdag_occluded_opts(d, &rays[i], opts) == 1;
+    }
+    CHECK(voxdag_raycast_many(d, rays, count, opts, hits, result) == want_hits);
+    CHECK(voxdag_occluded_many(d, rays, count, opts, occ) == want_occ);
+    for (i = 0; i < count; i++) {
+        int got;
+        memset(&one, 0xEE, sizeof one);
+        got = voxdag_raycast(d, &rays[i], opts, &one);
+        CHECK_MSG(result[i] == got && same_hit(&hits[i], &one), "ray %zu: batch %d t %.17g (%u %u %u), one %d t %.17g (%u %u %u)",
+                  i, result[i], hits[i].t, hits[i].xyz[0], hits[i].xyz[1], hits[i].xyz[2], got, one.t, one.xyz[0],
+                  one.xyz[1], one.xyz[2]);
+        CHECK_MSG(occ[i] == voxdag_occluded_opts(d, &rays[i], opts), "ray %zu: batch occluded %d", i, occ[i]);
+        if (got == 1) {
+            st->hits++;
+            st->lod_hits += one.level < levels;
+        } else if (opts && opts->t_max_exclusive) { /* a hit the half-open end removes */
+            voxdag_ray_opts closed = *opts;
+            closed.t_max_exclusive = 0;
+            st->open_cut += rays[i].t_max != 0 && voxdag_raycast(d, &rays[i], &closed, &one) == 1;
+        }
+        st->occluded += occ[i];
+    }
+    st->rays += count;
+    free(hits), free(result), free(occ);
+}
+
+/* voxdag_raycast_many and voxdag_occluded_many against one call per ray on
+   the oracle scenes (whose single calls test_raytrace_oracle checks), in
+   every symmetry group, with and without level of detail, closed and
+   half-open ranges; then the argument checks. */
+static void test_ray_batches(void) {
+    enum { COUNT = 600 };
+    voxdag_ray *rays = (voxdag_ray *)malloc(COUNT * sizeof *rays);
+    batch_stats st;
+    uint32_t levels;
+    int kind, sym;
+    oracle_double_precision();
+    memset(&st, 0, sizeof st);
+    for (levels = 2; levels <= 7; levels++)
+        for (kind = 0; kind < RS_COUNT; kind++)
+            for (sym = 0; sym < 3; sym++) {
+                rscene s;
+                uint64_t r = 0xBA7C + (uint64_t)kind * 100 + levels * 7 + (uint64_t)sym;
+                voxdag *d = rscene_make(&s, kind, levels, sym, r);
+                voxdag_ray_opts opts;
+                int variant;
+                for (variant = 0; d && variant < 4; variant++) {
+                    size_t i;
+                    memset(&opts, 0, sizeof opts);
+                    opts.want_index = variant & 1;
+                    opts.t_max_exclusive = variant >= 2;
+                    make_batch(d, s.n, &r, rays, COUNT);
+                    if (variant == 3) /* end some rays exactly where single calls hit */
+                        for (i = 0; i < COUNT; i += 2) {
+                            voxdag_hit h;
+                            if (voxdag_raycast(d, &rays[i], NULL, &h) == 1) rays[i].t_max = h.t;
+                        }
+                    check_batch(d, levels, rays, COUNT, variant ? &opts : NULL, &st);
+                    if (levels > 2) { /* level of detail */
+                        opts.lod_factor = rand_in(&r, 0.002, 0.2);
+                        opts.lod_pixels = 1;
+                        check_batch(d, levels, rays, COUNT, &opts, &st);
+                    }
+                }
+                voxdag_free(d);
+                rscene_free(&s);
+            }
+    fprintf(stderr, "  %llu rays in batches: %llu hits (%llu level of detail, %llu cut by a half-open end), %llu occluded\n",
+            (unsigned long long)st.rays, (unsigned long long)st.hits, (unsigned long long)st.lod_hits,
+            (unsigned long long)st.open_cut, (unsigned long long)st.occluded);
+    CHECK(st.rays > 500000 && st.hits > st.rays / 5 && st.hits < st.rays - st.rays / 5);
+    CHECK(st.lod_hits > 1000 && st.open_cut > 1000 && st.occluded > st.rays / 5);
+    { /* arguments: an empty batch, NULL pointers, invalid options */
+        rscene s;
+        voxdag *d = rscene_make(&s, RS_SPHERE, 4, 2, 5);
+        voxdag_ray_opts bad;
+        voxdag_hit h;
+        uint8_t res = 7;
+        memset(&bad, 0, sizeof bad);
+        bad.zero_end = 1;
+        make_batch(d, s.n, &st.rays, rays, 1);
+        CHECK(voxdag_raycast_many(d, NULL, 0, NULL, NULL, NULL) == 0 && voxdag_occluded_many(d, NULL, 0, NULL, NULL) == 0);
+        CHECK(voxdag_raycast_many(NULL, rays, 1, NULL, &h, &res) == -1 && voxdag_occluded_many(NULL, rays, 1, NULL, &res) == -1);
+        CHECK(voxdag_raycast_many(d, NULL, 1, NULL, &h, &res) == -1 && voxdag_raycast_many(d, rays, 1, NULL, NULL, &res) == -1);
+        CHECK(voxdag_raycast_many(d, rays, 1, NULL, &h, NULL) == -1 && voxdag_occluded_many(d, NULL, 1, NULL, &res) == -1);
+        CHECK(voxdag_occluded_many(d, rays, 1, NULL, NULL) == -1);
+        CHECK(voxdag_raycast_many(d, rays, 1, &bad, &h, &res) == -1 && voxdag_occluded_many(d, rays, 1, &bad, &res) == -1);
+        CHECK(voxdag_raycast_many(d, NULL, 0, &bad, NULL, NULL) == -1 && res == 7);
+        voxdag_free(d);
+        rscene_free(&s);
+    }
+    free(rays);
+}
+
 /* Hand-checked cases: the conventions of the header's comment. */
 static void test_raytrace_conventions(void) {
     rscene s;
@@ -720,6 +898,7 @@ const test_case test_raytrace_cases[] = {
     {"raytrace_conventions", test_raytrace_conventions},
     {"raytrace_oracle", test_raytrace_oracle},
     {"lookup_many", test_lookup_many},
+    {"raytrace_batches", test_ray_batches},
 #ifndef TEST_PORTABLE
     {"raytrace_render_image", test_raytrace_render_image},
 #endif
