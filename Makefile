@@ -18,7 +18,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h voxdag_gpu.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c examples/gpu_vulkan.c examples/gpu.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_no_voxcolor.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_no_voxcolor.c tests/test_edit.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
 # libstb-dev, a header compiled into the tool: nothing at run time. `make`

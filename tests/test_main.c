@@ -15,6 +15,7 @@ extern const test_case test_voxelize_cases[];
 extern const test_case test_raytrace_cases[];
 extern const test_case test_gpu_cases[];
 extern const test_case test_no_voxcolor_cases[];
+extern const test_case test_edit_cases[];
 #ifndef TEST_PORTABLE
 extern const test_case test_import_cases[];
 extern const test_case test_import_scene_cases[];
@@ -35,6 +36,7 @@ static const test_case *const suites[] = {
     test_raytrace_cases,
     test_gpu_cases,
     test_no_voxcolor_cases,
+    test_edit_cases,
 #ifndef TEST_PORTABLE
     test_image_cases,
     test_api_cases,
