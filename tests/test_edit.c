@@ -1,257 +1,40 @@
-/* The editor against a brute-force model: a dense grid of full flags and
-   colours, indexed by Morton code, with a snapshot per edit for undo and
-   redo. After every edit the editor's voxels, indices, colours, lookups and
-   rays must match the model, and its commit must be the very bytes the
-   builder makes of the model's voxels with the same options. */
+/* The editor against a brute-force model (tests/edit_model.h): after every
+   edit, undo and redo of random sequences the editor's voxels, indices,
+   colours, lookups and rays must match the model, and its commit must be
+   the very bytes the builder makes of the model's voxels with the same
+   options; allocation failures leave nothing half-applied. */
 #include "voxcolor.h"
 #include "voxdag.h"
 #include "test.h"
 #include "count_alloc.h"
+#include "edit_model.h"
 
-#define WHITE 0xFFFFFFu
-
-typedef struct model {
-    uint32_t levels, n;  /* n = 2^levels per axis */
-    size_t cells;
-    uint8_t *full;       /* per Morton code */
-    uint32_t *rgb;       /* 0xRRGGBB per Morton code */
-} model;
-
-/* A state per applied edit, for undo and redo. */
-typedef struct history {
-    model *state;
-    size_t done, kept, cap;
-} history;
-
-static void model_init(model *m, uint32_t levels) {
-    m->levels = levels;
-    m->n = 1u << levels;
-    m->cells = (size_t)1 << 3 * levels;
-    m->full = (uint8_t *)calloc(m->cells, 1);
-    m->rgb = (uint32_t *)calloc(m->cells, sizeof *m->rgb);
-}
-
-static void model_copy(model *dst, const model *src) {
-    model_init(dst, src->levels);
-    memcpy(dst->full, src->full, src->cells);
-    memcpy(dst->rgb, src->rgb, src->cells * sizeof *src->rgb);
-}
-
-static void model_free(model *m) {
-    free(m->full);
-    free(m->rgb);
-}
-
-static uint32_t pack(const uint8_t c[3]) { return (uint32_t)c[0] << 16 | (uint32_t)c[1] << 8 | c[2]; }
-
-static void brush_at(void *user, uint32_t x, uint32_t y, uint32_t z, uint8_t rgb[3]) {
-    uint32_t salt = *(const uint32_t *)user;
-    rgb[0] = (uint8_t)(x * 7 + y + salt);
-    rgb[1] = (uint8_t)(y * 13 + z);
-    rgb[2] = (uint8_t)(z * 5 + x + salt * 3);
-}
-
-static int in_grid(const model *m, int64_t v) { return v >= 0 && v < (int64_t)m->n; }
-
-static int in_shape(const voxdag_shape *s, int64_t x, int64_t y, int64_t z) {
-    if (s->kind == VOXDAG_SHAPE_BOX)
-        return x >= s->lo[0] && x < s->hi[0] && y >= s->lo[1] && y < s->hi[1] && z >= s->lo[2] && z < s->hi[2];
-    {
-        int64_t dx = 2 * x + 1 - 2 * s->center[0], dy = 2 * y + 1 - 2 * s->center[1];
-        int64_t dz = 2 * z + 1 - 2 * s->center[2];
-        return dx * dx + dy * dy + dz * dz <= 4 * s->radius * s->radius;
-    }
-}
-
-static uint32_t brush_color(const voxdag_brush *b, uint32_t x, uint32_t y, uint32_t z) {
-    uint8_t c[3];
-    if (!b->fn) return pack(b->rgb);
-    b->fn(b->user, x, y, z, c);
-    return pack(c);
-}
-
-enum { OP_FILL, OP_CARVE, OP_PAINT };
-
-static void model_shape(model *m, int op, const voxdag_shape *s, const voxdag_brush *b) {
-    uint32_t x, y, z;
-    for (z = 0; z < m->n; z++)
-        for (y = 0; y < m->n; y++)
-            for (x = 0; x < m->n; x++) {
-                size_t c = (size_t)voxdag_morton_encode(x, y, z);
-                if (!in_shape(s, x, y, z)) continue;
-                if (op == OP_CARVE) m->full[c] = 0;
-                if (op == OP_PAINT && m->full[c]) m->rgb[c] = brush_color(b, x, y, z);
-                if (op == OP_FILL) {
-                    if (b) m->rgb[c] = brush_color(b, x, y, z);
-                    else if (!m->full[c]) m->rgb[c] = WHITE;
-                    m->full[c] = 1;
-                }
-            }
-}
-
-static void model_copy_box(model *m, const int64_t lo[3], const int64_t hi[3], const int64_t d[3]) {
-    model src;
-    int64_t x, y, z;
-    model_copy(&src, m);
-    for (z = lo[2]; z < hi[2]; z++)
-        for (y = lo[1]; y < hi[1]; y++)
-            for (x = lo[0]; x < hi[0]; x++) {
-                size_t s, t;
-                if (!in_grid(m, x) || !in_grid(m, y) || !in_grid(m, z)) continue;
-                if (!in_grid(m, x + d[0]) || !in_grid(m, y + d[1]) || !in_grid(m, z + d[2])) continue;
-                s = (size_t)voxdag_morton_encode((uint32_t)x, (uint32_t)y, (uint32_t)z);
-                t = (size_t)voxdag_morton_encode((uint32_t)(x + d[0]), (uint32_t)(y + d[1]), (uint32_t)(z + d[2]));
-                m->full[t] = src.full[s];
-                m->rgb[t] = src.rgb[s];
-            }
-    model_free(&src);
-}
-
-/* Builds the model's voxels with the builder (colours when COLORS). */
-static voxdag *model_build(const model *m, voxdag_symmetry sym, int colors, const double *bounds) {
-    voxdag_build_opts o;
-    voxdag_builder *b;
-    voxdag *d = NULL;
-    uint32_t *xyz = (uint32_t *)malloc(3 * m->cells * sizeof *xyz);
-    uint8_t *rgb = (uint8_t *)malloc(3 * m->cells);
-    size_t c, k = 0;
-    memset(&o, 0, sizeof o);
-    o.levels = m->levels;
-    o.symmetry = sym;
-    o.colors = colors;
-    o.bounds = bounds;
-    for (c = 0; c < m->cells; c++) {
-        if (!m->full[c]) continue;
-        voxdag_morton_decode(c, &xyz[3 * k], &xyz[3 * k + 1], &xyz[3 * k + 2]);
-        rgb[3 * k] = (uint8_t)(m->rgb[c] >> 16);
-        rgb[3 * k + 1] = (uint8_t)(m->rgb[c] >> 8);
-        rgb[3 * k + 2] = (uint8_t)m->rgb[c];
-        k++;
-    }
-    if (voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK && voxdag_builder_add(b, xyz, rgb, k, NULL) == VOXDAG_OK)
-        voxdag_builder_finish(b, &d, NULL, NULL);
-    free(xyz);
-    free(rgb);
-    return d;
-}
-
-typedef struct seen {
-    const model *m;
-    uint64_t next_code, count;
-    int bad;
-} seen;
-
-/* for_each_voxel must give the model's voxels in Morton order, indices 0, 1, ... */
-static int seen_voxel(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
-    seen *s = (seen *)user;
-    uint64_t c = voxdag_morton_encode(x, y, z);
-    while (s->next_code < c && !s->m->full[s->next_code]) s->next_code++;
-    if (s->next_code != c || index != s->count) s->bad = 1;
-    s->next_code = c + 1;
-    s->count++;
-    return 0;
-}
-
-/* Everything the editor answers against the model; the commit against a
-   fresh build. Returns 0 when something differs. */
-static int check_state(voxdag_editor *ed, const model *m, voxdag_symmetry sym, int colors,
-                       const double *bounds, uint64_t *rng, int full_check) {
-    seen s;
-    uint64_t *rank = (uint64_t *)malloc((m->cells + 1) * sizeof *rank);
-    voxdag *built, *mine = NULL;
-    size_t c, k;
-    int before = test_current_failed;
-    rank[0] = 0;
-    for (c = 0; c < m->cells; c++) rank[c + 1] = rank[c] + m->full[c];
-    CHECK(voxdag_editor_voxels(ed) == rank[m->cells]);
-    memset(&s, 0, sizeof s);
-    s.m = m;
-    CHECK(voxdag_editor_for_each_voxel(ed, seen_voxel, &s) == rank[m->cells]);
-    CHECK(!s.bad && s.count == rank[m->cells]);
-    for (k = 0; k < (full_check ? m->cells : 200); k++) {
-        uint64_t index = UINT64_MAX;
-        uint32_t x, y, z;
-        c = full_check ? k : (size_t)(test_rand(rng) % m->cells);
-        voxdag_morton_decode(c, &x, &y, &z);
-        CHECK(voxdag_editor_lookup(ed, x, y, z, &index) == m->full[c]);
-        if (m->full[c]) {
-            uint8_t rgb[3];
-            CHECK(index == rank[c]);
-            CHECK(voxdag_editor_color(ed, index, rgb) == colors);
-            if (colors) CHECK_MSG(pack(rgb) == m->rgb[c], "colour of (%u %u %u): %06x, not %06x", x, y, z, pack(rgb), m->rgb[c]);
-        }
-    }
-    CHECK(voxdag_editor_lookup(ed, m->n, 0, 0, NULL) == 0);
-    built = model_build(m, sym, colors, bounds);
-    CHECK(built != NULL);
-    CHECK(voxdag_editor_commit(ed, &mine, NULL) == VOXDAG_OK);
-    if (built && mine) {
-        size_t a, b;
-        const void *pa = voxdag_image(built, &a), *pb = voxdag_image(mine, &b);
-        CHECK_MSG(a == b && !memcmp(pa, pb, a), "commit is not the builder's bytes (%zu vs %zu bytes)", b, a);
-        for (k = 0; k < 20; k++) { /* rays: the editor's against the fresh build's */
-            voxdag_ray ray;
-            voxdag_ray_opts ro;
-            voxdag_hit h1, h2;
-            int r1, r2, a2;
-            memset(&ray, 0, sizeof ray);
-            memset(&ro, 0, sizeof ro);
-            ro.want_index = 1;
-            for (a2 = 0; a2 < 3; a2++) {
-                ray.origin[a2] = (double)(test_rand(rng) % (4 * m->n)) / 2 - m->n / 2.0;
-                ray.dir[a2] = (double)((int)(test_rand(rng) % 9) - 4);
-            }
-            memset(&h1, 0, sizeof h1);
-            memset(&h2, 0, sizeof h2);
-            r1 = voxdag_editor_raycast(ed, &ray, &ro, &h1);
-            r2 = voxdag_raycast(built, &ray, &ro, &h2);
-            CHECK(r1 == r2 && (r1 != 1 || !memcmp(&h1, &h2, sizeof h1)));
-            CHECK(voxdag_editor_occluded(ed, &ray, NULL) == voxdag_occluded(built, &ray));
-        }
-    }
-    voxdag_free(built);
-    voxdag_free(mine);
-    free(rank);
-    return test_current_failed == before;
-}
-
-static void random_shape(uint64_t *rng, const model *m, voxdag_shape *s) {
-    int64_t span = 2 * (int64_t)m->n, a;
-    memset(s, 0, sizeof *s);
-    s->kind = test_rand(rng) & 1 ? VOXDAG_SHAPE_SPHERE : VOXDAG_SHAPE_BOX;
-    for (a = 0; a < 3; a++) {
-        s->lo[a] = (int64_t)(test_rand(rng) % (uint64_t)span) - (int64_t)m->n / 2;
-        s->hi[a] = s->lo[a] + (int64_t)(test_rand(rng) % (uint64_t)(m->n + 2)) - 1;
-        s->center[a] = (int64_t)(test_rand(rng) % (uint64_t)span) - (int64_t)m->n / 2;
-    }
-    s->radius = (int64_t)(test_rand(rng) % (m->n + 1));
-    if (test_rand(rng) % 8 == 0) { /* the whole grid and beyond */
-        for (a = 0; a < 3; a++) s->lo[a] = -1, s->hi[a] = m->n + 1;
-    }
-}
+static uint64_t next_rand(void *user) { return test_rand((uint64_t *)user); }
 
 /* One random sequence: a random scene, then EDITS random edits, undos and
    redos, each checked. */
 static void run_sequence(uint64_t seed, uint32_t levels, voxdag_symmetry sym, int colors, int voxcolor,
                          int edits, int full_check) {
     uint64_t rng = seed;
+    edit_src src;
     history h;
-    model *cur;
+    model start_model, *cur;
     voxdag *start;
     voxdag_editor *ed = NULL;
     double bounds[6] = {-1, -2, -3, 5, 6, 7};
     const double *bp = seed & 1 ? bounds : NULL;
     uint32_t salt = (uint32_t)seed;
-    int e, failed_at = -1;
+    const char *why = NULL;
+    int e = 0, wrong = 0;
     size_t c;
-    memset(&h, 0, sizeof h);
-    h.cap = (size_t)edits + 1;
-    h.state = (model *)calloc(h.cap, sizeof *h.state);
-    h.kept = 1;
-    model_init(&h.state[0], levels);
+    src.next = next_rand;
+    src.user = &rng;
+    model_init(&start_model, levels);
+    history_init(&h, &start_model);
     cur = &h.state[0];
     for (c = 0; c < cur->cells; c++) /* a random start: noise, denser in places */
         if (test_rand(&rng) % 8 < (c >> (3 * levels - 3)) % 4) cur->full[c] = 1, cur->rgb[c] = (uint32_t)test_rand(&rng) & 0xFFFFFF;
+    if (!colors) memset(cur->rgb, 0, cur->cells * sizeof *cur->rgb);
     start = model_build(cur, sym, colors, bp);
     if (colors && voxcolor) { /* the colours as a voxcolor stream: the model takes the decoded ones */
         const void *raw;
@@ -280,85 +63,19 @@ static void run_sequence(uint64_t seed, uint32_t levels, voxdag_symmetry sym, in
     }
     CHECK(voxdag_editor_create(start, NULL, &ed, NULL) == VOXDAG_OK);
     voxdag_free(start);
-    if (!ed) return;
-    if (!check_state(ed, cur, sym, colors, bp, &rng, full_check)) failed_at = 0;
-    for (e = 0; e < edits && failed_at < 0; e++) {
-        uint32_t kind = test_rand_below(&rng, 12);
-        model next;
-        voxdag_status st = VOXDAG_OK;
-        voxdag_brush brush;
-        voxdag_shape s;
-        cur = &h.state[h.done];
-        if (kind == 10 || kind == 11) { /* undo, redo */
-            int did = kind == 10 ? voxdag_editor_undo(ed) : voxdag_editor_redo(ed);
-            CHECK(did == (kind == 10 ? h.done > 0 : h.done + 1 < h.kept));
-            if (did) h.done += kind == 10 ? (size_t)-1 : 1;
-        } else {
-            model_copy(&next, cur);
-            memset(&brush, 0, sizeof brush);
-            brush.rgb[0] = (uint8_t)test_rand(&rng);
-            brush.rgb[1] = (uint8_t)test_rand(&rng);
-            brush.rgb[2] = (uint8_t)test_rand(&rng);
-            if (test_rand(&rng) & 1) brush.fn = brush_at, brush.user = &salt;
-            random_shape(&rng, cur, &s);
-            if (kind <= 3) { /* voxel lists */
-                uint32_t xyz[3 * 24];
-                uint8_t rgb[3 * 24];
-                size_t n = test_rand_below(&rng, 24), i;
-                int with_rgb = test_rand(&rng) & 1;
-                for (i = 0; i < n; i++) {
-                    size_t cc;
-                    if (i && test_rand(&rng) % 4 == 0) { /* a repeat */
-                        memcpy(xyz + 3 * i, xyz + 3 * (i - 1), 3 * sizeof *xyz);
-                    } else {
-                        xyz[3 * i] = test_rand_below(&rng, cur->n);
-                        xyz[3 * i + 1] = test_rand_below(&rng, cur->n);
-                        xyz[3 * i + 2] = test_rand_below(&rng, cur->n);
-                    }
-                    rgb[3 * i] = (uint8_t)test_rand(&rng);
-                    rgb[3 * i + 1] = (uint8_t)test_rand(&rng);
-                    rgb[3 * i + 2] = (uint8_t)test_rand(&rng);
-                    cc = (size_t)voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
-                    if (kind <= 1) {
-                        if (with_rgb) next.rgb[cc] = pack(rgb + 3 * i);
-                        else if (!next.full[cc]) next.rgb[cc] = WHITE;
-                        next.full[cc] = 1;
-                    } else {
-                        next.full[cc] = 0;
-                    }
-                }
-                st = kind <= 1 ? voxdag_editor_set(ed, xyz, with_rgb ? rgb : NULL, n, NULL)
-                               : voxdag_editor_clear(ed, xyz, n, NULL);
-            } else if (kind <= 5) {
-                int plain = test_rand(&rng) % 3 == 0;
-                model_shape(&next, OP_FILL, &s, plain ? NULL : &brush);
-                st = voxdag_editor_fill(ed, &s, plain ? NULL : &brush, NULL);
-            } else if (kind <= 7) {
-                model_shape(&next, OP_CARVE, &s, NULL);
-                st = voxdag_editor_carve(ed, &s, NULL);
-            } else if (kind == 8) {
-                model_shape(&next, OP_PAINT, &s, &brush);
-                st = voxdag_editor_paint(ed, &s, &brush, NULL);
-            } else {
-                int64_t d[3];
-                unsigned a;
-                for (a = 0; a < 3; a++) d[a] = (int64_t)test_rand_below(&rng, 2 * cur->n) - (int64_t)cur->n;
-                model_copy_box(&next, s.lo, s.hi, d);
-                st = voxdag_editor_copy(ed, s.lo, s.hi, d, NULL);
-            }
-            CHECK_MSG(st == VOXDAG_OK, "edit %d (kind %u) failed: %s", e, kind, voxdag_status_string(st));
-            if (!colors) memset(next.rgb, 0, next.cells * sizeof *next.rgb);
-            while (h.kept > h.done + 1) model_free(&h.state[--h.kept]);
-            h.state[++h.done] = next;
-            h.kept = h.done + 1;
+    if (ed) {
+        why = edit_compare(ed, cur, sym, colors, bp, &src, full_check);
+        for (e = 1; e <= edits && !why && !wrong; e++) {
+            voxdag_status st = edit_step(ed, &h, colors, &src, &salt, &wrong);
+            if (st != VOXDAG_OK) why = voxdag_status_string(st);
+            else if (wrong) why = "undo or redo";
+            else why = edit_compare(ed, &h.state[h.done], sym, colors, bp, &src, full_check);
         }
-        if (!check_state(ed, &h.state[h.done], sym, colors, bp, &rng, full_check)) failed_at = e + 1;
     }
-    CHECK_MSG(failed_at < 0, "seed %llu L %u symmetry %d colours %d/%d: differs after step %d",
-              (unsigned long long)seed, levels, (int)sym, colors, voxcolor, failed_at);
+    CHECK_MSG(!why, "seed %llu L %u symmetry %d colours %d/%d: %s after step %d", (unsigned long long)seed, levels,
+              (int)sym, colors, voxcolor, why, e - 1);
     voxdag_editor_free(ed);
-    for (c = 0; c < h.kept; c++) model_free(&h.state[c]);
-    free(h.state);
+    history_free(&h);
 }
 
 static const voxdag_symmetry groups[3] = {VOXDAG_SYMMETRY_NONE, VOXDAG_SYMMETRY_REFLECT, VOXDAG_SYMMETRY_FULL};
