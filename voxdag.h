@@ -1800,6 +1800,11 @@ static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t st
     return best;
 }
 
+/* The reference "T applied to reference REF": the same node, tag T o t. */
+static uint32_t voxdagi_ref_compose(unsigned tf, uint32_t ref) {
+    return (ref & ~63u) | voxdagi_cube_tables.comp[tf][ref & 63];
+}
+
 /* A reference to the canonical form: its key, the tag that maps the canonical
    node back to the input, and the canonical node's stabilizer. */
 typedef struct voxdagi_canon {
@@ -2659,11 +2664,6 @@ static void *voxdagi_worker_run(void *arg) {
         }
     }
     return NULL;
-}
-
-/* The reference "T applied to reference REF": the same node, tag T o t. */
-static uint32_t voxdagi_ref_compose(unsigned tf, uint32_t ref) {
-    return (ref & ~63u) | voxdagi_cube_tables.comp[tf][ref & 63];
 }
 
 /* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
@@ -7722,40 +7722,47 @@ VOXDAG_API void voxdag_editor_free(voxdag_editor *ed) {
     voxdagi_mem_destroy(&mem);
 }
 
-/* The commit feeds the builder in Morton order, a chunk at a time. */
-#define VOXDAGI_COMMIT_CHUNK 4096
-typedef struct voxdagi_ed_feed {
+/* The commit feeds the builder whole bricks in Morton order (its fast path,
+   the same file as voxel by voxel), a chunk at a time. */
+#define VOXDAGI_COMMIT_CHUNK 1024
+typedef struct voxdagi_ed_feeder {
     voxdag_builder *b;
-    uint32_t xyz[3 * VOXDAGI_COMMIT_CHUNK];
-    uint8_t rgb[3 * VOXDAGI_COMMIT_CHUNK];
-    size_t n;
+    uint64_t brick[2 * VOXDAGI_COMMIT_CHUNK]; /* key, mask */
+    uint8_t rgb[3 * 64 * VOXDAGI_COMMIT_CHUNK];
+    size_t n, colors;
     voxdag_status st;
     voxdag_error *err;
-} voxdagi_ed_feed;
+} voxdagi_ed_feeder;
 
-static int voxdagi_ed_feed_flush(voxdagi_ed_feed *f) {
-    if (f->n && f->st == VOXDAG_OK) {
-        f->st = voxdag_builder_add(f->b, f->xyz, f->rgb, f->n, f->err);
-        if (f->st == VOXDAG_OK) f->st = voxdag_builder_flush(f->b, f->err);
-    }
-    f->n = 0;
-    return f->st != VOXDAG_OK;
+static void voxdagi_ed_feed_flush(voxdagi_ed_feeder *f) {
+    if (f->n && f->st == VOXDAG_OK) f->st = voxdag_builder_add_bricks(f->b, f->brick, f->rgb, f->n, f->err);
+    f->n = f->colors = 0;
 }
 
-static int voxdagi_ed_feed_voxel(void *user, const voxdag_editor *ed, uint64_t code, uint64_t index) {
-    voxdagi_ed_feed *f = (voxdagi_ed_feed *)user;
-    (void)index;
-    voxdag_morton_decode(code, &f->xyz[3 * f->n], &f->xyz[3 * f->n + 1], &f->xyz[3 * f->n + 2]);
-    if (ed->colors) voxdagi_unpack_rgb(voxdagi_ed_color_at(ed, code), f->rgb + 3 * f->n);
-    return ++f->n == VOXDAGI_COMMIT_CHUNK ? voxdagi_ed_feed_flush(f) : 0;
+/* Feeds the bricks of subtree REF of LEVEL (Morton prefix KEY). */
+static void voxdagi_ed_feed(const voxdag_editor *ed, voxdagi_ed_feeder *f, uint32_t level, uint32_t ref,
+                            uint64_t key) {
+    uint32_t child[8];
+    unsigned j;
+    if (ref == VOXDAGI_NONE || f->st != VOXDAG_OK) return;
+    if (level == ed->levels - 2) {
+        uint64_t mask = voxdagi_ed_brick(ed, ref), bits;
+        const uint32_t *c = ed->colors ? voxdagi_ed_colors(ed, key) : NULL;
+        f->brick[2 * f->n] = key;
+        f->brick[2 * f->n + 1] = mask;
+        for (bits = ed->colors ? mask : 0; bits; bits &= bits - 1)
+            voxdagi_unpack_rgb(c ? c[voxdagi_lowest_bit(bits)] : VOXDAGI_WHITE, f->rgb + 3 * f->colors++);
+        if (++f->n == VOXDAGI_COMMIT_CHUNK) voxdagi_ed_feed_flush(f);
+        return;
+    }
+    voxdagi_ed_children(ed, level, ref, child);
+    for (j = 0; j < 8; j++) voxdagi_ed_feed(ed, f, level + 1, child[j], key << 3 | j);
 }
 
 VOXDAG_API voxdag_status voxdag_editor_commit(voxdag_editor *ed, voxdag **out, voxdag_error *err) {
     voxdag_build_opts o;
-    voxdagi_ed_feed *f;
+    voxdagi_ed_feeder *f;
     voxdag_status st;
-    int64_t origin[3] = {0, 0, 0};
-    uint64_t index = 0;
     if (!ed || !out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "a NULL argument");
     *out = NULL;
     memset(&o, 0, sizeof o);
@@ -7765,13 +7772,13 @@ VOXDAG_API voxdag_status voxdag_editor_commit(voxdag_editor *ed, voxdag **out, v
     o.bounds = ed->has_bounds ? ed->bounds : NULL;
     o.allocator = ed->mem.a;
     if (ed->mem.limit) o.max_memory = ed->mem.limit > ed->mem.used ? ed->mem.limit - ed->mem.used : 1;
-    f = (voxdagi_ed_feed *)voxdagi_alloc(&ed->mem, sizeof *f);
+    f = (voxdagi_ed_feeder *)voxdagi_alloc(&ed->mem, sizeof *f);
     if (!f) return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
-    f->n = 0;
+    f->n = f->colors = 0;
     f->err = err;
     f->st = voxdag_builder_create(&o, &f->b, err);
     if (f->st == VOXDAG_OK) {
-        voxdagi_ed_visit(ed, NULL, 0, ed->root, origin, 0, &index, voxdagi_ed_feed_voxel, f);
+        voxdagi_ed_feed(ed, f, 0, ed->root, 0);
         voxdagi_ed_feed_flush(f);
         if (f->st == VOXDAG_OK) f->st = voxdag_builder_finish(f->b, out, NULL, err);
         else voxdag_builder_free(f->b);
