@@ -7051,21 +7051,21 @@ static void voxdagi_unpack_rgb(uint32_t c, uint8_t rgb[3]) {
 /* Colours the voxels BITS of brick BRICK with BRUSH (NULL: white). Returns 0
    when out of memory. */
 static int voxdagi_ed_paint_bits(voxdag_editor *ed, uint64_t brick, uint64_t bits, const voxdag_brush *brush) {
-    uint32_t *c, fixed = brush ? voxdagi_pack_rgb(brush->rgb) : VOXDAGI_WHITE;
+    uint32_t *c, fixed = brush ? voxdagi_pack_rgb(brush->rgb) : VOXDAGI_WHITE, x, y, z;
     if (!ed->colors || !bits) return 1;
     c = voxdagi_ed_colors_to_write(ed, brick);
     if (!c) return 0;
+    if (!brush || !brush->fn) {
+        for (; bits; bits &= bits - 1) c[voxdagi_lowest_bit(bits)] = fixed;
+        return 1;
+    }
+    voxdag_morton_decode(brick << 6, &x, &y, &z); /* the brick's lowest voxel */
     for (; bits; bits &= bits - 1) {
         unsigned p = voxdagi_lowest_bit(bits);
-        if (brush && brush->fn) {
-            uint32_t x, y, z;
-            uint8_t rgb[3] = {0, 0, 0};
-            voxdag_morton_decode(brick << 6 | p, &x, &y, &z);
-            brush->fn(brush->user, x, y, z, rgb);
-            c[p] = voxdagi_pack_rgb(rgb);
-        } else {
-            c[p] = fixed;
-        }
+        uint8_t rgb[3] = {0, 0, 0};
+        brush->fn(brush->user, x + (p & 1) + (p >> 2 & 2), y + (p >> 1 & 1) + (p >> 3 & 2),
+                  z + (p >> 2 & 1) + (p >> 4 & 2), rgb);
+        c[p] = voxdagi_pack_rgb(rgb);
     }
     return 1;
 }
