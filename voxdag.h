@@ -75,6 +75,10 @@
      keep that shape because -1 would read as "full" in the
      `if (voxdag_lookup(...))` that existing code writes.
 
+   EDITING: voxdag_editor (see there) changes a scene in place (voxel lists,
+   boxes, spheres, paint, copies, undo and redo) and commits it as the same
+   bytes a build of the final voxels gives.
+
    FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
 */
 #ifndef VOXDAG_H
@@ -838,6 +842,10 @@ VOXDAG_API int voxdag_editor_lookup(const voxdag_editor *ed, uint32_t x, uint32_
 VOXDAG_API int voxdag_editor_color(const voxdag_editor *ed, uint64_t index, uint8_t rgb[3]);
 VOXDAG_API uint64_t voxdag_editor_for_each_voxel(const voxdag_editor *ed, voxdag_voxel_fn fn, void *user);
 VOXDAG_API uint64_t voxdag_editor_voxels(const voxdag_editor *ed);
+
+/* Bytes the editor holds now (nodes of every state the history can reach,
+   colour blocks, history), the figure max_memory limits. */
+VOXDAG_API uint64_t voxdag_editor_memory(const voxdag_editor *ed);
 
 /* The unique nodes the scene reaches now, per level as voxdag_info.nodes
    (levels 0..L-2, the last entry 4^3 bricks; the rest of NODES set to 0):
@@ -7430,6 +7438,8 @@ static uint32_t voxdagi_ed_color_at(const voxdag_editor *ed, uint64_t code) {
 VOXDAG_API uint64_t voxdag_editor_voxels(const voxdag_editor *ed) {
     return ed ? voxdagi_ed_count(ed, 0, ed->root) : 0;
 }
+
+VOXDAG_API uint64_t voxdag_editor_memory(const voxdag_editor *ed) { return ed ? ed->mem.used : 0; }
 
 VOXDAG_API int voxdag_editor_lookup(const voxdag_editor *ed, uint32_t x, uint32_t y, uint32_t z,
                                     uint64_t *index) {

@@ -198,6 +198,20 @@ static void test_edit_errors(void) {
     }
     voxdag_editor_free(ed);
     voxdag_editor_free(NULL);
+    /* a limit: the edit that needs more fails whole, and the scene stays */
+    o.levels = 8;
+    o.colors = 1;
+    o.max_memory = 1 << 20;
+    CHECK(voxdag_editor_create(NULL, &o, &ed, &err) == VOXDAG_OK);
+    s.kind = VOXDAG_SHAPE_SPHERE;
+    s.center[0] = s.center[1] = s.center[2] = 40;
+    s.radius = 3;
+    CHECK(voxdag_editor_fill(ed, &s, NULL, &err) == VOXDAG_OK && voxdag_editor_voxels(ed) == 136);
+    s.radius = 100;
+    CHECK(voxdag_editor_fill(ed, &s, NULL, &err) == VOXDAG_ERR_LIMIT);
+    CHECK(voxdag_editor_voxels(ed) == 136 && voxdag_editor_memory(ed) <= o.max_memory);
+    CHECK(voxdag_editor_undo(ed) == 1 && voxdag_editor_undo(ed) == 0);
+    voxdag_editor_free(ed);
     CHECK(voxdag_editor_undo(NULL) == 0 && voxdag_editor_lookup(NULL, 0, 0, 0, NULL) == 0);
 }
 
