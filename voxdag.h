@@ -833,6 +833,13 @@ VOXDAG_API voxdag_status voxdag_editor_copy(voxdag_editor *ed, const int64_t lo[
 VOXDAG_API int voxdag_editor_undo(voxdag_editor *ed);
 VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed);
 
+/* Forgets the history (nothing to undo or redo afterwards) and frees the
+   colour blocks only the history held: an edit keeps every block it
+   replaced (256 bytes per brick whose colours it changed) until then.
+   Nodes are kept (they are shared and small). Returns VOXDAG_OK, or
+   VOXDAG_ERR_OUT_OF_MEMORY / VOXDAG_ERR_LIMIT with nothing changed. */
+VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err);
+
 /* Queries on the edited scene, with the meaning of voxdag_lookup,
    voxdag_color and voxdag_for_each_voxel (voxel indices are ranks in Morton
    order of the scene as it is now). voxdag_editor_voxels gives the voxel
@@ -7139,6 +7146,39 @@ VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed) {
     ed->root = rec->root_after;
     voxdagi_ed_drop_traced(ed);
     return 1;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err) {
+    uint32_t *block = NULL;
+    uint64_t *serial = NULL;
+    size_t i, n = 0;
+    if (!ed) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no editor");
+    for (i = 0; i < ed->map_cap; i++) n += ed->map_used[i] && ed->map_block[i] != VOXDAGI_NO_BLOCK;
+    if (n) {
+        block = (uint32_t *)voxdagi_alloc(&ed->mem, n * 64 * sizeof *block);
+        serial = (uint64_t *)voxdagi_alloc(&ed->mem, n * sizeof *serial);
+    }
+    if (n && (!block || !serial)) {
+        voxdagi_free(&ed->mem, block, n * 64 * sizeof *block);
+        voxdagi_free(&ed->mem, serial, n * sizeof *serial);
+        return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    for (i = 0, n = 0; i < ed->map_cap; i++) { /* the blocks the scene uses now, packed */
+        if (!ed->map_used[i] || ed->map_block[i] == VOXDAGI_NO_BLOCK) continue;
+        memcpy(block + 64 * n, ed->block + 64 * (size_t)ed->map_block[i], 64 * sizeof *block);
+        serial[n] = 0; /* no edit's: the next one copies before writing */
+        ed->map_block[i] = (uint32_t)n++;
+    }
+    voxdagi_free(&ed->mem, ed->block, ed->block_cap * sizeof *ed->block);
+    voxdagi_free(&ed->mem, ed->block_serial, ed->serial_cap * sizeof *ed->block_serial);
+    ed->block = block;
+    ed->block_serial = serial;
+    ed->block_n = n;
+    ed->block_cap = n * 64;
+    ed->serial_cap = n;
+    ed->change_n = 0;
+    ed->done = ed->kept = 0;
+    return voxdagi_ok(err);
 }
 
 // -- Editing: shapes

@@ -72,6 +72,27 @@ static void run_sequence(uint64_t seed, uint32_t levels, voxdag_symmetry sym, in
             else why = edit_compare(ed, &h.state[h.done], sym, colors, bp, &src, full_check);
         }
     }
+    if (ed && !why) { /* forgetting the history keeps the scene, frees blocks, ends undo */
+        uint64_t held = voxdag_editor_memory(ed);
+        model now;
+        model_copy(&now, &h.state[h.done]);
+        if (voxdag_editor_forget_history(ed, NULL) != VOXDAG_OK) why = "forget_history failed";
+        else if (voxdag_editor_memory(ed) > held || voxdag_editor_undo(ed) || voxdag_editor_redo(ed))
+            why = "forget_history: memory or history";
+        else why = edit_compare(ed, &now, sym, colors, bp, &src, full_check);
+        if (!why) { /* and edits go on as before */
+            history_free(&h);
+            history_init(&h, &now);
+            for (e = 0; e < 4 && !why && !wrong; e++) {
+                voxdag_status st = edit_step(ed, &h, colors, &src, &salt, &wrong);
+                if (st != VOXDAG_OK) why = voxdag_status_string(st);
+                else if (wrong) why = "undo or redo after forget_history";
+                else why = edit_compare(ed, &h.state[h.done], sym, colors, bp, &src, full_check);
+            }
+        } else {
+            model_free(&now);
+        }
+    }
     CHECK_MSG(!why, "seed %llu L %u symmetry %d colours %d/%d: %s after step %d", (unsigned long long)seed, levels,
               (int)sym, colors, voxcolor, why, e - 1);
     voxdag_editor_free(ed);
