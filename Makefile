@@ -18,7 +18,7 @@ SAN     := -fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-fram
 HEADERS := voxdag.h voxcolor.h voxdag_gpu.h
 
 VDAG_SRC := examples/vdag.c examples/import.c examples/render.c examples/image_stb.c examples/check_colors.c examples/gpu_vulkan.c examples/gpu.c
-TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_no_voxcolor.c tests/test_lod_colors.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
+TEST_SRC := tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_import.c tests/test_voxelize.c tests/test_raytrace.c tests/test_gpu.c tests/test_format.c tests/test_import_scene.c tests/test_image.c tests/test_api.c tests/test_no_voxcolor.c tests/test_lod_colors.c tests/test_edit.c tests/test_check_colors.c examples/import.c examples/image_stb.c examples/check_colors.c
 
 # Texture decoding (examples/image_stb.c) uses stb_image.h from Debian's
 # libstb-dev, a header compiled into the tool: nothing at run time. `make`
@@ -115,7 +115,7 @@ $(STB_IMAGE):
 $(BUILD)/opt/%.o: %.c $(wildcard examples/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) $(OPT) $(THREADS) -I. -c -o $@ $<
-$(BUILD)/san/%.o: %.c tests/test.h tests/rscene.h tests/gpu_oracle.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h examples/shaders/*.h) $(HEADERS)
+$(BUILD)/san/%.o: %.c tests/test.h tests/edit_model.h tests/rscene.h tests/gpu_oracle.h tests/count_alloc.h tests/import_test.h tests/oiio_ref.h $(wildcard examples/*.h examples/shaders/*.h) $(HEADERS)
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -g $(SAN) $(THREADS) -I. -c -o $@ $<
 $(BUILD)/opt/examples/image_stb.o $(BUILD)/san/examples/image_stb.o: $(STB_IMAGE)
@@ -174,15 +174,16 @@ $(BUILD)/test_gpu_vk: tests/test_gpu_vk.c tests/gpu_oracle.h tests/rscene.h test
 #   voxcolor   colour streams decoded, and colours encoded and decoded
 #   load       .vdag files loaded, and queries on what loaded
 #   roundtrip  scenes built, saved and loaded, every query against an oracle
+#   edit       random edits on random scenes against a brute-force model
 # `make fuzz-NAME` builds one with libFuzzer, ASan and UBSan (clang; any
 # finding stops the run and is saved in $(BUILD)) and fuzzes it for
 # FUZZ_SECONDS from the committed corpus tests/data/fuzz/NAME, with
 # tests/data/fuzz/NAME.dict when there is one. Built without libFuzzer,
 # $(BUILD)/fuzz_NAME replays files with the same entry point
 # (tests/fuzz_replay.h); `make test` replays and sweeps every corpus.
-FUZZ_NAMES   := import voxcolor load roundtrip
+FUZZ_NAMES   := import voxcolor load roundtrip edit
 FUZZ_SECONDS ?= 120
-FUZZ_DEPS    := tests/fuzz_replay.h tests/fuzz_require.h tests/count_alloc.h tests/golden.h $(HEADERS) \
+FUZZ_DEPS    := tests/fuzz_replay.h tests/fuzz_require.h tests/count_alloc.h tests/golden.h tests/edit_model.h $(HEADERS) \
                 examples/import.c examples/import_scene.c examples/import.h examples/image.h
 FUZZ_EXTRA_import := examples/import.c examples/image_none.c -DVDAG_IMPORT_REALLOC=fuzz_import_realloc
 FUZZ_FLAGS   = $(CSTD) $(WARN) -g $(THREADS) -I. tests/fuzz_$*.c $(FUZZ_EXTRA_$*) -lm
@@ -233,7 +234,7 @@ $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scen
 test-real: $(BUILD)/vdag $(BUILD)/import_dump
 	@sh tests/real.sh $(BUILD)
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/fuzz_edit $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
                  $(if $(VULKAN),$(VK_SMOKE:.h=.spv) $(VDAG_KERNEL:.h=.spv) $(README_SHADERS))
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)

@@ -76,6 +76,10 @@
      keep that shape because -1 would read as "full" in the
      `if (voxdag_lookup(...))` that existing code writes.
 
+   EDITING: voxdag_editor (see there) changes a scene in place (voxel lists,
+   boxes, spheres, paint, copies, undo and redo) and commits it as the same
+   bytes a build of the final voxels gives.
+
    FILE FORMAT: FORMAT.md documents every byte; VOXDAG_FILE_* mirror it.
 */
 #ifndef VOXDAG_H
@@ -806,6 +810,162 @@ VOXDAG_API voxdag_status voxdag_world_ray(const voxdag *dag, const voxdag_ray *w
                                           voxdag_ray *grid_ray);
 
 #endif /* VOXDAG_NO_RAYTRACE */
+
+// -- Editing (needs the builder: not under VOXDAG_NO_BUILD)
+#ifndef VOXDAG_NO_BUILD
+
+/* An editor holds a scene as a DAG in memory, hash-consed and canonical
+   under the scene's symmetry group exactly as the builder's (the same node
+   tables and canonical forms), with every node's voxel count. An edit
+   rebuilds only the nodes along the edited region, bottom-up, and looks each
+   one up, so a node that becomes equal to an existing one (up to the group)
+   is shared again. Colours are kept per 4^3 brick, by position, not by voxel
+   index: inserting a voxel shifts no colour, and an edit copies only the
+   colour blocks of the bricks it changes (copy on write, which also makes
+   undo cheap). voxdag_editor_commit encodes the result: the same bytes as
+   voxdag_builder run on the final voxels with the same options.
+   An editor belongs to one thread at a time. */
+typedef struct voxdag_editor voxdag_editor;
+
+/* Editor options. NULL or an all-zero struct means defaults; zero_begin and
+   zero_end must be 0 (VOXDAG_ERR_INVALID_ARGUMENT otherwise). LEVELS,
+   SYMMETRY and COLORS describe an empty scene; opening a DAG takes its own. */
+typedef struct voxdag_editor_opts {
+    uint32_t zero_begin;
+    uint32_t levels;          /* empty scene: L, 2..VOXDAG_MAX_LEVELS; 0 means 10 */
+    voxdag_symmetry symmetry; /* empty scene: 0 means VOXDAG_SYMMETRY_FULL */
+    int colors;               /* empty scene: 1 gives every voxel an RGB8 colour */
+    uint64_t max_memory;      /* bytes the editor may hold (nodes, colours, history,
+                                 a commit's builder); 0: no limit; more is
+                                 VOXDAG_ERR_LIMIT and the edit is not applied */
+    voxdag_allocator allocator;
+    uint32_t zero_end;
+} voxdag_editor_opts;
+
+/* Opens an editor on the voxels and colours of DAG (NULL: an empty scene as
+   OPTS describes). A DAG with voxcolor colours needs voxcolor.h compiled in
+   (VOXDAG_ERR_INVALID_ARGUMENT otherwise); the editor then holds the decoded
+   colours. The DAG is not kept. Returns VOXDAG_OK and *OUT, or an error with
+   nothing allocated. */
+VOXDAG_API voxdag_status voxdag_editor_create(const voxdag *dag, const voxdag_editor_opts *opts,
+                                              voxdag_editor **out, voxdag_error *err);
+
+/* Frees an editor (NULL is allowed). DAGs it committed stay valid. */
+VOXDAG_API void voxdag_editor_free(voxdag_editor *ed);
+
+/* The colour an edit gives voxels: RGB when FN is NULL, else FN's answer for
+   each voxel's position. A NULL brush gives new voxels white (255, 255, 255)
+   and leaves the colours of voxels already there. */
+typedef void (*voxdag_color_at_fn)(void *user, uint32_t x, uint32_t y, uint32_t z, uint8_t rgb[3]);
+typedef struct voxdag_brush {
+    uint8_t rgb[3];
+    voxdag_color_at_fn fn;
+    void *user;
+} voxdag_brush;
+
+/* A region of the grid, in signed voxel coordinates (each within +-2^28,
+   VOXDAG_ERR_COORDINATE otherwise); the part outside the grid is ignored.
+   BOX: voxels with lo[a] <= v[a] < hi[a], empty when hi[a] <= lo[a].
+   SPHERE: voxels with (2x+1-2c[0])^2 + (2y+1-2c[1])^2 + (2z+1-2c[2])^2
+   <= 4 radius^2 (radius 0..2^28). */
+typedef enum voxdag_shape_kind {
+    VOXDAG_SHAPE_BOX = 0,
+    VOXDAG_SHAPE_SPHERE = 1,
+    VOXDAG_SHAPE_COUNT,
+    VOXDAG_SHAPE_FORCE_32BIT = 0x7fffffff
+} voxdag_shape_kind;
+
+typedef struct voxdag_shape {
+    voxdag_shape_kind kind;
+    int64_t lo[3], hi[3]; /* BOX */
+    int64_t center[3];    /* SPHERE */
+    int64_t radius;       /* SPHERE */
+} voxdag_shape;
+
+/* Edits. Each call is one edit in the history (also one that changes
+   nothing); after an undo, a new edit discards what could be redone. A
+   failed edit changes nothing. Returns VOXDAG_OK, VOXDAG_ERR_COORDINATE for
+   a coordinate outside the grid (set, clear: err->node is the voxel's
+   position in XYZ) or beyond +-2^28 (shapes, copy),
+   VOXDAG_ERR_INVALID_ARGUMENT for a NULL pointer, a bad shape kind or a
+   negative radius, VOXDAG_ERR_OUT_OF_MEMORY or VOXDAG_ERR_LIMIT.
+   set:   makes the N voxels XYZ (3 coordinates each) full; RGB, 3 bytes per
+          voxel, gives their colours (NULL: new voxels white, the others
+          keep theirs). A voxel given twice takes the last colour.
+   clear: makes the N voxels XYZ empty.
+   fill:  makes SHAPE full; BRUSH (may be NULL) colours it, also the
+          voxels already there.
+   carve: makes SHAPE empty.
+   paint: recolours the full voxels in SHAPE with BRUSH (geometry untouched).
+   copy:  copies the voxels of box LO..HI (full and empty, with colours) to
+          the same box moved by OFFSET; the whole source is read before
+          anything is written, and destinations outside the grid are dropped. */
+VOXDAG_API voxdag_status voxdag_editor_set(voxdag_editor *ed, const uint32_t *xyz, const uint8_t *rgb,
+                                           size_t n, voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_editor_clear(voxdag_editor *ed, const uint32_t *xyz, size_t n,
+                                             voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_editor_fill(voxdag_editor *ed, const voxdag_shape *shape,
+                                            const voxdag_brush *brush, voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_editor_carve(voxdag_editor *ed, const voxdag_shape *shape,
+                                             voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_editor_paint(voxdag_editor *ed, const voxdag_shape *shape,
+                                             const voxdag_brush *brush, voxdag_error *err);
+VOXDAG_API voxdag_status voxdag_editor_copy(voxdag_editor *ed, const int64_t lo[3], const int64_t hi[3],
+                                            const int64_t offset[3], voxdag_error *err);
+
+/* Undoes the last applied edit, or redoes the last undone one. Returns 1,
+   or 0 when there is none (or ED is NULL). No allocation; cannot fail. */
+VOXDAG_API int voxdag_editor_undo(voxdag_editor *ed);
+VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed);
+
+/* Forgets the history (nothing to undo or redo afterwards) and frees the
+   colour blocks only the history held: an edit keeps every block it
+   replaced (256 bytes per brick whose colours it changed) until then.
+   Nodes are kept (they are shared and small). Returns VOXDAG_OK, or
+   VOXDAG_ERR_OUT_OF_MEMORY / VOXDAG_ERR_LIMIT with nothing changed. */
+VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err);
+
+/* Queries on the edited scene, with the meaning of voxdag_lookup,
+   voxdag_color and voxdag_for_each_voxel (voxel indices are ranks in Morton
+   order of the scene as it is now). voxdag_editor_voxels gives the voxel
+   count. Thread-safe between edits (they only read). */
+VOXDAG_API int voxdag_editor_lookup(const voxdag_editor *ed, uint32_t x, uint32_t y, uint32_t z,
+                                    uint64_t *index);
+VOXDAG_API int voxdag_editor_color(const voxdag_editor *ed, uint64_t index, uint8_t rgb[3]);
+VOXDAG_API uint64_t voxdag_editor_for_each_voxel(const voxdag_editor *ed, voxdag_voxel_fn fn, void *user);
+VOXDAG_API uint64_t voxdag_editor_voxels(const voxdag_editor *ed);
+
+/* Bytes the editor holds now (nodes of every state the history can reach,
+   colour blocks, history), the figure max_memory limits. */
+VOXDAG_API uint64_t voxdag_editor_memory(const voxdag_editor *ed);
+
+/* The unique nodes the scene reaches now, per level as voxdag_info.nodes
+   (levels 0..L-2, the last entry 4^3 bricks; the rest of NODES set to 0):
+   the canonical counts of the scene's voxels, as a build gives them. Returns
+   VOXDAG_OK, VOXDAG_ERR_INVALID_ARGUMENT for a NULL argument, or
+   VOXDAG_ERR_OUT_OF_MEMORY / VOXDAG_ERR_LIMIT (a byte per stored node is
+   needed for a moment). */
+VOXDAG_API voxdag_status voxdag_editor_nodes(voxdag_editor *ed, uint64_t nodes[VOXDAG_LEVEL_CAPACITY],
+                                             voxdag_error *err);
+
+/* Encodes the scene as it is now into a new DAG (*OUT, freed with
+   voxdag_free): the bytes voxdag_builder gives for the same voxels and
+   colours with the same levels, symmetry and world bounds, colours raw RGB8
+   (voxdag_with_colors can replace them). The editor stays usable. Time and
+   memory are those of a build of the scene's voxels. */
+VOXDAG_API voxdag_status voxdag_editor_commit(voxdag_editor *ed, voxdag **out, voxdag_error *err);
+
+#ifndef VOXDAG_NO_RAYTRACE
+/* voxdag_raycast and voxdag_occluded_opts on the edited scene. They trace a
+   commit that the editor keeps until the next edit, undo or redo (so the
+   first ray after a change costs a commit). Return -1 also when that commit
+   fails (memory, limits). */
+VOXDAG_API int voxdag_editor_raycast(voxdag_editor *ed, const voxdag_ray *ray,
+                                     const voxdag_ray_opts *opts, voxdag_hit *hit);
+VOXDAG_API int voxdag_editor_occluded(voxdag_editor *ed, const voxdag_ray *ray,
+                                      const voxdag_ray_opts *opts);
+#endif
+#endif /* VOXDAG_NO_BUILD */
 
 // -- File layout (FORMAT.md): byte offsets and codes, checked by the tests
 
@@ -1751,6 +1911,11 @@ static unsigned voxdagi_normalize(const voxdagi_cube *c, unsigned t, uint64_t st
     return best;
 }
 
+/* The reference "T applied to reference REF": the same node, tag T o t. */
+static uint32_t voxdagi_ref_compose(unsigned tf, uint32_t ref) {
+    return (ref & ~63u) | voxdagi_cube_tables.comp[tf][ref & 63];
+}
+
 /* A reference to the canonical form: its key, the tag that maps the canonical
    node back to the input, and the canonical node's stabilizer. */
 typedef struct voxdagi_canon {
@@ -2610,11 +2775,6 @@ static void *voxdagi_worker_run(void *arg) {
         }
     }
     return NULL;
-}
-
-/* The reference "T applied to reference REF": the same node, tag T o t. */
-static uint32_t voxdagi_ref_compose(unsigned tf, uint32_t ref) {
-    return (ref & ~63u) | voxdagi_cube_tables.comp[tf][ref & 63];
 }
 
 /* Re-interns every node of a worker's reducer W into R, bottom-up. MAP[l]
@@ -7368,6 +7528,1004 @@ VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path, v
     return voxdagi_ok(err);
 }
 #endif
+
+// -- Editing: the builder's node tables, changed path by path
+#ifndef VOXDAG_NO_BUILD
+//
+// The scene is a reference into a voxdagi_reducer's unique-node stores, which
+// never change once a node is interned: an edit builds new nodes along the
+// edited region bottom-up through voxdagi_reduce_node / _brick (the builder's
+// canonical forms and hash-consing), so old roots stay valid and undo is a
+// root swap. Colours live in 64-colour blocks, one per 4^3 brick, found by
+// the brick's Morton key; an edit writes only into blocks it made itself and
+// copies any other block first, logging (brick, block before, block after),
+// which is what undo and redo replay. Nothing is freed before the editor is.
+
+#define VOXDAGI_NO_BLOCK 0xFFFFFFFFu
+#define VOXDAGI_EDIT_COORD_MAX ((int64_t)1 << 28)
+#define VOXDAGI_WHITE 0xFFFFFFu
+
+typedef struct voxdagi_color_change {
+    uint64_t brick;
+    uint32_t before, after; /* blocks, VOXDAGI_NO_BLOCK when none */
+} voxdagi_color_change;
+
+typedef struct voxdagi_edit_record {
+    uint32_t root_before, root_after;
+    size_t change_begin, change_end; /* its colour changes */
+} voxdagi_edit_record;
+
+struct voxdag_editor {
+    voxdagi_mem mem;
+    uint32_t levels;
+    voxdag_symmetry symmetry;
+    int colors, has_bounds;
+    double bounds[6];
+    voxdagi_group group;
+    voxdagi_reducer red;                /* the unique nodes of every level */
+    uint32_t root;                      /* the scene now; VOXDAGI_NONE: empty */
+    uint32_t full[VOXDAG_MAX_LEVELS];   /* a full subtree per level, once made */
+    uint32_t *block;                    /* 64 packed 0xRRGGBB per block */
+    uint64_t *block_serial;             /* the edit that made each block */
+    size_t block_n, block_cap, serial_cap;
+    uint64_t *map_key;                  /* brick key -> block, open addressing */
+    uint32_t *map_block;
+    uint8_t *map_used;
+    size_t map_n, map_cap;              /* map_cap: a power of two or 0 */
+    voxdagi_color_change *change;
+    size_t change_n, change_cap;
+    voxdagi_edit_record *history;       /* [0, done) applied, [done, kept) undone */
+    size_t done, kept, history_cap;
+    uint64_t serial;                    /* the edit being made */
+    size_t edit_change_begin;
+    voxdag *traced;                     /* a commit of the scene now, for rays */
+};
+
+static uint64_t voxdagi_ed_count(const voxdag_editor *ed, uint32_t level, uint32_t ref) {
+    return ref == VOXDAGI_NONE ? 0 : ed->red.store[level].node[ref >> 6].count;
+}
+
+/* The mask of brick reference REF in world orientation. */
+static uint64_t voxdagi_ed_brick(const voxdag_editor *ed, uint32_t ref) {
+    if (ref == VOXDAGI_NONE) return 0;
+    return voxdagi_transform_brick(&ed->group, ed->red.store[ed->levels - 2].node[ref >> 6].key, ref & 63);
+}
+
+/* The world-oriented child references of inner reference REF of LEVEL: the
+   stored child of octant j lands in octant T(j), transformed by T. */
+static void voxdagi_ed_children(const voxdag_editor *ed, uint32_t level, uint32_t ref, uint32_t child[8]) {
+    unsigned j, tf = ref & 63;
+    const uint32_t *slot;
+    for (j = 0; j < 8; j++) child[j] = VOXDAGI_NONE;
+    if (ref == VOXDAGI_NONE) return;
+    slot = ed->red.store[level].child + 8 * (size_t)(ref >> 6);
+    for (j = 0; j < 8; j++)
+        if (slot[j] != VOXDAGI_NONE) child[voxdagi_cube_tables.act[tf][j]] = voxdagi_ref_compose(tf, slot[j]);
+}
+
+/* The node of LEVEL with world children CHILD (all absent: none). */
+static uint32_t voxdagi_ed_node(voxdag_editor *ed, uint32_t level, const uint32_t child[8]) {
+    unsigned j;
+    for (j = 0; j < 8; j++)
+        if (child[j] != VOXDAGI_NONE) return voxdagi_reduce_node(&ed->red, level, child);
+    return VOXDAGI_NONE;
+}
+
+static uint32_t voxdagi_ed_brick_ref(voxdag_editor *ed, uint64_t mask) {
+    return mask ? voxdagi_reduce_brick(&ed->red, mask) : VOXDAGI_NONE;
+}
+
+/* The full subtree of LEVEL (VOXDAGI_NONE when out of memory). */
+static uint32_t voxdagi_ed_full(voxdag_editor *ed, uint32_t level) {
+    uint32_t child[8];
+    unsigned j;
+    if (ed->full[level] != VOXDAGI_NONE) return ed->full[level];
+    if (level == ed->levels - 2) {
+        ed->full[level] = voxdagi_reduce_brick(&ed->red, ~0ull);
+    } else {
+        uint32_t c = voxdagi_ed_full(ed, level + 1);
+        if (c == VOXDAGI_NONE) return c;
+        for (j = 0; j < 8; j++) child[j] = c;
+        ed->full[level] = voxdagi_reduce_node(&ed->red, level, child);
+    }
+    return ed->full[level];
+}
+
+// -- Editing: colour blocks (per brick, copy on write)
+
+static size_t voxdagi_ed_map_find(const voxdag_editor *ed, uint64_t brick) {
+    size_t i, mask = ed->map_cap - 1;
+    if (!ed->map_cap) return (size_t)-1;
+    for (i = (size_t)voxdagi_mix64(brick) & mask; ed->map_used[i]; i = (i + 1) & mask)
+        if (ed->map_key[i] == brick) return i;
+    return (size_t)-1;
+}
+
+/* The map slot of BRICK, made when missing. Returns (size_t)-1 when out of memory. */
+static size_t voxdagi_ed_map_slot(voxdag_editor *ed, uint64_t brick) {
+    size_t i = voxdagi_ed_map_find(ed, brick), mask;
+    if (i != (size_t)-1) return i;
+    if ((ed->map_n + 1) * 2 > ed->map_cap) { /* rehash at half load */
+        size_t cap = ed->map_cap ? ed->map_cap * 2 : 256, j;
+        uint64_t *key = (uint64_t *)voxdagi_alloc(&ed->mem, cap * sizeof *key);
+        uint32_t *block = (uint32_t *)voxdagi_alloc(&ed->mem, cap * sizeof *block);
+        uint8_t *used = (uint8_t *)voxdagi_alloc(&ed->mem, cap);
+        if (!key || !block || !used) {
+            voxdagi_free(&ed->mem, key, cap * sizeof *key);
+            voxdagi_free(&ed->mem, block, cap * sizeof *block);
+            voxdagi_free(&ed->mem, used, cap);
+            return (size_t)-1;
+        }
+        memset(used, 0, cap);
+        for (j = 0; j < ed->map_cap; j++) {
+            if (!ed->map_used[j]) continue;
+            for (i = (size_t)voxdagi_mix64(ed->map_key[j]) & (cap - 1); used[i]; i = (i + 1) & (cap - 1)) {}
+            used[i] = 1;
+            key[i] = ed->map_key[j];
+            block[i] = ed->map_block[j];
+        }
+        voxdagi_free(&ed->mem, ed->map_key, ed->map_cap * sizeof *ed->map_key);
+        voxdagi_free(&ed->mem, ed->map_block, ed->map_cap * sizeof *ed->map_block);
+        voxdagi_free(&ed->mem, ed->map_used, ed->map_cap);
+        ed->map_key = key;
+        ed->map_block = block;
+        ed->map_used = used;
+        ed->map_cap = cap;
+    }
+    mask = ed->map_cap - 1;
+    for (i = (size_t)voxdagi_mix64(brick) & mask; ed->map_used[i]; i = (i + 1) & mask) {}
+    ed->map_used[i] = 1;
+    ed->map_key[i] = brick;
+    ed->map_block[i] = VOXDAGI_NO_BLOCK;
+    ed->map_n++;
+    return i;
+}
+
+/* The colours of BRICK (packed 0xRRGGBB), NULL when it has none. */
+static const uint32_t *voxdagi_ed_colors(const voxdag_editor *ed, uint64_t brick) {
+    size_t i = voxdagi_ed_map_find(ed, brick);
+    if (i == (size_t)-1 || ed->map_block[i] == VOXDAGI_NO_BLOCK) return NULL;
+    return ed->block + 64 * (size_t)ed->map_block[i];
+}
+
+/* The colours of BRICK for this edit to write: its own block, or a new copy
+   of the current one (logged). NULL when out of memory. */
+static uint32_t *voxdagi_ed_colors_to_write(voxdag_editor *ed, uint64_t brick) {
+    size_t i = voxdagi_ed_map_slot(ed, brick), k;
+    uint32_t old, made;
+    if (i == (size_t)-1) return NULL;
+    old = ed->map_block[i];
+    if (old != VOXDAGI_NO_BLOCK && ed->block_serial[old] == ed->serial) return ed->block + 64 * (size_t)old;
+    if (ed->block_n + 1 >= VOXDAGI_NO_BLOCK) return NULL;
+    if (!voxdagi_grow(&ed->mem, (void **)&ed->block, &ed->block_cap, (ed->block_n + 1) * 64, sizeof *ed->block) ||
+        !voxdagi_grow(&ed->mem, (void **)&ed->block_serial, &ed->serial_cap, ed->block_n + 1,
+                      sizeof *ed->block_serial) ||
+        !voxdagi_grow(&ed->mem, (void **)&ed->change, &ed->change_cap, ed->change_n + 1, sizeof *ed->change))
+        return NULL;
+    made = (uint32_t)ed->block_n++;
+    if (old != VOXDAGI_NO_BLOCK) memcpy(ed->block + 64 * (size_t)made, ed->block + 64 * (size_t)old, 64 * sizeof *ed->block);
+    else for (k = 0; k < 64; k++) ed->block[64 * (size_t)made + k] = VOXDAGI_WHITE;
+    ed->block_serial[made] = ed->serial;
+    ed->change[ed->change_n].brick = brick;
+    ed->change[ed->change_n].before = old;
+    ed->change[ed->change_n].after = made;
+    ed->change_n++;
+    ed->map_block[i] = made;
+    return ed->block + 64 * (size_t)made;
+}
+
+/* Points every brick of changes [BEGIN, END) at its block before (or after). */
+static void voxdagi_ed_replay(voxdag_editor *ed, size_t begin, size_t end, int after) {
+    size_t k;
+    if (after) {
+        for (k = begin; k < end; k++) ed->map_block[voxdagi_ed_map_find(ed, ed->change[k].brick)] = ed->change[k].after;
+    } else {
+        for (k = end; k-- > begin;) ed->map_block[voxdagi_ed_map_find(ed, ed->change[k].brick)] = ed->change[k].before;
+    }
+}
+
+static uint32_t voxdagi_pack_rgb(const uint8_t rgb[3]) {
+    return (uint32_t)rgb[0] << 16 | (uint32_t)rgb[1] << 8 | rgb[2];
+}
+
+static void voxdagi_unpack_rgb(uint32_t c, uint8_t rgb[3]) {
+    rgb[0] = (uint8_t)(c >> 16);
+    rgb[1] = (uint8_t)(c >> 8);
+    rgb[2] = (uint8_t)c;
+}
+
+/* Colours the voxels BITS of brick BRICK with BRUSH (NULL: white). Returns 0
+   when out of memory. */
+static int voxdagi_ed_paint_bits(voxdag_editor *ed, uint64_t brick, uint64_t bits, const voxdag_brush *brush) {
+    uint32_t *c, fixed = brush ? voxdagi_pack_rgb(brush->rgb) : VOXDAGI_WHITE, x, y, z;
+    if (!ed->colors || !bits) return 1;
+    c = voxdagi_ed_colors_to_write(ed, brick);
+    if (!c) return 0;
+    if (!brush || !brush->fn) {
+        for (; bits; bits &= bits - 1) c[voxdagi_lowest_bit(bits)] = fixed;
+        return 1;
+    }
+    voxdag_morton_decode(brick << 6, &x, &y, &z); /* the brick's lowest voxel */
+    for (; bits; bits &= bits - 1) {
+        unsigned p = voxdagi_lowest_bit(bits);
+        uint8_t rgb[3] = {0, 0, 0};
+        brush->fn(brush->user, x + (p & 1) + (p >> 2 & 2), y + (p >> 1 & 1) + (p >> 3 & 2),
+                  z + (p >> 2 & 1) + (p >> 4 & 2), rgb);
+        c[p] = voxdagi_pack_rgb(rgb);
+    }
+    return 1;
+}
+
+// -- Editing: transactions and history
+
+static void voxdagi_ed_drop_traced(voxdag_editor *ed) {
+    voxdag_free(ed->traced);
+    ed->traced = NULL;
+}
+
+/* Starts an edit: room for its record, a serial of its own. */
+static voxdag_status voxdagi_ed_begin(voxdag_editor *ed, voxdag_error *err) {
+    if (!voxdagi_grow(&ed->mem, (void **)&ed->history, &ed->history_cap, ed->kept + 1, sizeof *ed->history))
+        return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    ed->serial++;
+    ed->red.failed = 0;
+    ed->edit_change_begin = ed->change_n;
+    return VOXDAG_OK;
+}
+
+/* Ends an edit that made ROOT: applies it, or (after a failure) undoes its
+   colour changes and keeps the scene as it was. The edits that could be
+   redone are discarded only by an edit that succeeds. */
+static voxdag_status voxdagi_ed_end(voxdag_editor *ed, uint32_t root, int failed, voxdag_error *err) {
+    size_t begin = ed->edit_change_begin, n = ed->change_n - begin, at;
+    voxdagi_edit_record *rec;
+    if (failed || ed->red.failed) {
+        voxdagi_ed_replay(ed, begin, ed->change_n, 0);
+        ed->change_n = begin;
+        ed->red.failed = 0;
+        return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    at = ed->done ? ed->history[ed->done - 1].change_end : 0;
+    if (n && at != begin) memmove(ed->change + at, ed->change + begin, n * sizeof *ed->change);
+    ed->change_n = at + n;
+    rec = &ed->history[ed->done];
+    rec->root_before = ed->root;
+    rec->root_after = root;
+    rec->change_begin = at;
+    rec->change_end = at + n;
+    ed->kept = ++ed->done;
+    ed->root = root;
+    voxdagi_ed_drop_traced(ed);
+    return voxdagi_ok(err);
+}
+
+VOXDAG_API int voxdag_editor_undo(voxdag_editor *ed) {
+    voxdagi_edit_record *rec;
+    if (!ed || !ed->done) return 0;
+    rec = &ed->history[--ed->done];
+    voxdagi_ed_replay(ed, rec->change_begin, rec->change_end, 0);
+    ed->root = rec->root_before;
+    voxdagi_ed_drop_traced(ed);
+    return 1;
+}
+
+VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed) {
+    voxdagi_edit_record *rec;
+    if (!ed || ed->done == ed->kept) return 0;
+    rec = &ed->history[ed->done++];
+    voxdagi_ed_replay(ed, rec->change_begin, rec->change_end, 1);
+    ed->root = rec->root_after;
+    voxdagi_ed_drop_traced(ed);
+    return 1;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err) {
+    uint32_t *block = NULL;
+    uint64_t *serial = NULL;
+    size_t i, n = 0;
+    if (!ed) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no editor");
+    for (i = 0; i < ed->map_cap; i++) n += ed->map_used[i] && ed->map_block[i] != VOXDAGI_NO_BLOCK;
+    if (n) {
+        block = (uint32_t *)voxdagi_alloc(&ed->mem, n * 64 * sizeof *block);
+        serial = (uint64_t *)voxdagi_alloc(&ed->mem, n * sizeof *serial);
+    }
+    if (n && (!block || !serial)) {
+        voxdagi_free(&ed->mem, block, n * 64 * sizeof *block);
+        voxdagi_free(&ed->mem, serial, n * sizeof *serial);
+        return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    }
+    for (i = 0, n = 0; i < ed->map_cap; i++) { /* the blocks the scene uses now, packed */
+        if (!ed->map_used[i] || ed->map_block[i] == VOXDAGI_NO_BLOCK) continue;
+        memcpy(block + 64 * n, ed->block + 64 * (size_t)ed->map_block[i], 64 * sizeof *block);
+        serial[n] = 0; /* no edit's: the next one copies before writing */
+        ed->map_block[i] = (uint32_t)n++;
+    }
+    voxdagi_free(&ed->mem, ed->block, ed->block_cap * sizeof *ed->block);
+    voxdagi_free(&ed->mem, ed->block_serial, ed->serial_cap * sizeof *ed->block_serial);
+    ed->block = block;
+    ed->block_serial = serial;
+    ed->block_n = n;
+    ed->block_cap = n * 64;
+    ed->serial_cap = n;
+    ed->change_n = 0;
+    ed->done = ed->kept = 0;
+    return voxdagi_ok(err);
+}
+
+// -- Editing: shapes
+
+enum { VOXDAGI_OUTSIDE, VOXDAGI_PARTLY, VOXDAGI_INSIDE };
+enum { VOXDAGI_FILL, VOXDAGI_CARVE, VOXDAGI_PAINT };
+
+/* A shape edit: what it does, where (integers, spheres doubled), with what. */
+typedef struct voxdagi_ed_op {
+    int action;
+    voxdag_shape_kind kind;
+    int64_t lo[3], hi[3];       /* box */
+    int64_t c2[3], r2;          /* sphere: 2 centre, 4 radius^2 */
+    const voxdag_brush *brush;
+} voxdagi_ed_op;
+
+/* The smallest and largest (2v+1-c2)^2 over v in [o, o+size). */
+static void voxdagi_ed_sq_range(int64_t o, int64_t size, int64_t c2, int64_t *lo, int64_t *hi) {
+    int64_t a = 2 * o + 1 - c2, b = 2 * (o + size - 1) + 1 - c2;
+    int64_t aa = a < 0 ? -a : a, bb = b < 0 ? -b : b;
+    *hi = aa > bb ? aa * aa : bb * bb;
+    *lo = a <= 0 && b >= 0 ? 1 : aa < bb ? aa * aa : bb * bb;
+}
+
+/* Where the cube [o, o+size)^3 lies against the op's shape. */
+static int voxdagi_ed_classify(const voxdagi_ed_op *op, const int64_t o[3], int64_t size) {
+    unsigned a;
+    if (op->kind == VOXDAG_SHAPE_BOX) {
+        int inside = 1;
+        for (a = 0; a < 3; a++) {
+            if (op->hi[a] <= op->lo[a] || o[a] + size <= op->lo[a] || o[a] >= op->hi[a]) return VOXDAGI_OUTSIDE;
+            if (o[a] < op->lo[a] || o[a] + size > op->hi[a]) inside = 0;
+        }
+        return inside ? VOXDAGI_INSIDE : VOXDAGI_PARTLY;
+    } else {
+        int64_t near = 0, far = 0, lo, hi;
+        for (a = 0; a < 3; a++) {
+            voxdagi_ed_sq_range(o[a], size, op->c2[a], &lo, &hi);
+            near += lo;
+            far += hi;
+        }
+        return near > op->r2 ? VOXDAGI_OUTSIDE : far <= op->r2 ? VOXDAGI_INSIDE : VOXDAGI_PARTLY;
+    }
+}
+
+/* The voxels of the brick at O that lie in the op's shape. */
+static uint64_t voxdagi_ed_shape_mask(const voxdagi_ed_op *op, const int64_t o[3]) {
+    uint64_t mask = 0;
+    unsigned p;
+    int cls = voxdagi_ed_classify(op, o, 4);
+    if (cls != VOXDAGI_PARTLY) return cls == VOXDAGI_INSIDE ? ~0ull : 0;
+    for (p = 0; p < 64; p++) {
+        int64_t v[3];
+        v[0] = o[0] + (p & 1) + (p >> 2 & 2);
+        v[1] = o[1] + (p >> 1 & 1) + (p >> 3 & 2);
+        v[2] = o[2] + (p >> 2 & 1) + (p >> 4 & 2);
+        if (voxdagi_ed_classify(op, v, 1) == VOXDAGI_INSIDE) mask |= 1ull << p;
+    }
+    return mask;
+}
+
+/* Applies OP to the subtree REF of LEVEL whose lowest voxel is O (Morton
+   prefix KEY); returns the new reference. Depth at most L - 1. */
+static uint32_t voxdagi_ed_apply(voxdag_editor *ed, const voxdagi_ed_op *op, uint32_t level, uint32_t ref,
+                                 const int64_t o[3], uint64_t key) {
+    int64_t size = (int64_t)1 << (ed->levels - level);
+    int cls = voxdagi_ed_classify(op, o, size);
+    int colored = ed->colors && (op->action == VOXDAGI_PAINT || op->action == VOXDAGI_FILL);
+    uint32_t child[8], made[8];
+    unsigned j, same = 1;
+    if (cls == VOXDAGI_OUTSIDE || ed->red.failed) return ref;
+    if (op->action == VOXDAGI_PAINT && ref == VOXDAGI_NONE) return ref;
+    if (op->action == VOXDAGI_CARVE && (ref == VOXDAGI_NONE || cls == VOXDAGI_INSIDE)) return VOXDAGI_NONE;
+    if (op->action == VOXDAGI_FILL && cls == VOXDAGI_INSIDE) {
+        uint32_t full = voxdagi_ed_full(ed, level);
+        if (full == VOXDAGI_NONE) return ref;
+        if (!colored || (full == ref && !op->brush)) return full;
+    }
+    if (level == ed->levels - 2) {
+        uint64_t old = voxdagi_ed_brick(ed, ref), in = voxdagi_ed_shape_mask(op, o), now = old, bits = 0;
+        if (op->action == VOXDAGI_FILL) now = old | in, bits = op->brush ? in : in & ~old;
+        if (op->action == VOXDAGI_CARVE) now = old & ~in;
+        if (op->action == VOXDAGI_PAINT) bits = old & in;
+        if (colored && !voxdagi_ed_paint_bits(ed, key, bits, op->brush)) ed->red.failed = 1;
+        return now == old ? ref : voxdagi_ed_brick_ref(ed, now);
+    }
+    voxdagi_ed_children(ed, level, ref, child);
+    for (j = 0; j < 8; j++) {
+        int64_t c[3], half = size / 2;
+        c[0] = o[0] + (j & 1) * half;
+        c[1] = o[1] + (j >> 1 & 1) * half;
+        c[2] = o[2] + (j >> 2 & 1) * half;
+        made[j] = voxdagi_ed_apply(ed, op, level + 1, child[j], c, key << 3 | j);
+        same &= made[j] == child[j];
+    }
+    return same ? ref : voxdagi_ed_node(ed, level, made);
+}
+
+/* Checks a shape and turns it into an op. */
+static voxdag_status voxdagi_ed_op_make(voxdagi_ed_op *op, int action, const voxdag_shape *shape,
+                                        const voxdag_brush *brush, voxdag_error *err) {
+    unsigned a;
+    memset(op, 0, sizeof *op);
+    if (!shape || (shape->kind != VOXDAG_SHAPE_BOX && shape->kind != VOXDAG_SHAPE_SPHERE))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no shape, or an unknown shape kind");
+    op->action = action;
+    op->kind = shape->kind;
+    op->brush = brush;
+    for (a = 0; a < 3; a++) {
+        const int64_t *v = shape->kind == VOXDAG_SHAPE_BOX ? shape->lo : shape->center;
+        const int64_t *w = shape->kind == VOXDAG_SHAPE_BOX ? shape->hi : shape->center;
+        if (v[a] < -VOXDAGI_EDIT_COORD_MAX || v[a] > VOXDAGI_EDIT_COORD_MAX ||
+            w[a] < -VOXDAGI_EDIT_COORD_MAX || w[a] > VOXDAGI_EDIT_COORD_MAX)
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_COORDINATE, "a shape coordinate is beyond +-2^28");
+        op->lo[a] = shape->lo[a];
+        op->hi[a] = shape->hi[a];
+        op->c2[a] = 2 * shape->center[a];
+    }
+    if (shape->kind == VOXDAG_SHAPE_SPHERE) {
+        if (shape->radius < 0) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "a negative radius");
+        if (shape->radius > VOXDAGI_EDIT_COORD_MAX)
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_COORDINATE, "a radius beyond 2^28");
+        op->r2 = 4 * shape->radius * shape->radius;
+    }
+    return VOXDAG_OK;
+}
+
+/* One shape edit, as a whole edit of the history. */
+static voxdag_status voxdagi_ed_shape_edit(voxdag_editor *ed, int action, const voxdag_shape *shape,
+                                           const voxdag_brush *brush, voxdag_error *err) {
+    voxdagi_ed_op op;
+    int64_t o[3] = {0, 0, 0};
+    voxdag_status st;
+    uint32_t root;
+    if (!ed) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no editor");
+    if ((st = voxdagi_ed_op_make(&op, action, shape, brush, err)) != VOXDAG_OK) return st;
+    if ((st = voxdagi_ed_begin(ed, err)) != VOXDAG_OK) return st;
+    root = voxdagi_ed_apply(ed, &op, 0, ed->root, o, 0);
+    return voxdagi_ed_end(ed, root, 0, err);
+}
+
+VOXDAG_API voxdag_status voxdag_editor_fill(voxdag_editor *ed, const voxdag_shape *shape,
+                                            const voxdag_brush *brush, voxdag_error *err) {
+    return voxdagi_ed_shape_edit(ed, VOXDAGI_FILL, shape, brush, err);
+}
+
+VOXDAG_API voxdag_status voxdag_editor_carve(voxdag_editor *ed, const voxdag_shape *shape, voxdag_error *err) {
+    return voxdagi_ed_shape_edit(ed, VOXDAGI_CARVE, shape, NULL, err);
+}
+
+VOXDAG_API voxdag_status voxdag_editor_paint(voxdag_editor *ed, const voxdag_shape *shape,
+                                             const voxdag_brush *brush, voxdag_error *err) {
+    if (!brush) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "paint needs a brush");
+    return voxdagi_ed_shape_edit(ed, VOXDAGI_PAINT, shape, brush, err);
+}
+
+// -- Editing: voxel lists
+
+/* One voxel of a list edit: its Morton code, whether it becomes full, its
+   colour (HAS_RGB 0: white when new, else kept) and its order in the call. */
+typedef struct voxdagi_ed_voxel {
+    uint64_t code;
+    uint32_t rgb;
+    uint8_t full, has_rgb;
+    size_t order;
+} voxdagi_ed_voxel;
+
+static int voxdagi_ed_voxel_cmp(const void *a, const void *b) {
+    const voxdagi_ed_voxel *u = (const voxdagi_ed_voxel *)a, *v = (const voxdagi_ed_voxel *)b;
+    if (u->code != v->code) return u->code < v->code ? -1 : 1;
+    return u->order < v->order ? -1 : u->order > v->order;
+}
+
+/* Applies the voxels V[0..N) (sorted by code, all inside this subtree) to
+   subtree REF of LEVEL with Morton prefix KEY. */
+static uint32_t voxdagi_ed_apply_list(voxdag_editor *ed, uint32_t level, uint32_t ref, uint64_t key,
+                                      const voxdagi_ed_voxel *v, size_t n) {
+    uint32_t child[8], made[8];
+    unsigned j, same = 1, shift;
+    size_t i = 0;
+    if (!n || ed->red.failed) return ref;
+    if (level == ed->levels - 2) {
+        uint64_t old = voxdagi_ed_brick(ed, ref), now = old;
+        uint32_t *c = NULL;
+        for (i = 0; i < n; i++) {
+            uint64_t bit = 1ull << (v[i].code & 63);
+            int fresh = v[i].full && !(now & bit);
+            now = v[i].full ? now | bit : now & ~bit;
+            if (ed->colors && v[i].full && (v[i].has_rgb || fresh)) {
+                if (!c && !(c = voxdagi_ed_colors_to_write(ed, key))) {
+                    ed->red.failed = 1;
+                    return ref;
+                }
+                c[v[i].code & 63] = v[i].has_rgb ? v[i].rgb : VOXDAGI_WHITE;
+            }
+        }
+        return now == old ? ref : voxdagi_ed_brick_ref(ed, now);
+    }
+    shift = 3 * (ed->levels - level - 1);
+    voxdagi_ed_children(ed, level, ref, child);
+    for (j = 0; j < 8; j++) {
+        size_t begin = i;
+        while (i < n && (v[i].code >> shift & 7) == j) i++;
+        made[j] = voxdagi_ed_apply_list(ed, level + 1, child[j], key << 3 | j, v + begin, i - begin);
+        same &= made[j] == child[j];
+    }
+    return same ? ref : voxdagi_ed_node(ed, level, made);
+}
+
+/* Applies the list V (N voxels, sorted here) as part of the current edit. */
+static uint32_t voxdagi_ed_list(voxdag_editor *ed, uint32_t root, voxdagi_ed_voxel *v, size_t n) {
+    if (n) qsort(v, n, sizeof *v, voxdagi_ed_voxel_cmp);
+    return voxdagi_ed_apply_list(ed, 0, root, 0, v, n);
+}
+
+static voxdag_status voxdagi_ed_list_edit(voxdag_editor *ed, const uint32_t *xyz, const uint8_t *rgb,
+                                          size_t n, int full, voxdag_error *err) {
+    voxdagi_ed_voxel *v;
+    voxdag_status st;
+    uint32_t root;
+    size_t i, bytes;
+    if (!ed || (n && !xyz)) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no editor or no voxels");
+    for (i = 0; i < n; i++)
+        if ((xyz[3 * i] | xyz[3 * i + 1] | xyz[3 * i + 2]) >> ed->levels)
+            return voxdagi_fail(err, VOXDAG_ERR_COORDINATE, "a voxel outside the grid", UINT64_MAX, i);
+    if (n > (size_t)-1 / sizeof *v) return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "too many voxels");
+    bytes = n * sizeof *v;
+    v = (voxdagi_ed_voxel *)voxdagi_alloc(&ed->mem, bytes);
+    if (!v) return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    for (i = 0; i < n; i++) {
+        v[i].code = voxdag_morton_encode(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
+        v[i].full = (uint8_t)full;
+        v[i].has_rgb = (uint8_t)(full && rgb);
+        v[i].rgb = full && rgb ? voxdagi_pack_rgb(rgb + 3 * i) : 0;
+        v[i].order = i;
+    }
+    st = voxdagi_ed_begin(ed, err);
+    if (st == VOXDAG_OK) {
+        root = voxdagi_ed_list(ed, ed->root, v, n);
+        st = voxdagi_ed_end(ed, root, 0, err);
+    }
+    voxdagi_free(&ed->mem, v, bytes);
+    return st;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_set(voxdag_editor *ed, const uint32_t *xyz, const uint8_t *rgb,
+                                           size_t n, voxdag_error *err) {
+    return voxdagi_ed_list_edit(ed, xyz, rgb, n, 1, err);
+}
+
+VOXDAG_API voxdag_status voxdag_editor_clear(voxdag_editor *ed, const uint32_t *xyz, size_t n, voxdag_error *err) {
+    return voxdagi_ed_list_edit(ed, xyz, NULL, n, 0, err);
+}
+
+// -- Editing: queries
+
+/* Visits the full voxels of subtree REF (LEVEL, lowest voxel O, prefix KEY)
+   inside BOX (an op, NULL: all) in Morton order, counting *INDEX; stops
+   when FN returns nonzero (returns 1 then). */
+typedef int (*voxdagi_ed_visit_fn)(void *user, const voxdag_editor *ed, uint64_t code, uint64_t index);
+
+static int voxdagi_ed_visit(const voxdag_editor *ed, const voxdagi_ed_op *box, uint32_t level, uint32_t ref,
+                            const int64_t o[3], uint64_t key, uint64_t *index, voxdagi_ed_visit_fn fn, void *user) {
+    int64_t size = (int64_t)1 << (ed->levels - level);
+    uint32_t child[8];
+    unsigned j;
+    if (ref == VOXDAGI_NONE) return 0;
+    if (box && voxdagi_ed_classify(box, o, size) == VOXDAGI_OUTSIDE) {
+        *index += voxdagi_ed_count(ed, level, ref);
+        return 0;
+    }
+    if (level == ed->levels - 2) {
+        uint64_t mask = voxdagi_ed_brick(ed, ref), in = box ? voxdagi_ed_shape_mask(box, o) : ~0ull;
+        for (; mask; mask &= mask - 1) {
+            unsigned p = voxdagi_lowest_bit(mask);
+            if ((in >> p & 1) && fn && fn(user, ed, key << 6 | p, *index)) return 1;
+            ++*index;
+        }
+        return 0;
+    }
+    voxdagi_ed_children(ed, level, ref, child);
+    for (j = 0; j < 8; j++) {
+        int64_t c[3], half = size / 2;
+        c[0] = o[0] + (j & 1) * half;
+        c[1] = o[1] + (j >> 1 & 1) * half;
+        c[2] = o[2] + (j >> 2 & 1) * half;
+        if (voxdagi_ed_visit(ed, box, level + 1, child[j], c, key << 3 | j, index, fn, user)) return 1;
+    }
+    return 0;
+}
+
+static uint32_t voxdagi_ed_color_at(const voxdag_editor *ed, uint64_t code) {
+    const uint32_t *c = voxdagi_ed_colors(ed, code >> 6);
+    return c ? c[code & 63] : VOXDAGI_WHITE;
+}
+
+VOXDAG_API uint64_t voxdag_editor_voxels(const voxdag_editor *ed) {
+    return ed ? voxdagi_ed_count(ed, 0, ed->root) : 0;
+}
+
+VOXDAG_API uint64_t voxdag_editor_memory(const voxdag_editor *ed) { return ed ? ed->mem.used : 0; }
+
+VOXDAG_API int voxdag_editor_lookup(const voxdag_editor *ed, uint32_t x, uint32_t y, uint32_t z,
+                                    uint64_t *index) {
+    uint32_t level, ref, child[8];
+    uint64_t code, at = 0, mask;
+    unsigned j, p;
+    if (!ed || (x | y | z) >> ed->levels) return 0;
+    code = voxdag_morton_encode(x, y, z);
+    ref = ed->root;
+    for (level = 0; level + 2 < ed->levels && ref != VOXDAGI_NONE; level++) {
+        unsigned w = (unsigned)(code >> 3 * (ed->levels - level - 1) & 7);
+        voxdagi_ed_children(ed, level, ref, child);
+        for (j = 0; j < w; j++) at += voxdagi_ed_count(ed, level + 1, child[j]);
+        ref = child[w];
+    }
+    if (ref == VOXDAGI_NONE) return 0;
+    mask = voxdagi_ed_brick(ed, ref);
+    p = (unsigned)(code & 63);
+    if (!(mask >> p & 1)) return 0;
+    if (index) *index = at + (uint64_t)voxdagi_popcount64(mask & ((1ull << p) - 1));
+    return 1;
+}
+
+VOXDAG_API int voxdag_editor_color(const voxdag_editor *ed, uint64_t index, uint8_t rgb[3]) {
+    uint32_t level, ref, child[8];
+    uint64_t code = 0, mask;
+    unsigned j;
+    if (!ed || !rgb || !ed->colors || index >= voxdag_editor_voxels(ed)) return 0;
+    ref = ed->root;
+    for (level = 0; level + 2 < ed->levels; level++) { /* the voxel of rank INDEX */
+        voxdagi_ed_children(ed, level, ref, child);
+        for (j = 0; j < 8; j++) {
+            uint64_t c = voxdagi_ed_count(ed, level + 1, child[j]);
+            if (index < c) break;
+            index -= c;
+        }
+        code = code << 3 | j;
+        ref = child[j];
+    }
+    mask = voxdagi_ed_brick(ed, ref);
+    while (index--) mask &= mask - 1;
+    voxdagi_unpack_rgb(voxdagi_ed_color_at(ed, code << 6 | voxdagi_lowest_bit(mask)), rgb);
+    return 1;
+}
+
+typedef struct voxdagi_ed_each {
+    voxdag_voxel_fn fn;
+    void *user;
+} voxdagi_ed_each;
+
+static int voxdagi_ed_each_voxel(void *user, const voxdag_editor *ed, uint64_t code, uint64_t index) {
+    voxdagi_ed_each *e = (voxdagi_ed_each *)user;
+    uint32_t x, y, z;
+    (void)ed;
+    voxdag_morton_decode(code, &x, &y, &z);
+    return e->fn(e->user, x, y, z, index);
+}
+
+VOXDAG_API uint64_t voxdag_editor_for_each_voxel(const voxdag_editor *ed, voxdag_voxel_fn fn, void *user) {
+    voxdagi_ed_each e;
+    uint64_t index = 0;
+    int64_t o[3] = {0, 0, 0};
+    if (!ed) return 0;
+    if (!fn) return voxdag_editor_voxels(ed);
+    e.fn = fn;
+    e.user = user;
+    if (voxdagi_ed_visit(ed, NULL, 0, ed->root, o, 0, &index, voxdagi_ed_each_voxel, &e)) index++;
+    return index;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_nodes(voxdag_editor *ed, uint64_t nodes[VOXDAG_LEVEL_CAPACITY],
+                                             voxdag_error *err) {
+    uint8_t *seen[VOXDAG_MAX_LEVELS];
+    voxdag_status st = VOXDAG_OK;
+    uint32_t l, last;
+    if (!ed || !nodes) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "a NULL argument");
+    memset(nodes, 0, VOXDAG_LEVEL_CAPACITY * sizeof *nodes);
+    memset(seen, 0, sizeof seen);
+    last = ed->levels - 2;
+    for (l = 0; l <= last && st == VOXDAG_OK; l++) {
+        seen[l] = (uint8_t *)voxdagi_alloc(&ed->mem, ed->red.store[l].n);
+        if (!seen[l]) st = voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+        else memset(seen[l], 0, ed->red.store[l].n);
+    }
+    if (st == VOXDAG_OK && ed->root != VOXDAGI_NONE) { /* marks level by level, top down */
+        seen[0][ed->root >> 6] = 1;
+        for (l = 0; l <= last; l++) {
+            size_t id;
+            unsigned j;
+            for (id = 0; id < ed->red.store[l].n; id++) {
+                if (!seen[l][id]) continue;
+                nodes[l]++;
+                if (l == last) continue;
+                for (j = 0; j < 8; j++) {
+                    uint32_t c = ed->red.store[l].child[8 * id + j];
+                    if (c != VOXDAGI_NONE) seen[l + 1][c >> 6] = 1;
+                }
+            }
+        }
+    }
+    for (l = 0; l <= last; l++) voxdagi_free(&ed->mem, seen[l], ed->red.store[l].n);
+    return st == VOXDAG_OK ? voxdagi_ok(err) : st;
+}
+
+// -- Editing: copy a box
+
+/* The full voxels of the copy's source, moved, with their colours. */
+typedef struct voxdagi_ed_gather {
+    voxdagi_ed_voxel *v;
+    size_t n, cap;
+    int64_t offset[3];
+    voxdagi_mem *mem;
+    int failed;
+} voxdagi_ed_gather;
+
+static int voxdagi_ed_gather_voxel(void *user, const voxdag_editor *ed, uint64_t code, uint64_t index) {
+    voxdagi_ed_gather *g = (voxdagi_ed_gather *)user;
+    uint32_t xyz[3];
+    int64_t d[3];
+    unsigned a;
+    (void)index;
+    voxdag_morton_decode(code, &xyz[0], &xyz[1], &xyz[2]);
+    for (a = 0; a < 3; a++) {
+        d[a] = (int64_t)xyz[a] + g->offset[a];
+        if (d[a] < 0 || d[a] >> ed->levels) return 0; /* dropped */
+    }
+    if (!voxdagi_grow(g->mem, (void **)&g->v, &g->cap, g->n + 1, sizeof *g->v)) {
+        g->failed = 1;
+        return 1;
+    }
+    g->v[g->n].code = voxdag_morton_encode((uint32_t)d[0], (uint32_t)d[1], (uint32_t)d[2]);
+    g->v[g->n].rgb = voxdagi_ed_color_at(ed, code);
+    g->v[g->n].full = 1;
+    g->v[g->n].has_rgb = (uint8_t)ed->colors;
+    g->v[g->n].order = g->n;
+    g->n++;
+    return 0;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_copy(voxdag_editor *ed, const int64_t lo[3], const int64_t hi[3],
+                                            const int64_t offset[3], voxdag_error *err) {
+    voxdagi_ed_op src, dst;
+    voxdagi_ed_gather g;
+    voxdag_shape box;
+    voxdag_status st;
+    int64_t o[3] = {0, 0, 0};
+    uint64_t index = 0;
+    uint32_t root;
+    unsigned a;
+    if (!ed || !lo || !hi || !offset) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "a NULL argument");
+    memset(&box, 0, sizeof box);
+    box.kind = VOXDAG_SHAPE_BOX;
+    for (a = 0; a < 3; a++) {
+        if (offset[a] < -VOXDAGI_EDIT_COORD_MAX || offset[a] > VOXDAGI_EDIT_COORD_MAX)
+            return VOXDAGI_FAIL(err, VOXDAG_ERR_COORDINATE, "an offset beyond +-2^28");
+        box.lo[a] = lo[a];
+        box.hi[a] = hi[a];
+    }
+    if ((st = voxdagi_ed_op_make(&src, VOXDAGI_CARVE, &box, NULL, err)) != VOXDAG_OK) return st;
+    /* the destination: the source's part inside the grid, moved */
+    dst = src;
+    for (a = 0; a < 3; a++) {
+        int64_t l = lo[a] < 0 ? 0 : lo[a], h = hi[a] > ((int64_t)1 << ed->levels) ? (int64_t)1 << ed->levels : hi[a];
+        dst.lo[a] = l + offset[a];
+        dst.hi[a] = h + offset[a];
+    }
+    memset(&g, 0, sizeof g);
+    memcpy(g.offset, offset, sizeof g.offset);
+    g.mem = &ed->mem;
+    voxdagi_ed_visit(ed, &src, 0, ed->root, o, 0, &index, voxdagi_ed_gather_voxel, &g);
+    st = g.failed ? voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory")
+                  : voxdagi_ed_begin(ed, err);
+    if (st == VOXDAG_OK) {
+        root = voxdagi_ed_apply(ed, &dst, 0, ed->root, o, 0);
+        root = voxdagi_ed_list(ed, root, g.v, g.n);
+        st = voxdagi_ed_end(ed, root, 0, err);
+    }
+    voxdagi_free(&ed->mem, g.v, g.cap * sizeof *g.v);
+    return st;
+}
+
+// -- Editing: opening and committing
+
+typedef struct voxdagi_ed_open {
+    voxdag_editor *ed;
+    const voxdag *dag;
+    int failed; /* 1 memory, 2 colours */
+} voxdagi_ed_open;
+
+static int voxdagi_ed_open_voxel(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    voxdagi_ed_open *op = (voxdagi_ed_open *)user;
+    uint64_t code = voxdag_morton_encode(x, y, z);
+    voxdagi_reducer_voxel(&op->ed->red, code);
+    if (op->ed->colors) {
+        uint8_t rgb[3];
+        uint32_t *c;
+        if (voxdag_color(op->dag, index, rgb) != 1) {
+            op->failed = 2;
+            return 1;
+        }
+        c = voxdagi_ed_colors_to_write(op->ed, code >> 6);
+        if (!c) {
+            op->failed = 1;
+            return 1;
+        }
+        c[code & 63] = voxdagi_pack_rgb(rgb);
+    }
+    return op->ed->red.failed;
+}
+
+VOXDAG_API voxdag_status voxdag_editor_create(const voxdag *dag, const voxdag_editor_opts *opts,
+                                              voxdag_editor **out, voxdag_error *err) {
+    voxdag_editor_opts o;
+    voxdag_editor *ed;
+    voxdagi_mem mem;
+    uint32_t l;
+    if (!out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "OUT is NULL");
+    *out = NULL;
+    memset(&o, 0, sizeof o);
+    if (opts) o = *opts;
+    if (o.zero_begin || o.zero_end)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "options not initialised (zero_begin/zero_end)");
+    if (!o.levels) o.levels = 10;
+    if (o.levels < 2 || o.levels > VOXDAG_MAX_LEVELS)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_LIMIT, "levels outside 2..VOXDAG_MAX_LEVELS");
+    if ((unsigned)o.symmetry >= VOXDAG_SYMMETRY_COUNT)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "unknown symmetry");
+    if (!o.allocator.alloc != !o.allocator.free)
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "allocator: give alloc and free, or neither");
+    voxdagi_mem_init(&mem, &o.allocator, o.max_memory);
+    ed = (voxdag_editor *)voxdagi_alloc(&mem, sizeof *ed);
+    if (!ed) {
+        voxdag_status st = voxdagi_mem_fail(&mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+        voxdagi_mem_destroy(&mem);
+        return st;
+    }
+    memset(ed, 0, sizeof *ed);
+    ed->mem = mem;
+    if (dag) {
+        voxdag_info info;
+        voxdag_get_info(dag, &info);
+        o.levels = info.levels;
+        o.symmetry = info.symmetry;
+        o.colors = info.color_kind != VOXDAG_COLORS_NONE;
+        ed->has_bounds = info.has_bounds;
+        memcpy(ed->bounds, info.bounds, sizeof ed->bounds);
+    }
+    ed->levels = o.levels;
+    ed->symmetry = o.symmetry ? o.symmetry : VOXDAG_SYMMETRY_FULL;
+    ed->colors = o.colors != 0;
+    ed->root = VOXDAGI_NONE;
+    for (l = 0; l < VOXDAG_MAX_LEVELS; l++) ed->full[l] = VOXDAGI_NONE;
+    voxdagi_group_init(&ed->group, ed->symmetry);
+    voxdagi_reducer_init(&ed->red, &ed->mem, &ed->group, ed->levels, 0);
+    if (dag) {
+        voxdagi_ed_open op;
+        op.ed = ed;
+        op.dag = dag;
+        op.failed = 0;
+        voxdag_for_each_voxel(dag, voxdagi_ed_open_voxel, &op);
+        if (!op.failed && !ed->red.failed) voxdagi_reducer_finish(&ed->red);
+        if (op.failed || ed->red.failed) {
+            voxdag_status st = op.failed == 2 ? VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT,
+                                                             "the colours cannot be decoded (voxcolor.h not compiled in)")
+                                              : voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+            voxdag_editor_free(ed);
+            return st;
+        }
+        ed->root = ed->red.root;
+        ed->change_n = 0; /* the colours read are the start, not an edit */
+    }
+    *out = ed;
+    return voxdagi_ok(err);
+}
+
+VOXDAG_API void voxdag_editor_free(voxdag_editor *ed) {
+    voxdagi_mem mem;
+    if (!ed) return;
+    voxdagi_ed_drop_traced(ed);
+    voxdagi_reducer_free(&ed->red);
+    voxdagi_free(&ed->mem, ed->block, ed->block_cap * sizeof *ed->block);
+    voxdagi_free(&ed->mem, ed->block_serial, ed->serial_cap * sizeof *ed->block_serial);
+    voxdagi_free(&ed->mem, ed->map_key, ed->map_cap * sizeof *ed->map_key);
+    voxdagi_free(&ed->mem, ed->map_block, ed->map_cap * sizeof *ed->map_block);
+    voxdagi_free(&ed->mem, ed->map_used, ed->map_cap);
+    voxdagi_free(&ed->mem, ed->change, ed->change_cap * sizeof *ed->change);
+    voxdagi_free(&ed->mem, ed->history, ed->history_cap * sizeof *ed->history);
+    mem = ed->mem;
+    voxdagi_free(&mem, ed, sizeof *ed);
+    voxdagi_mem_destroy(&mem);
+}
+
+/* The commit feeds the builder whole bricks in Morton order (its fast path,
+   the same file as voxel by voxel), a chunk at a time. */
+#define VOXDAGI_COMMIT_CHUNK 1024
+typedef struct voxdagi_ed_feeder {
+    voxdag_builder *b;
+    uint64_t brick[2 * VOXDAGI_COMMIT_CHUNK]; /* key, mask */
+    uint8_t rgb[3 * 64 * VOXDAGI_COMMIT_CHUNK];
+    size_t n, colors;
+    voxdag_status st;
+    voxdag_error *err;
+} voxdagi_ed_feeder;
+
+static void voxdagi_ed_feed_flush(voxdagi_ed_feeder *f) {
+    if (f->n && f->st == VOXDAG_OK) f->st = voxdag_builder_add_bricks(f->b, f->brick, f->rgb, f->n, f->err);
+    f->n = f->colors = 0;
+}
+
+/* Feeds the bricks of subtree REF of LEVEL (Morton prefix KEY). */
+static void voxdagi_ed_feed(const voxdag_editor *ed, voxdagi_ed_feeder *f, uint32_t level, uint32_t ref,
+                            uint64_t key) {
+    uint32_t child[8];
+    unsigned j;
+    if (ref == VOXDAGI_NONE || f->st != VOXDAG_OK) return;
+    if (level == ed->levels - 2) {
+        uint64_t mask = voxdagi_ed_brick(ed, ref), bits;
+        const uint32_t *c = ed->colors ? voxdagi_ed_colors(ed, key) : NULL;
+        f->brick[2 * f->n] = key;
+        f->brick[2 * f->n + 1] = mask;
+        for (bits = ed->colors ? mask : 0; bits; bits &= bits - 1)
+            voxdagi_unpack_rgb(c ? c[voxdagi_lowest_bit(bits)] : VOXDAGI_WHITE, f->rgb + 3 * f->colors++);
+        if (++f->n == VOXDAGI_COMMIT_CHUNK) voxdagi_ed_feed_flush(f);
+        return;
+    }
+    voxdagi_ed_children(ed, level, ref, child);
+    for (j = 0; j < 8; j++) voxdagi_ed_feed(ed, f, level + 1, child[j], key << 3 | j);
+}
+
+VOXDAG_API voxdag_status voxdag_editor_commit(voxdag_editor *ed, voxdag **out, voxdag_error *err) {
+    voxdag_build_opts o;
+    voxdagi_ed_feeder *f;
+    voxdag_status st;
+    if (!ed || !out) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "a NULL argument");
+    *out = NULL;
+    memset(&o, 0, sizeof o);
+    o.levels = ed->levels;
+    o.symmetry = ed->symmetry;
+    o.colors = ed->colors;
+    o.bounds = ed->has_bounds ? ed->bounds : NULL;
+    o.allocator = ed->mem.a;
+    if (ed->mem.limit) o.max_memory = ed->mem.limit > ed->mem.used ? ed->mem.limit - ed->mem.used : 1;
+    f = (voxdagi_ed_feeder *)voxdagi_alloc(&ed->mem, sizeof *f);
+    if (!f) return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
+    f->n = f->colors = 0;
+    f->err = err;
+    f->st = voxdag_builder_create(&o, &f->b, err);
+    if (f->st == VOXDAG_OK) {
+        voxdagi_ed_feed(ed, f, 0, ed->root, 0);
+        voxdagi_ed_feed_flush(f);
+        if (f->st == VOXDAG_OK) f->st = voxdag_builder_finish(f->b, out, NULL, err);
+        else voxdag_builder_free(f->b);
+    }
+    st = f->st;
+    voxdagi_free(&ed->mem, f, sizeof *f);
+    return st;
+}
+
+#ifndef VOXDAG_NO_RAYTRACE
+static int voxdagi_ed_trace_ready(voxdag_editor *ed) {
+    return ed->traced || voxdag_editor_commit(ed, &ed->traced, NULL) == VOXDAG_OK;
+}
+
+VOXDAG_API int voxdag_editor_raycast(voxdag_editor *ed, const voxdag_ray *ray, const voxdag_ray_opts *opts,
+                                     voxdag_hit *hit) {
+    if (!ed || !voxdagi_ed_trace_ready(ed)) return -1;
+    return voxdag_raycast(ed->traced, ray, opts, hit);
+}
+
+VOXDAG_API int voxdag_editor_occluded(voxdag_editor *ed, const voxdag_ray *ray, const voxdag_ray_opts *opts) {
+    if (!ed || !voxdagi_ed_trace_ready(ed)) return -1;
+    return voxdag_occluded_opts(ed->traced, ray, opts);
+}
+#endif
+#endif /* VOXDAG_NO_BUILD */
 
 #endif /* VOXDAG_IMPLEMENTED */
 #endif /* VOXDAG_IMPLEMENTATION */

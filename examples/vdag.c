@@ -12,6 +12,7 @@
    vdag rays FILE            (rays on stdin)
    vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] [--fov deg] [--threads T]
    vdag export-voxels FILE
+   vdag edit IN.vdag OUT.vdag [--color-error E]   (operations on stdin)
    vdag gen SCENE OUT.xyz [--levels L]   (built-in scenes: demo)
 
    Progress and diagnostics go to stderr; stdout carries only documented
@@ -251,6 +252,23 @@ static const struct {
                "                    the rays then start (the same picture)\n"},
     {"export-voxels", "usage: vdag export-voxels FILE\n"
                       "Prints every voxel as \"x y z r g b\" (grid units), in voxel-index order.\n"},
+    {"edit", "usage: vdag edit IN.vdag OUT.vdag [--color-error E]\n"
+             "Applies the operations on stdin, one a line, to IN's voxels and writes OUT (the same bytes as\n"
+             "building the final voxels). Integers in grid units (signed; shapes are clipped to the grid),\n"
+             "colours 0..255; boxes are half-open [X0, X1) per axis; a sphere holds the voxels with\n"
+             "(2x+1-2CX)^2 + (2y+1-2CY)^2 + (2z+1-2CZ)^2 <= 4 RADIUS^2:\n"
+             "  set X Y Z [R G B]                 clear X Y Z\n"
+             "  fill-box X0 Y0 Z0 X1 Y1 Z1 [R G B] carve-box X0 Y0 Z0 X1 Y1 Z1\n"
+             "  fill-sphere CX CY CZ RADIUS [R G B] carve-sphere CX CY CZ RADIUS\n"
+             "  paint-box X0 Y0 Z0 X1 Y1 Z1 R G B  paint-sphere CX CY CZ RADIUS R G B\n"
+             "  copy-box X0 Y0 Z0 X1 Y1 Z1 DX DY DZ  (the box's voxels, empty ones too, moved by D)\n"
+             "  undo   redo\n"
+             "A fill with a colour recolours the voxels already in its shape too; without one, new voxels\n"
+             "are white. Every operation line is one edit of the history. Blank lines and # comments are\n"
+             "ignored; a line that does not parse stops it with its number, and nothing is written.\n"
+             "  --color-error E   required when IN's colours are voxcolor: OUT's are compressed within E\n"
+             "                    (untouched voxels stay within E of IN's decoded colours); raw RGB8\n"
+             "                    colours stay raw\n"},
     {"gen", "usage: vdag gen demo OUT.xyz [--levels L]\n"
             "Writes the built-in demo scene as a voxel list.\n"
             "  --levels L   grid of 2^L voxels per axis, 4..10 (default: 7)\n"},
@@ -1603,6 +1621,263 @@ static int cmd_export(int argc, char **argv) {
     return fflush(stdout) ? vdag_fail("export-voxels: write error") : 0;
 }
 
+// -- vdag edit: operations from stdin, one a line
+
+/* The operations of a script: name, the integers before an optional
+   colour, and whether the colour is required (R G B close the line). */
+typedef enum { ED_SET, ED_CLEAR, ED_FILL_BOX, ED_CARVE_BOX, ED_FILL_SPHERE, ED_CARVE_SPHERE, ED_PAINT_BOX,
+               ED_PAINT_SPHERE, ED_COPY_BOX, ED_UNDO, ED_REDO } edit_kind;
+
+static const struct {
+    const char *name;
+    edit_kind kind;
+    int numbers;   /* integers before the colour */
+    int color;     /* 0 none, 1 optional, 2 required */
+} edit_ops[] = {
+    {"set", ED_SET, 3, 1},           {"clear", ED_CLEAR, 3, 0},
+    {"fill-box", ED_FILL_BOX, 6, 1}, {"carve-box", ED_CARVE_BOX, 6, 0},
+    {"fill-sphere", ED_FILL_SPHERE, 4, 1}, {"carve-sphere", ED_CARVE_SPHERE, 4, 0},
+    {"paint-box", ED_PAINT_BOX, 6, 2}, {"paint-sphere", ED_PAINT_SPHERE, 4, 2},
+    {"copy-box", ED_COPY_BOX, 9, 0}, {"undo", ED_UNDO, 0, 0}, {"redo", ED_REDO, 0, 0},
+};
+
+#define EDIT_COORD_MAX ((long long)1 << 28)
+
+/* One parsed line: its operation, numbers and colour. */
+typedef struct edit_line {
+    int op; /* index into edit_ops */
+    long long v[9];
+    int has_color;
+    uint8_t rgb[3];
+} edit_line;
+
+/* Parses LINE (comments cut off); returns 1 (a blank line: op -1), or 0
+   with WHY set. */
+static int parse_edit_line(char *line, edit_line *e, const char **why) {
+    char *tok[16], *p, *hash = strchr(line, '#');
+    int n = 0, k, numbers;
+    size_t i;
+    if (hash) *hash = 0;
+    for (p = strtok(line, " \t\r\n"); p; p = strtok(NULL, " \t\r\n")) {
+        if (n == 16) return *why = "too many fields", 0;
+        tok[n++] = p;
+    }
+    e->op = -1;
+    if (!n) return 1;
+    for (i = 0; i < sizeof edit_ops / sizeof edit_ops[0] && strcmp(tok[0], edit_ops[i].name); i++) {}
+    if (i == sizeof edit_ops / sizeof edit_ops[0]) return *why = "unknown operation", 0;
+    e->op = (int)i;
+    numbers = edit_ops[i].numbers;
+    e->has_color = n - 1 == numbers + 3;
+    if (n - 1 != numbers && !(edit_ops[i].color && e->has_color)) return *why = "wrong number of fields", 0;
+    if (edit_ops[i].color == 2 && !e->has_color) return *why = "wrong number of fields (R G B required)", 0;
+    for (k = 0; k < n - 1; k++) {
+        char *end;
+        long long v;
+        errno = 0;
+        v = strtoll(tok[1 + k], &end, 10);
+        if (end == tok[1 + k] || *end || errno) return *why = "not an integer", 0;
+        if (k < numbers) {
+            if (v < -EDIT_COORD_MAX || v > EDIT_COORD_MAX) return *why = "a number beyond +-2^28", 0;
+            e->v[k] = v;
+        } else {
+            if (v < 0 || v > 255) return *why = "a colour outside 0..255", 0;
+            e->rgb[k - numbers] = (uint8_t)v;
+        }
+    }
+    if ((edit_ops[i].kind == ED_FILL_SPHERE || edit_ops[i].kind == ED_CARVE_SPHERE ||
+         edit_ops[i].kind == ED_PAINT_SPHERE) && e->v[3] < 0)
+        return *why = "a negative radius", 0;
+    return 1;
+}
+
+/* Applies a parsed line to ED. */
+static voxdag_status apply_edit_line(voxdag_editor *ed, uint32_t levels, const edit_line *e, voxdag_error *err) {
+    voxdag_shape s;
+    voxdag_brush b;
+    const voxdag_brush *brush = e->has_color ? &b : NULL;
+    int a;
+    memset(&s, 0, sizeof s);
+    memset(&b, 0, sizeof b);
+    memcpy(b.rgb, e->rgb, 3);
+    switch (edit_ops[e->op].kind) {
+    case ED_SET:
+    case ED_CLEAR: {
+        uint32_t xyz[3];
+        size_t n = 1;
+        for (a = 0; a < 3; a++) {
+            if (e->v[a] < 0 || e->v[a] >= (1ll << levels)) n = 0; /* outside the grid: clipped away */
+            xyz[a] = (uint32_t)(e->v[a] & 0xFFFFFFFF);
+        }
+        return edit_ops[e->op].kind == ED_SET ? voxdag_editor_set(ed, xyz, brush ? b.rgb : NULL, n, err)
+                                              : voxdag_editor_clear(ed, xyz, n, err);
+    }
+    case ED_FILL_BOX:
+    case ED_CARVE_BOX:
+    case ED_PAINT_BOX:
+        s.kind = VOXDAG_SHAPE_BOX;
+        for (a = 0; a < 3; a++) s.lo[a] = e->v[a], s.hi[a] = e->v[3 + a];
+        break;
+    case ED_FILL_SPHERE:
+    case ED_CARVE_SPHERE:
+    case ED_PAINT_SPHERE:
+        s.kind = VOXDAG_SHAPE_SPHERE;
+        for (a = 0; a < 3; a++) s.center[a] = e->v[a];
+        s.radius = e->v[3];
+        break;
+    case ED_COPY_BOX: {
+        int64_t lo[3], hi[3], d[3];
+        for (a = 0; a < 3; a++) lo[a] = e->v[a], hi[a] = e->v[3 + a], d[a] = e->v[6 + a];
+        return voxdag_editor_copy(ed, lo, hi, d, err);
+    }
+    case ED_UNDO:
+        voxdag_editor_undo(ed);
+        return VOXDAG_OK;
+    case ED_REDO:
+        voxdag_editor_redo(ed);
+        return VOXDAG_OK;
+    }
+    switch (edit_ops[e->op].kind) {
+    case ED_FILL_BOX:
+    case ED_FILL_SPHERE: return voxdag_editor_fill(ed, &s, brush, err);
+    case ED_CARVE_BOX:
+    case ED_CARVE_SPHERE: return voxdag_editor_carve(ed, &s, err);
+    default: return voxdag_editor_paint(ed, &s, &b, err);
+    }
+}
+
+/* The committed DAG with its colours compressed by voxcolor within E. */
+static int compress_colors(voxdag **dag, double e) {
+    const void *rgb;
+    size_t size, cap, len;
+    uint8_t *stream;
+    voxcolor_encode_opts o;
+    voxcolor_error verr;
+    voxdag *with = NULL;
+    voxdag_error err;
+    if (voxdag_colors(*dag, &rgb, &size) != VOXDAG_COLORS_RGB8) return 0;
+    cap = voxcolor_encode_bound(size / 3);
+    stream = (uint8_t *)malloc(cap ? cap : 1);
+    if (!stream) return vdag_fail("edit: out of memory for the colours");
+    memset(&o, 0, sizeof o);
+    o.max_error = e;
+    len = voxcolor_encode(stream, cap, (const uint8_t *)rgb, size / 3, &o, &verr);
+    if (!len) {
+        free(stream);
+        return vdag_fail("edit: colour compression failed: %s", verr.message);
+    }
+    if (voxdag_with_colors(*dag, VOXDAG_COLORS_VOXCOLOR, stream, len, &with, &err) != VOXDAG_OK) {
+        free(stream);
+        return vdag_fail("edit: %s", err.message);
+    }
+    free(stream);
+    voxdag_free(*dag);
+    *dag = with;
+    return 0;
+}
+
+/* Replaces F's voxcolor colours by their decoded RGB8 (this tool's
+   voxdag.h decodes voxcolor only through F's view). */
+static int decode_colors(vdag_file *f) {
+    voxdag_info info;
+    voxdag *raw = NULL;
+    voxdag_error err;
+    uint8_t *rgb;
+    uint64_t i;
+    voxdag_get_info(f->dag, &info);
+    if (info.voxels > (uint64_t)(SIZE_MAX / 3)) return vdag_fail("edit: too many colours for memory");
+    rgb = (uint8_t *)malloc(info.voxels ? (size_t)info.voxels * 3 : 1);
+    if (!rgb) return vdag_fail("edit: out of memory for %llu colours", (unsigned long long)info.voxels);
+    for (i = 0; i < info.voxels; i++) vdag_voxel_color(f, i, rgb + 3 * i);
+    if (voxdag_with_colors(f->dag, VOXDAG_COLORS_RGB8, rgb, (size_t)info.voxels * 3, &raw, &err) != VOXDAG_OK) {
+        free(rgb);
+        return vdag_fail("edit: %s", err.message);
+    }
+    free(rgb);
+    vdag_close(f);
+    f->dag = raw;
+    f->has_colors = 1;
+    return 0;
+}
+
+static int cmd_edit(int argc, char **argv) {
+    vdag_file f;
+    voxdag_editor *ed = NULL;
+    voxdag *out = NULL;
+    voxdag_error err;
+    voxdag_info info;
+    voxdag_color_kind kind;
+    const void *payload;
+    size_t size, cap = 0;
+    char *line = NULL, tmp[4200];
+    double color_error = -1;
+    unsigned long long number = 0, edits = 0;
+    int rc = 0, warned = 0;
+    if (argc == 5 && !strcmp(argv[3], "--color-error")) {
+        char *end;
+        color_error = strtod(argv[4], &end);
+        if (end == argv[4] || *end || !(color_error >= 0) || color_error > 1e9)
+            return vdag_fail("edit: --color-error takes a number >= 0");
+    } else if (argc != 3) {
+        return vdag_fail("usage: vdag edit IN.vdag OUT.vdag [--color-error E]   (operations on stdin)");
+    }
+    if (!vdag_check_output(argv[1], argv[2]) || !vdag_open(argv[1], &f)) return 1;
+    kind = voxdag_colors(f.dag, &payload, &size);
+    if (kind == VOXDAG_COLORS_VOXCOLOR && color_error < 0) {
+        vdag_close(&f);
+        return vdag_fail("edit: %s has voxcolor colours: give --color-error E, the bound for the output's "
+                         "(the stream does not record its own)", argv[1]);
+    }
+    if (kind != VOXDAG_COLORS_VOXCOLOR && color_error >= 0) {
+        vdag_close(&f);
+        return vdag_fail("edit: --color-error is for input with voxcolor colours; %s has %s", argv[1],
+                         kind == VOXDAG_COLORS_RGB8 ? "raw RGB8 colours, and so will the output" : "no colours");
+    }
+    voxdag_get_info(f.dag, &info);
+    if (kind == VOXDAG_COLORS_VOXCOLOR && decode_colors(&f)) {
+        vdag_close(&f);
+        return 1;
+    }
+    if (voxdag_editor_create(f.dag, NULL, &ed, &err) != VOXDAG_OK) {
+        vdag_close(&f);
+        return vdag_fail("edit: %s (%s)", voxdag_status_string(err.status), err.message);
+    }
+    vdag_close(&f);
+    while (!rc && getline(&line, &cap, stdin) >= 0) {
+        edit_line e;
+        const char *why = NULL;
+        number++;
+        if (!parse_edit_line(line, &e, &why)) {
+            rc = vdag_fail("edit: line %llu: %s (nothing written)", number, why);
+            break;
+        }
+        if (e.op < 0) continue;
+        if (e.has_color && kind == VOXDAG_COLORS_NONE && !warned++)
+            fprintf(stderr, "vdag: warning: %s has no colours; the colours in edits are ignored\n", argv[1]);
+        if (apply_edit_line(ed, info.levels, &e, &err) != VOXDAG_OK)
+            rc = vdag_fail("edit: line %llu: %s (%s; nothing written)", number, voxdag_status_string(err.status),
+                           err.message);
+        edits++;
+    }
+    free(line);
+    if (!rc && ferror(stdin)) rc = vdag_fail("edit: cannot read the operations from stdin (nothing written)");
+    if (!rc && voxdag_editor_commit(ed, &out, &err) != VOXDAG_OK)
+        rc = vdag_fail("edit: %s (%s)", voxdag_status_string(err.status), err.message);
+    if (!rc && kind == VOXDAG_COLORS_VOXCOLOR) rc = compress_colors(&out, color_error);
+    if (!rc) {
+        errno = 0;
+        if (save_file(out, argv[2], tmp, sizeof tmp, &err) != VOXDAG_OK)
+            rc = err.os_error ? vdag_fail("%s: %s (%s)", argv[2], err.message, strerror(err.os_error))
+                              : vdag_fail("%s: %s", argv[2], err.message);
+    }
+    if (!rc)
+        fprintf(stderr, "vdag: %llu edits, %llu voxels; wrote %s\n", edits,
+                (unsigned long long)voxdag_editor_voxels(ed), argv[2]);
+    voxdag_free(out);
+    voxdag_editor_free(ed);
+    return rc;
+}
+
 // -- vdag gen: the built-in demo scene
 
 /* A coloured landscape: rolling terrain with grass and rock, a pond, and a
@@ -1665,6 +1940,7 @@ static int usage(FILE *f) {
           "                      [--shadows] [--light x y z] [--lod PIXELS] [--samples N]\n"
           "                      [--threads T] [--quiet]\n"
           "  export-voxels FILE\n"
+          "  edit IN.vdag OUT.vdag [--color-error E]   (operations on stdin, one a line)\n"
           "  gen demo OUT.xyz [--levels L]\n",
           f);
     return f == stdout ? 0 : 1;
@@ -1676,7 +1952,7 @@ int main(int argc, char **argv) {
         int (*fn)(int, char **);
     } commands[] = {{"build", cmd_build},   {"info", cmd_info},         {"validate", cmd_validate},
                     {"lookup", cmd_lookup}, {"rays", vdag_cmd_rays},    {"render", vdag_cmd_render},
-                    {"export-voxels", cmd_export}, {"gen", cmd_gen}};
+                    {"export-voxels", cmd_export}, {"edit", cmd_edit}, {"gen", cmd_gen}};
     size_t i;
     if (argc < 2) return usage(stderr);
     if (!strcmp(argv[1], "--help") || !strcmp(argv[1], "-h") || !strcmp(argv[1], "help")) return usage(stdout);

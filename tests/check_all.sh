@@ -405,7 +405,7 @@ fi
 # tests/platform_answers.c.
 M=$out/matrix
 mkdir -p "$M"
-PORTABLE_SRC="tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_format.c tests/test_raytrace.c tests/test_gpu.c tests/test_voxelize.c tests/test_no_voxcolor.c tests/test_lod_colors.c"
+PORTABLE_SRC="tests/test_main.c tests/impl.c tests/test_core.c tests/test_voxcolor.c tests/test_format.c tests/test_raytrace.c tests/test_gpu.c tests/test_voxelize.c tests/test_no_voxcolor.c tests/test_lod_colors.c tests/test_edit.c"
 PORTABLE="$C99 -O2 -DTEST_PORTABLE -I. -o"
 SEL_QEMU="format/golden format/offsets format/header format/limits format/hostile format/version3 format/save
           format/build_allocation voxcolor/golden voxcolor/lossless voxcolor/handmade voxcolor/rejects

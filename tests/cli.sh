@@ -937,13 +937,120 @@ for words in ['keeps a copy of it, its user pointer included', 'voxdag_with_colo
     assert words in part, words
 "
 
+# -- vdag edit: a random script against a model in python
+python3 - "$T" <<'EOF'
+import random, sys
+t = sys.argv[1]
+random.seed(26)
+n = 32
+vox = {}
+for line in open(t + "/in.xyz"):
+    if line.startswith("#"): continue
+    x, y, z, r, g, b = map(int, line.split())
+    vox[(x, y, z)] = (r, g, b)
+def inside(v): return all(0 <= c < n for c in v)
+def box(a):
+    return [(x, y, z) for x in range(max(a[0], 0), min(a[3], n)) for y in range(max(a[1], 0), min(a[4], n))
+            for z in range(max(a[2], 0), min(a[5], n))]
+def sphere(a):
+    cx, cy, cz, r = a
+    return [(x, y, z) for x in range(n) for y in range(n) for z in range(n)
+            if (2*x+1-2*cx)**2 + (2*y+1-2*cy)**2 + (2*z+1-2*cz)**2 <= 4*r*r]
+def num(): return random.randrange(-8, n + 8)
+def col(): return [random.randrange(256) for _ in range(3)]
+def fill(cur, v, c): cur[v] = tuple(c) if c else cur.get(v, (255, 255, 255))
+states, done, lines = [dict(vox)], 0, ["# a random script", ""]
+for _ in range(40):
+    k = random.choice(["set", "clear", "fill-box", "carve-box", "fill-sphere", "carve-sphere", "paint-box",
+                       "paint-sphere", "copy-box", "undo", "redo"])
+    if k == "undo":
+        lines.append("undo")
+        if done > 0: done -= 1
+        continue
+    if k == "redo":
+        lines.append("redo  # again")
+        if done + 1 < len(states): done += 1
+        continue
+    cur = dict(states[done])
+    c = col() if random.random() < 0.6 or k.startswith("paint") else None
+    if k.startswith("carve") or k in ("clear", "copy-box"): c = None
+    if k in ("set", "clear"):
+        a = [num(), num(), num()]
+        cells = [tuple(a)] if inside(a) else []
+    elif k == "copy-box":
+        a = [num() for _ in range(6)] + [random.randrange(-n, n) for _ in range(3)]
+        cells = box(a)
+    elif k.endswith("box"):
+        a = [num() for _ in range(6)]
+        cells = box(a)
+    else:
+        a = [num(), num(), num(), random.randrange(0, 12)]
+        cells = sphere(a)
+    src = dict(cur)
+    for v in cells:
+        if k in ("clear", "carve-box", "carve-sphere"): cur.pop(v, None)
+        elif k.startswith("paint"):
+            if v in cur: cur[v] = tuple(c)
+        elif k == "copy-box":
+            d = (v[0] + a[6], v[1] + a[7], v[2] + a[8])
+            if not inside(d): continue
+            if v in src: cur[d] = src[v]
+            else: cur.pop(d, None)
+        else: fill(cur, v, c)
+    lines.append(" ".join(map(str, [k] + a + (c or []))))
+    states = states[:done + 1] + [cur]
+    done += 1
+open(t + "/script", "w").write("\n".join(lines) + "\n")
+def morton(x, y, z):
+    c = 0
+    for b in range(4, -1, -1):
+        c = c << 3 | (x >> b & 1) | (y >> b & 1) << 1 | (z >> b & 1) << 2
+    return c
+final = states[done]
+with open(t + "/expected_edit", "w") as f:
+    for v in sorted(final, key=lambda v: morton(*v)):
+        f.write("%d %d %d %d %d %d\n" % (*v, *final[v]))
+EOF
+"$VDAG" build "$T/in.xyz" "$T/raw.vdag" --levels 5 --raw-colors --quiet 2>/dev/null
+check "edit: a random script" "$VDAG" edit "$T/raw.vdag" "$T/edited.vdag" <"$T/script" 2>/dev/null
+"$VDAG" export-voxels "$T/edited.vdag" >"$T/export_edit" 2>/dev/null
+check "edit: the voxels and colours of the model" cmp -s "$T/export_edit" "$T/expected_edit"
+cp "$T/expected_edit" "$T/edited.xyz"
+"$VDAG" build "$T/edited.xyz" "$T/rebuilt.vdag" --levels 5 --raw-colors --quiet 2>/dev/null
+check "edit: the bytes of a build of the final voxels" cmp -s "$T/edited.vdag" "$T/rebuilt.vdag"
+printf 'set 1 2 3\n\n# fine so far\nfill-box 1 2 3 4 5\n' >"$T/bad_script"
+check "edit: a bad line fails with its number, nothing written" sh -c "
+    ! '$VDAG' edit '$T/raw.vdag' '$T/none.vdag' <'$T/bad_script' 2>'$T/err' &&
+    grep -q 'line 4' '$T/err' && [ \$(wc -l <'$T/err') = 1 ] && [ ! -e '$T/none.vdag' ]"
+for bad in 'frob 1 2 3' 'set 1 2' 'set 1 2 3 4' 'set 1 2 3 1 2 256' 'clear 1 2 3 4 5 6' 'paint-box 0 0 0 4 4 4' \
+           'fill-sphere 1 2 3 -1' 'set 1 2 x' 'undo 1' 'set 1 2 268435457'; do
+    check "edit: '$bad' is refused" sh -c "! printf '%s\n' '$bad' | '$VDAG' edit '$T/raw.vdag' '$T/none.vdag' 2>/dev/null &&
+        [ ! -e '$T/none.vdag' ]"
+done
+"$VDAG" build "$T/in.xyz" "$T/vc.vdag" --levels 5 --color-error 0.03 --quiet 2>/dev/null
+check "edit: voxcolor input needs --color-error" sh -c "! '$VDAG' edit '$T/vc.vdag' '$T/none.vdag' <'$T/script' 2>/dev/null"
+check "edit: voxcolor input with --color-error" "$VDAG" edit "$T/vc.vdag" "$T/edited_vc.vdag" --color-error 0.03 <"$T/script" 2>/dev/null
+"$VDAG" export-voxels "$T/edited_vc.vdag" >"$T/export_edit_vc" 2>/dev/null
+check "edit: voxcolor output: the same voxels, colours within twice the bound" python3 -c "
+a = [list(map(int, l.split())) for l in open('$T/export_edit_vc')]
+b = [list(map(int, l.split())) for l in open('$T/expected_edit')]
+assert len(a) == len(b) and all(p[:3] == q[:3] for p, q in zip(a, b))
+worst = max([sum((p[i] - q[i]) ** 2 for i in range(3, 6)) ** 0.5 / 255 for p, q in zip(a, b)] + [0])
+assert worst <= 2 * 0.03 + 1e-9, worst
+"
+check "edit: raw input refuses --color-error" sh -c "! '$VDAG' edit '$T/raw.vdag' '$T/none.vdag' --color-error 0.1 </dev/null 2>/dev/null"
+"$VDAG" build "$T/in.xyz" "$T/nc.vdag" --levels 5 --no-colors --quiet 2>/dev/null
+check "edit: no colours: one warning, colours ignored" sh -c "
+    printf 'set 1 1 1 9 9 9\nfill-box 0 0 0 2 2 2 1 2 3\n' | '$VDAG' edit '$T/nc.vdag' '$T/nc_out.vdag' 2>'$T/err' &&
+    [ \$(grep -c warning '$T/err') = 1 ] && '$VDAG' lookup '$T/nc_out.vdag' 1 1 1 | grep -q '^1 '"
+
 # -- README's tool section names every command and every option of --help
 check "README lists every command and option of --help" python3 -c "
 import re, subprocess, sys
 readme = open('README.md').read()
 section = readme[readme.index('## The \`vdag\` tool'):readme.index('## Robustness')]
 missing = []
-for cmd in ['build', 'info', 'validate', 'lookup', 'rays', 'render', 'export-voxels', 'gen']:
+for cmd in ['build', 'info', 'validate', 'lookup', 'rays', 'render', 'export-voxels', 'edit', 'gen']:
     if 'vdag ' + cmd not in section: missing.append(cmd)
     h = subprocess.run(['$VDAG', cmd, '--help'], capture_output=True, text=True).stdout
     missing += [cmd + ' ' + o for o in set(re.findall(r'(?<![\w-])--[a-z][a-z-]*', h)) if o not in section]

@@ -47,6 +47,7 @@ run fuzz-import "$build/fuzz_import" $sweep tests/data/fuzz/import
 run fuzz-voxcolor "$build/fuzz_voxcolor" $sweep tests/data/fuzz/voxcolor
 run fuzz-load "$build/fuzz_load" $sweep tests/data/fuzz/load
 run fuzz-roundtrip "$build/fuzz_roundtrip" $sweep tests/data/fuzz/roundtrip
+run fuzz-edit "$build/fuzz_edit" $sweep tests/data/fuzz/edit
 run check-all sh tests/check_all.sh "$build"
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]

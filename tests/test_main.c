@@ -16,6 +16,7 @@ extern const test_case test_raytrace_cases[];
 extern const test_case test_gpu_cases[];
 extern const test_case test_no_voxcolor_cases[];
 extern const test_case test_lod_colors_cases[];
+extern const test_case test_edit_cases[];
 #ifndef TEST_PORTABLE
 extern const test_case test_import_cases[];
 extern const test_case test_import_scene_cases[];
@@ -37,6 +38,7 @@ static const test_case *const suites[] = {
     test_gpu_cases,
     test_no_voxcolor_cases,
     test_lod_colors_cases,
+    test_edit_cases,
 #ifndef TEST_PORTABLE
     test_image_cases,
     test_api_cases,
