@@ -7591,6 +7591,14 @@ static uint64_t voxdagi_ed_brick(const voxdag_editor *ed, uint32_t ref) {
     return voxdagi_transform_brick(&ed->group, ed->red.store[ed->levels - 2].node[ref >> 6].key, ref & 63);
 }
 
+/* The lowest corner C of child J of the node of side SIZE at corner O. */
+static void voxdagi_ed_child_corner(const int64_t o[3], int64_t size, unsigned j, int64_t c[3]) {
+    int64_t half = size / 2;
+    c[0] = o[0] + (j & 1) * half;
+    c[1] = o[1] + (j >> 1 & 1) * half;
+    c[2] = o[2] + (j >> 2 & 1) * half;
+}
+
 /* The world-oriented child references of inner reference REF of LEVEL: the
    stored child of octant j lands in octant T(j), transformed by T. */
 static void voxdagi_ed_children(const voxdag_editor *ed, uint32_t level, uint32_t ref, uint32_t child[8]) {
@@ -7938,10 +7946,8 @@ static uint32_t voxdagi_ed_apply(voxdag_editor *ed, const voxdagi_ed_op *op, uin
     }
     voxdagi_ed_children(ed, level, ref, child);
     for (j = 0; j < 8; j++) {
-        int64_t c[3], half = size / 2;
-        c[0] = o[0] + (j & 1) * half;
-        c[1] = o[1] + (j >> 1 & 1) * half;
-        c[2] = o[2] + (j >> 2 & 1) * half;
+        int64_t c[3];
+        voxdagi_ed_child_corner(o, size, j, c);
         made[j] = voxdagi_ed_apply(ed, op, level + 1, child[j], c, key << 3 | j);
         same &= made[j] == child[j];
     }
@@ -8132,10 +8138,8 @@ static int voxdagi_ed_visit(const voxdag_editor *ed, const voxdagi_ed_op *box, u
     }
     voxdagi_ed_children(ed, level, ref, child);
     for (j = 0; j < 8; j++) {
-        int64_t c[3], half = size / 2;
-        c[0] = o[0] + (j & 1) * half;
-        c[1] = o[1] + (j >> 1 & 1) * half;
-        c[2] = o[2] + (j >> 2 & 1) * half;
+        int64_t c[3];
+        voxdagi_ed_child_corner(o, size, j, c);
         if (voxdagi_ed_visit(ed, box, level + 1, child[j], c, key << 3 | j, index, fn, user)) return 1;
     }
     return 0;
