@@ -7893,13 +7893,13 @@ static int voxdagi_ed_classify(const voxdagi_ed_op *op, const int64_t o[3], int6
         }
         return inside ? VOXDAGI_INSIDE : VOXDAGI_PARTLY;
     } else {
-        int64_t near = 0, far = 0, lo, hi;
+        int64_t least = 0, most = 0, lo, hi; /* the squared distance's range over the cell */
         for (a = 0; a < 3; a++) {
             voxdagi_ed_sq_range(o[a], size, op->c2[a], &lo, &hi);
-            near += lo;
-            far += hi;
+            least += lo;
+            most += hi;
         }
-        return near > op->r2 ? VOXDAGI_OUTSIDE : far <= op->r2 ? VOXDAGI_INSIDE : VOXDAGI_PARTLY;
+        return least > op->r2 ? VOXDAGI_OUTSIDE : most <= op->r2 ? VOXDAGI_INSIDE : VOXDAGI_PARTLY;
     }
 }
 

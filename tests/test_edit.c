@@ -189,7 +189,7 @@ static void test_edit_errors(void) {
     voxdag_error err;
     voxdag_shape s;
     uint32_t xyz[6] = {1, 1, 1, 0, 16, 0};
-    int64_t lo[3] = {0, 0, 0}, hi[3] = {4, 4, 4}, far[3] = {0, (int64_t)1 << 29, 0};
+    int64_t lo[3] = {0, 0, 0}, hi[3] = {4, 4, 4}, away[3] = {0, (int64_t)1 << 29, 0};
     memset(&o, 0, sizeof o);
     o.zero_end = 1;
     CHECK(voxdag_editor_create(NULL, &o, &ed, &err) == VOXDAG_ERR_INVALID_ARGUMENT && !ed);
@@ -210,7 +210,7 @@ static void test_edit_errors(void) {
     s.kind = (voxdag_shape_kind)7;
     CHECK(voxdag_editor_fill(ed, &s, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT);
     CHECK(voxdag_editor_paint(ed, &s, NULL, &err) == VOXDAG_ERR_INVALID_ARGUMENT);
-    CHECK(voxdag_editor_copy(ed, lo, hi, far, &err) == VOXDAG_ERR_COORDINATE);
+    CHECK(voxdag_editor_copy(ed, lo, hi, away, &err) == VOXDAG_ERR_COORDINATE);
     CHECK(voxdag_editor_undo(ed) == 0 && voxdag_editor_redo(ed) == 0);
     CHECK(voxdag_editor_set(ed, xyz, NULL, 1, &err) == VOXDAG_OK && voxdag_editor_voxels(ed) == 1);
     {
