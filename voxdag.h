@@ -920,7 +920,9 @@ VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed);
 
 /* Forgets the history (nothing to undo or redo afterwards) and frees the
    colour blocks only the history held: an edit keeps every block it
-   replaced (256 bytes per brick whose colours it changed) until then.
+   replaced (256 bytes per brick whose colours it changed) until then, or
+   until a new edit discards it from the edits that could be redone (their
+   blocks are reused).
    Nodes are kept (they are shared and small). Returns VOXDAG_OK, or
    VOXDAG_ERR_OUT_OF_MEMORY / VOXDAG_ERR_LIMIT with nothing changed. */
 VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err);
@@ -7539,11 +7541,23 @@ VOXDAG_API voxdag_status voxdag_save_file(const voxdag *dag, const char *path, v
 // root swap. Colours live in 64-colour blocks, one per 4^3 brick, found by
 // the brick's Morton key; an edit writes only into blocks it made itself and
 // copies any other block first, logging (brick, block before, block after),
-// which is what undo and redo replay. Nothing is freed before the editor is.
+// which is what undo and redo replay. Blocks live in fixed chunks (growing
+// never copies them); the blocks of edits that can no longer be redone, or
+// of a failed edit, are reused. Nodes are kept until the editor is freed.
 
 #define VOXDAGI_NO_BLOCK 0xFFFFFFFFu
 #define VOXDAGI_EDIT_COORD_MAX ((int64_t)1 << 28)
 #define VOXDAGI_WHITE 0xFFFFFFu
+#define VOXDAGI_ED_CHUNK_BITS 10 /* 1024 blocks (256 KB) a chunk */
+#define VOXDAGI_ED_NO_GROUP (~0ull) /* group keys have at most 3 (21 - 4) bits */
+
+/* The block map: a hash of groups of 4^3 bricks (brick key >> 6), each
+   holding its 64 bricks' blocks, so that bricks met in Morton order share
+   a lookup and its cache lines. */
+typedef struct voxdagi_ed_slot {
+    uint64_t group;  /* VOXDAGI_ED_NO_GROUP: a free slot */
+    uint32_t record; /* its 64 blocks: group_block + 64 * record */
+} voxdagi_ed_slot;
 
 typedef struct voxdagi_color_change {
     uint64_t brick;
@@ -7565,13 +7579,16 @@ struct voxdag_editor {
     voxdagi_reducer red;                /* the unique nodes of every level */
     uint32_t root;                      /* the scene now; VOXDAGI_NONE: empty */
     uint32_t full[VOXDAG_MAX_LEVELS];   /* a full subtree per level, once made */
-    uint32_t *block;                    /* 64 packed 0xRRGGBB per block */
+    uint32_t **chunk;                   /* colour blocks: 64 packed 0xRRGGBB each */
+    size_t chunk_n, chunk_cap;
     uint64_t *block_serial;             /* the edit that made each block */
-    size_t block_n, block_cap, serial_cap;
-    uint64_t *map_key;                  /* brick key -> block, open addressing */
-    uint32_t *map_block;
-    uint8_t *map_used;
+    size_t block_n, serial_cap;
+    uint32_t *spare;                    /* blocks no state reaches, to reuse */
+    size_t spare_n, spare_cap;
+    voxdagi_ed_slot *map;               /* brick group -> record, open addressing */
     size_t map_n, map_cap;              /* map_cap: a power of two or 0 */
+    uint32_t *group_block;              /* 64 blocks (VOXDAGI_NO_BLOCK: none) per record */
+    size_t group_cap;                   /* map_n records are used */
     voxdagi_color_change *change;
     size_t change_n, change_cap;
     voxdagi_edit_record *history;       /* [0, done) applied, [done, kept) undone */
@@ -7641,94 +7658,123 @@ static uint32_t voxdagi_ed_full(voxdag_editor *ed, uint32_t level) {
 
 // -- Editing: colour blocks (per brick, copy on write)
 
-static size_t voxdagi_ed_map_find(const voxdag_editor *ed, uint64_t brick) {
-    size_t i, mask = ed->map_cap - 1;
-    if (!ed->map_cap) return (size_t)-1;
-    for (i = (size_t)voxdagi_mix64(brick) & mask; ed->map_used[i]; i = (i + 1) & mask)
-        if (ed->map_key[i] == brick) return i;
-    return (size_t)-1;
+static uint32_t *voxdagi_ed_block(const voxdag_editor *ed, uint32_t block) {
+    return ed->chunk[block >> VOXDAGI_ED_CHUNK_BITS] + 64 * (size_t)(block & ((1u << VOXDAGI_ED_CHUNK_BITS) - 1));
 }
 
-/* The map slot of BRICK, made when missing. Returns (size_t)-1 when out of memory. */
-static size_t voxdagi_ed_map_slot(voxdag_editor *ed, uint64_t brick) {
-    size_t i = voxdagi_ed_map_find(ed, brick), mask;
-    if (i != (size_t)-1) return i;
+/* The block entry of BRICK, NULL when its group has none. */
+static uint32_t *voxdagi_ed_map_find(const voxdag_editor *ed, uint64_t brick) {
+    size_t i, mask = ed->map_cap - 1;
+    uint64_t group = brick >> 6;
+    if (!ed->map_cap) return NULL;
+    for (i = (size_t)voxdagi_mix64(group) & mask; ed->map[i].group != VOXDAGI_ED_NO_GROUP; i = (i + 1) & mask)
+        if (ed->map[i].group == group) return ed->group_block + 64 * (size_t)ed->map[i].record + (brick & 63);
+    return NULL;
+}
+
+/* The block entry of BRICK, its group made when missing. NULL when out of memory. */
+static uint32_t *voxdagi_ed_map_slot(voxdag_editor *ed, uint64_t brick) {
+    uint32_t *at = voxdagi_ed_map_find(ed, brick);
+    size_t i, mask, k;
+    if (at) return at;
+    if (!voxdagi_grow(&ed->mem, (void **)&ed->group_block, &ed->group_cap, 64 * (ed->map_n + 1),
+                      sizeof *ed->group_block))
+        return NULL;
     if ((ed->map_n + 1) * 2 > ed->map_cap) { /* rehash at half load */
         size_t cap = ed->map_cap ? ed->map_cap * 2 : 256, j;
-        uint64_t *key = (uint64_t *)voxdagi_alloc(&ed->mem, cap * sizeof *key);
-        uint32_t *block = (uint32_t *)voxdagi_alloc(&ed->mem, cap * sizeof *block);
-        uint8_t *used = (uint8_t *)voxdagi_alloc(&ed->mem, cap);
-        if (!key || !block || !used) {
-            voxdagi_free(&ed->mem, key, cap * sizeof *key);
-            voxdagi_free(&ed->mem, block, cap * sizeof *block);
-            voxdagi_free(&ed->mem, used, cap);
-            return (size_t)-1;
-        }
-        memset(used, 0, cap);
+        voxdagi_ed_slot *map = (voxdagi_ed_slot *)voxdagi_alloc(&ed->mem, cap * sizeof *map);
+        if (!map) return NULL;
+        for (j = 0; j < cap; j++) map[j].group = VOXDAGI_ED_NO_GROUP;
         for (j = 0; j < ed->map_cap; j++) {
-            if (!ed->map_used[j]) continue;
-            for (i = (size_t)voxdagi_mix64(ed->map_key[j]) & (cap - 1); used[i]; i = (i + 1) & (cap - 1)) {}
-            used[i] = 1;
-            key[i] = ed->map_key[j];
-            block[i] = ed->map_block[j];
+            if (ed->map[j].group == VOXDAGI_ED_NO_GROUP) continue;
+            for (i = (size_t)voxdagi_mix64(ed->map[j].group) & (cap - 1); map[i].group != VOXDAGI_ED_NO_GROUP;
+                 i = (i + 1) & (cap - 1)) {}
+            map[i] = ed->map[j];
         }
-        voxdagi_free(&ed->mem, ed->map_key, ed->map_cap * sizeof *ed->map_key);
-        voxdagi_free(&ed->mem, ed->map_block, ed->map_cap * sizeof *ed->map_block);
-        voxdagi_free(&ed->mem, ed->map_used, ed->map_cap);
-        ed->map_key = key;
-        ed->map_block = block;
-        ed->map_used = used;
+        voxdagi_free(&ed->mem, ed->map, ed->map_cap * sizeof *ed->map);
+        ed->map = map;
         ed->map_cap = cap;
     }
     mask = ed->map_cap - 1;
-    for (i = (size_t)voxdagi_mix64(brick) & mask; ed->map_used[i]; i = (i + 1) & mask) {}
-    ed->map_used[i] = 1;
-    ed->map_key[i] = brick;
-    ed->map_block[i] = VOXDAGI_NO_BLOCK;
-    ed->map_n++;
-    return i;
+    for (i = (size_t)voxdagi_mix64(brick >> 6) & mask; ed->map[i].group != VOXDAGI_ED_NO_GROUP; i = (i + 1) & mask) {}
+    ed->map[i].group = brick >> 6;
+    ed->map[i].record = (uint32_t)ed->map_n;
+    at = ed->group_block + 64 * ed->map_n++;
+    for (k = 0; k < 64; k++) at[k] = VOXDAGI_NO_BLOCK;
+    return at + (brick & 63);
 }
 
 /* The colours of BRICK (packed 0xRRGGBB), NULL when it has none. */
 static const uint32_t *voxdagi_ed_colors(const voxdag_editor *ed, uint64_t brick) {
-    size_t i = voxdagi_ed_map_find(ed, brick);
-    if (i == (size_t)-1 || ed->map_block[i] == VOXDAGI_NO_BLOCK) return NULL;
-    return ed->block + 64 * (size_t)ed->map_block[i];
+    const uint32_t *at = voxdagi_ed_map_find(ed, brick);
+    return at && *at != VOXDAGI_NO_BLOCK ? voxdagi_ed_block(ed, *at) : NULL;
+}
+
+/* A block for this edit: a spare one, or one more. VOXDAGI_NO_BLOCK when out of memory. */
+static uint32_t voxdagi_ed_new_block(voxdag_editor *ed) {
+    uint32_t made;
+    if (ed->spare_n) {
+        made = ed->spare[--ed->spare_n];
+    } else {
+        size_t c = ed->block_n >> VOXDAGI_ED_CHUNK_BITS;
+        if (ed->block_n + 1 >= VOXDAGI_NO_BLOCK ||
+            !voxdagi_grow(&ed->mem, (void **)&ed->block_serial, &ed->serial_cap, ed->block_n + 1,
+                          sizeof *ed->block_serial))
+            return VOXDAGI_NO_BLOCK;
+        if (c == ed->chunk_n) {
+            if (!voxdagi_grow(&ed->mem, (void **)&ed->chunk, &ed->chunk_cap, c + 1, sizeof *ed->chunk))
+                return VOXDAGI_NO_BLOCK;
+            ed->chunk[c] = (uint32_t *)voxdagi_alloc(&ed->mem, (64u << VOXDAGI_ED_CHUNK_BITS) * sizeof **ed->chunk);
+            if (!ed->chunk[c]) return VOXDAGI_NO_BLOCK;
+            ed->chunk_n++;
+        }
+        made = (uint32_t)ed->block_n++;
+    }
+    ed->block_serial[made] = ed->serial;
+    return made;
+}
+
+/* Gives the blocks made by changes [BEGIN, END) back for reuse (kept until
+   the editor is freed when there is no memory to note them). */
+static void voxdagi_ed_spare(voxdag_editor *ed, size_t begin, size_t end) {
+    size_t k;
+    if (end <= begin ||
+        !voxdagi_grow(&ed->mem, (void **)&ed->spare, &ed->spare_cap, ed->spare_n + (end - begin), sizeof *ed->spare))
+        return;
+    for (k = begin; k < end; k++) ed->spare[ed->spare_n++] = ed->change[k].after;
 }
 
 /* The colours of BRICK for this edit to write: its own block, or a new copy
-   of the current one (logged). NULL when out of memory. */
-static uint32_t *voxdagi_ed_colors_to_write(voxdag_editor *ed, uint64_t brick) {
-    size_t i = voxdagi_ed_map_slot(ed, brick), k;
-    uint32_t old, made;
-    if (i == (size_t)-1) return NULL;
-    old = ed->map_block[i];
-    if (old != VOXDAGI_NO_BLOCK && ed->block_serial[old] == ed->serial) return ed->block + 64 * (size_t)old;
-    if (ed->block_n + 1 >= VOXDAGI_NO_BLOCK) return NULL;
-    if (!voxdagi_grow(&ed->mem, (void **)&ed->block, &ed->block_cap, (ed->block_n + 1) * 64, sizeof *ed->block) ||
-        !voxdagi_grow(&ed->mem, (void **)&ed->block_serial, &ed->serial_cap, ed->block_n + 1,
-                      sizeof *ed->block_serial) ||
-        !voxdagi_grow(&ed->mem, (void **)&ed->change, &ed->change_cap, ed->change_n + 1, sizeof *ed->change))
+   of the current one (logged; no copy when WHOLE: every colour will be
+   written). NULL when out of memory. */
+static uint32_t *voxdagi_ed_colors_to_write(voxdag_editor *ed, uint64_t brick, int whole) {
+    uint32_t *at = voxdagi_ed_map_slot(ed, brick), old, made, *c;
+    size_t k;
+    if (!at) return NULL;
+    old = *at;
+    if (old != VOXDAGI_NO_BLOCK && ed->block_serial[old] == ed->serial) return voxdagi_ed_block(ed, old);
+    if (!voxdagi_grow(&ed->mem, (void **)&ed->change, &ed->change_cap, ed->change_n + 1, sizeof *ed->change))
         return NULL;
-    made = (uint32_t)ed->block_n++;
-    if (old != VOXDAGI_NO_BLOCK) memcpy(ed->block + 64 * (size_t)made, ed->block + 64 * (size_t)old, 64 * sizeof *ed->block);
-    else for (k = 0; k < 64; k++) ed->block[64 * (size_t)made + k] = VOXDAGI_WHITE;
-    ed->block_serial[made] = ed->serial;
+    made = voxdagi_ed_new_block(ed);
+    if (made == VOXDAGI_NO_BLOCK) return NULL;
+    c = voxdagi_ed_block(ed, made);
+    if (!whole && old != VOXDAGI_NO_BLOCK) memcpy(c, voxdagi_ed_block(ed, old), 64 * sizeof *c);
+    else if (!whole) for (k = 0; k < 64; k++) c[k] = VOXDAGI_WHITE;
     ed->change[ed->change_n].brick = brick;
     ed->change[ed->change_n].before = old;
     ed->change[ed->change_n].after = made;
     ed->change_n++;
-    ed->map_block[i] = made;
-    return ed->block + 64 * (size_t)made;
+    *at = made;
+    return c;
 }
 
 /* Points every brick of changes [BEGIN, END) at its block before (or after). */
 static void voxdagi_ed_replay(voxdag_editor *ed, size_t begin, size_t end, int after) {
     size_t k;
     if (after) {
-        for (k = begin; k < end; k++) ed->map_block[voxdagi_ed_map_find(ed, ed->change[k].brick)] = ed->change[k].after;
+        for (k = begin; k < end; k++) *voxdagi_ed_map_find(ed, ed->change[k].brick) = ed->change[k].after;
     } else {
-        for (k = end; k-- > begin;) ed->map_block[voxdagi_ed_map_find(ed, ed->change[k].brick)] = ed->change[k].before;
+        for (k = end; k-- > begin;) *voxdagi_ed_map_find(ed, ed->change[k].brick) = ed->change[k].before;
     }
 }
 
@@ -7747,7 +7793,7 @@ static void voxdagi_unpack_rgb(uint32_t c, uint8_t rgb[3]) {
 static int voxdagi_ed_paint_bits(voxdag_editor *ed, uint64_t brick, uint64_t bits, const voxdag_brush *brush) {
     uint32_t *c, fixed = brush ? voxdagi_pack_rgb(brush->rgb) : VOXDAGI_WHITE, x, y, z;
     if (!ed->colors || !bits) return 1;
-    c = voxdagi_ed_colors_to_write(ed, brick);
+    c = voxdagi_ed_colors_to_write(ed, brick, bits == ~0ull);
     if (!c) return 0;
     if (!brush || !brush->fn) {
         for (; bits; bits &= bits - 1) c[voxdagi_lowest_bit(bits)] = fixed;
@@ -7789,11 +7835,13 @@ static voxdag_status voxdagi_ed_end(voxdag_editor *ed, uint32_t root, int failed
     voxdagi_edit_record *rec;
     if (failed || ed->red.failed) {
         voxdagi_ed_replay(ed, begin, ed->change_n, 0);
+        voxdagi_ed_spare(ed, begin, ed->change_n);
         ed->change_n = begin;
         ed->red.failed = 0;
         return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
     }
     at = ed->done ? ed->history[ed->done - 1].change_end : 0;
+    voxdagi_ed_spare(ed, at, begin); /* the edits that could be redone */
     if (n && at != begin) memmove(ed->change + at, ed->change + begin, n * sizeof *ed->change);
     ed->change_n = at + n;
     rec = &ed->history[ed->done];
@@ -7827,34 +7875,38 @@ VOXDAG_API int voxdag_editor_redo(voxdag_editor *ed) {
     return 1;
 }
 
+static void voxdagi_ed_free_chunks(voxdag_editor *ed, uint32_t **chunk, size_t n, size_t cap) {
+    size_t c;
+    for (c = 0; c < n; c++) voxdagi_free(&ed->mem, chunk[c], (64u << VOXDAGI_ED_CHUNK_BITS) * sizeof **chunk);
+    voxdagi_free(&ed->mem, chunk, cap * sizeof *chunk);
+}
+
 VOXDAG_API voxdag_status voxdag_editor_forget_history(voxdag_editor *ed, voxdag_error *err) {
-    uint32_t *block = NULL;
-    uint64_t *serial = NULL;
-    size_t i, n = 0;
+    uint32_t **chunk = NULL;
+    size_t i, n = 0, chunks, made = 0;
     if (!ed) return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "no editor");
-    for (i = 0; i < ed->map_cap; i++) n += ed->map_used[i] && ed->map_block[i] != VOXDAGI_NO_BLOCK;
-    if (n) {
-        block = (uint32_t *)voxdagi_alloc(&ed->mem, n * 64 * sizeof *block);
-        serial = (uint64_t *)voxdagi_alloc(&ed->mem, n * sizeof *serial);
-    }
-    if (n && (!block || !serial)) {
-        voxdagi_free(&ed->mem, block, n * 64 * sizeof *block);
-        voxdagi_free(&ed->mem, serial, n * sizeof *serial);
+    for (i = 0; i < 64 * ed->map_n; i++) n += ed->group_block[i] != VOXDAGI_NO_BLOCK;
+    chunks = (n + (1u << VOXDAGI_ED_CHUNK_BITS) - 1) >> VOXDAGI_ED_CHUNK_BITS;
+    if (chunks && (chunk = (uint32_t **)voxdagi_alloc(&ed->mem, chunks * sizeof *chunk)) != NULL)
+        for (; made < chunks; made++)
+            if (!(chunk[made] = (uint32_t *)voxdagi_alloc(&ed->mem, (64u << VOXDAGI_ED_CHUNK_BITS) * sizeof **chunk))) break;
+    if (made < chunks) {
+        if (chunk) voxdagi_ed_free_chunks(ed, chunk, made, chunks);
         return voxdagi_mem_fail(&ed->mem, err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory");
     }
-    for (i = 0, n = 0; i < ed->map_cap; i++) { /* the blocks the scene uses now, packed */
-        if (!ed->map_used[i] || ed->map_block[i] == VOXDAGI_NO_BLOCK) continue;
-        memcpy(block + 64 * n, ed->block + 64 * (size_t)ed->map_block[i], 64 * sizeof *block);
-        serial[n] = 0; /* no edit's: the next one copies before writing */
-        ed->map_block[i] = (uint32_t)n++;
+    for (i = 0, n = 0; i < 64 * ed->map_n; i++) { /* the blocks the scene uses now, packed */
+        uint32_t *to;
+        if (ed->group_block[i] == VOXDAGI_NO_BLOCK) continue;
+        to = chunk[n >> VOXDAGI_ED_CHUNK_BITS] + 64 * (n & ((1u << VOXDAGI_ED_CHUNK_BITS) - 1));
+        memcpy(to, voxdagi_ed_block(ed, ed->group_block[i]), 64 * sizeof *to);
+        ed->block_serial[n] = 0; /* no edit's: the next one copies before writing */
+        ed->group_block[i] = (uint32_t)n++;
     }
-    voxdagi_free(&ed->mem, ed->block, ed->block_cap * sizeof *ed->block);
-    voxdagi_free(&ed->mem, ed->block_serial, ed->serial_cap * sizeof *ed->block_serial);
-    ed->block = block;
-    ed->block_serial = serial;
+    voxdagi_ed_free_chunks(ed, ed->chunk, ed->chunk_n, ed->chunk_cap);
+    ed->chunk = chunk;
+    ed->chunk_n = ed->chunk_cap = chunks;
     ed->block_n = n;
-    ed->block_cap = n * 64;
-    ed->serial_cap = n;
+    ed->spare_n = 0;
     ed->change_n = 0;
     ed->done = ed->kept = 0;
     return voxdagi_ok(err);
@@ -8045,7 +8097,7 @@ static uint32_t voxdagi_ed_apply_list(voxdag_editor *ed, uint32_t level, uint32_
             int fresh = v[i].full && !(now & bit);
             now = v[i].full ? now | bit : now & ~bit;
             if (ed->colors && v[i].full && (v[i].has_rgb || fresh)) {
-                if (!c && !(c = voxdagi_ed_colors_to_write(ed, key))) {
+                if (!c && !(c = voxdagi_ed_colors_to_write(ed, key, 0))) {
                     ed->red.failed = 1;
                     return ref;
                 }
@@ -8355,7 +8407,7 @@ static int voxdagi_ed_open_voxel(void *user, uint32_t x, uint32_t y, uint32_t z,
             op->failed = 2;
             return 1;
         }
-        c = voxdagi_ed_colors_to_write(op->ed, code >> 6);
+        c = voxdagi_ed_colors_to_write(op->ed, code >> 6, 0);
         if (!c) {
             op->failed = 1;
             return 1;
@@ -8435,11 +8487,11 @@ VOXDAG_API void voxdag_editor_free(voxdag_editor *ed) {
     if (!ed) return;
     voxdagi_ed_drop_traced(ed);
     voxdagi_reducer_free(&ed->red);
-    voxdagi_free(&ed->mem, ed->block, ed->block_cap * sizeof *ed->block);
+    voxdagi_ed_free_chunks(ed, ed->chunk, ed->chunk_n, ed->chunk_cap);
     voxdagi_free(&ed->mem, ed->block_serial, ed->serial_cap * sizeof *ed->block_serial);
-    voxdagi_free(&ed->mem, ed->map_key, ed->map_cap * sizeof *ed->map_key);
-    voxdagi_free(&ed->mem, ed->map_block, ed->map_cap * sizeof *ed->map_block);
-    voxdagi_free(&ed->mem, ed->map_used, ed->map_cap);
+    voxdagi_free(&ed->mem, ed->spare, ed->spare_cap * sizeof *ed->spare);
+    voxdagi_free(&ed->mem, ed->map, ed->map_cap * sizeof *ed->map);
+    voxdagi_free(&ed->mem, ed->group_block, ed->group_cap * sizeof *ed->group_block);
     voxdagi_free(&ed->mem, ed->change, ed->change_cap * sizeof *ed->change);
     voxdagi_free(&ed->mem, ed->history, ed->history_cap * sizeof *ed->history);
     mem = ed->mem;
