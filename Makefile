@@ -302,11 +302,15 @@ $(BUILD)/bench/bench_rays: bench/bench_rays.c bench/bench_rays_nanovdb.cpp bench
 bench-rays: bench-data $(BUILD)/bench/bench_rays
 	$(BUILD)/bench/bench_rays bench/data $(BENCH_FLAGS)
 
+$(BUILD)/bench/bench_edit: bench/bench_edit.c $(BENCH_DEPS)
+	@mkdir -p $(@D)
+	$(CC) $(BENCH_CFLAGS) -o $@ $< examples/import.c examples/image_none.c -lm
+
 $(BUILD)/bench/ssim: bench/ssim.c
 	@mkdir -p $(@D)
 	$(CC) $(CSTD) $(WARN) -O2 -o $@ $< -lm
 
-BENCH_PROGRAMS := $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/bench/ssim $(BUILD)/vdag
+BENCH_PROGRAMS := $(BUILD)/bench/bench_build $(BUILD)/bench/bench_geometry $(BUILD)/bench/bench_edit $(BUILD)/bench/ssim $(BUILD)/vdag
 bench: bench-data $(BENCH_PROGRAMS)
 	@MAKE="$(BENCH_SUBMAKE)" CC="$(CC)" sh bench/report.sh full $(BUILD)
 bench-quick: bench-data $(BENCH_PROGRAMS)
