@@ -53,6 +53,7 @@ fi
 section image sh bench/image_quality.sh "$mode" "$build/vdag" "$build/bench/ssim" bench/data "$docs"
 section distance sh bench/distance.sh "$mode" "$build/vdag" bench/data
 section gpu sh bench/gpu.sh "$mode" "$build/vdag" bench/data
+section edit sh bench/edit.sh "$mode" "$build/vdag" "$build/bench/bench_edit" bench/data
 step "plots"
 
 version() { dpkg-query -W -f '${Version}' "$1" 2>/dev/null || echo "not installed"; }
@@ -95,6 +96,7 @@ tmp=$out/BENCHMARKS.md.tmp
     cat "$out/image.md"
     cat "$out/distance.md"
     cat "$out/gpu.md"
+    cat "$out/edit.md"
     if [ -f bench/reading.md ]; then cat bench/reading.md; echo; fi
     if [ -f bench/real_scenes.md ]; then cat bench/real_scenes.md; echo; fi
     echo "Total benchmark time: $(( $(date +%s) - start )) s ($mode run, including data fetch and package checks)."
