@@ -222,6 +222,10 @@ check-all:
 	@sh tests/check_all.sh $(BUILD)
 
 # The importers' triangles, printed for tests/third_party.sh (sanitized).
+# The editing example (README, Editing), run by tests/cli.sh.
+$(BUILD)/edit_demo: examples/edit_demo.c $(HEADERS) | $(BUILD)
+	$(CC) $(CSTD) $(WARN) -O2 -I. -o $@ examples/edit_demo.c $(THREADS) -lm
+
 $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scene.c examples/image_none.c examples/import.h examples/image.h | $(BUILD)
 	$(CC) $(CSTD) $(WARN) -O1 -g $(SAN) -I. -o $@ tests/import_dump.c examples/import.c examples/image_none.c -lm
 
@@ -234,7 +238,7 @@ $(BUILD)/import_dump: tests/import_dump.c examples/import.c examples/import_scen
 test-real: $(BUILD)/vdag $(BUILD)/import_dump
 	@sh tests/real.sh $(BUILD)
 
-TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/fuzz_edit $(BUILD)/import_dump $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
+TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/fuzz_edit $(BUILD)/import_dump $(BUILD)/edit_demo $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
                  $(if $(VULKAN),$(VK_SMOKE:.h=.spv) $(VDAG_KERNEL:.h=.spv) $(README_SHADERS))
 test: deps $(TEST_PROGRAMS)
 	@sh tests/run.sh $(BUILD)

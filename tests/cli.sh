@@ -1044,6 +1044,26 @@ check "edit: no colours: one warning, colours ignored" sh -c "
     printf 'set 1 1 1 9 9 9\nfill-box 0 0 0 2 2 2 1 2 3\n' | '$VDAG' edit '$T/nc.vdag' '$T/nc_out.vdag' 2>'$T/err' &&
     [ \$(grep -c warning '$T/err') = 1 ] && '$VDAG' lookup '$T/nc_out.vdag' 1 1 1 | grep -q '^1 '"
 
+# -- the editing example (examples/edit_demo.c, built beside the tool): its
+# voxel count against the shapes counted here
+EDIT_DEMO=${EDIT_DEMO:-$(dirname "$VDAG")/edit_demo}
+check "edit_demo runs and writes a valid file" sh -c "
+    '$EDIT_DEMO' '$T/demo_edited.vdag' >'$T/edit_demo.out' && '$VDAG' validate '$T/demo_edited.vdag' 2>/dev/null"
+check "edit_demo: voxels = 2 x (planet - tunnel), the band's colour" python3 -c "
+import json, subprocess
+n = 0
+for z in range(56, 137):
+    for y in range(88, 169):
+        for x in range(40, 121):
+            if (2*x+1-160)**2 + (2*y+1-256)**2 + (2*z+1-192)**2 <= 4*40*40 and not (30 <= x < 130 and 120 <= y < 136 and 88 <= z < 104):
+                n += 1
+out = open('$T/edit_demo.out').read()
+assert 'after 4 edits: %d voxels' % (2 * n) in out, (n, out)
+assert 'colour 255 200 40' in out, out
+info = json.loads(subprocess.run(['$VDAG', 'info', '$T/demo_edited.vdag', '--json'], capture_output=True, text=True).stdout)
+assert info['voxels'] == 2 * n, (info['voxels'], n)
+"
+
 # -- README's tool section names every command and every option of --help
 check "README lists every command and option of --help" python3 -c "
 import re, subprocess, sys
