@@ -16,9 +16,11 @@ fi
 export VDAG="$build/vdag" # the tool the tests run, from the same build
 total_pass=0
 total_fail=0
+start=$(date +%s)
 run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed"
     name=$1; shift
     echo "== $name" >&2
+    t0=$(date +%s)
     out=$("$@")
     status=$?
     line=$(printf '%s\n' "$out" | tail -n 1)
@@ -31,7 +33,7 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
         echo "$name: exit status $status" >&2
         f=1
     fi
-    echo "$name: $line" >&2
+    echo "$name: $line ($(( $(date +%s) - t0 )) s)" >&2
     total_pass=$((total_pass + p))
     total_fail=$((total_fail + f))
 }
@@ -49,5 +51,6 @@ run fuzz-load "$build/fuzz_load" $sweep tests/data/fuzz/load
 run fuzz-roundtrip "$build/fuzz_roundtrip" $sweep tests/data/fuzz/roundtrip
 run fuzz-edit "$build/fuzz_edit" $sweep tests/data/fuzz/edit
 run check-all sh tests/check_all.sh "$build"
+echo "all: $(( $(date +%s) - start )) s" >&2
 echo "$total_pass passed, $total_fail failed"
 [ "$total_fail" = 0 ]

@@ -5,6 +5,8 @@
    no importers, no images, no tool. */
 #include "test.h"
 
+#include <time.h>
+
 int test_current_failed;
 int test_full;
 
@@ -61,9 +63,12 @@ int main(int argc, char **argv) {
         for (t = suites[s]; t->name; t++) {
             for (i = first; i < argc && !strstr(t->name, argv[i]); i++) continue;
             if (first < argc && i == argc) continue;
+            clock_t start = clock();
             test_current_failed = 0;
             fprintf(stderr, "[ RUN ] %s\n", t->name);
             t->fn();
+            if (clock() - start > CLOCKS_PER_SEC) /* where the suite's time goes */
+                fprintf(stderr, "[ CPU ] %s: %.1f s\n", t->name, (double)(clock() - start) / CLOCKS_PER_SEC);
             if (test_current_failed) {
                 fprintf(stderr, "[FAIL ] %s (%d checks failed)\n", t->name, test_current_failed);
                 failed++;
