@@ -2,7 +2,9 @@
    edit, undo and redo of random sequences the editor's voxels, indices,
    colours, lookups and rays must match the model, and its commit must be
    the very bytes the builder makes of the model's voxels with the same
-   options; allocation failures leave nothing half-applied. */
+   options; allocation failures leave nothing half-applied. L = 2..8 use
+   the dense model; L = 9 and 10 a sparse one (sorted voxels), with small
+   shapes near voxels and grid borders. */
 #include "voxcolor.h"
 #include "voxdag.h"
 #include "test.h"
@@ -121,6 +123,358 @@ static void test_edit_sequences_large(void) {
         for (g = 0; g < 3; g++)
             run_sequence(seed++, levels, groups[g], g != 1, levels == 7, levels == 6 ? 12 : 6, 0);
     run_sequence(seed, 8, VOXDAG_SYMMETRY_FULL, 1, 0, 3, 0);
+}
+
+// -- L = 9 and 10: a sparse model (sorted voxels), small shapes anywhere
+
+/* A scene as its voxels sorted by Morton code, with colours. */
+typedef struct sparse {
+    uint64_t *code;
+    uint32_t *rgb;
+    size_t n, cap;
+} sparse;
+
+static void sparse_push(sparse *s, uint64_t code, uint32_t rgb) {
+    if (s->n == s->cap) {
+        s->cap = s->cap ? 2 * s->cap : 1024;
+        s->code = (uint64_t *)realloc(s->code, s->cap * sizeof *s->code);
+        s->rgb = (uint32_t *)realloc(s->rgb, s->cap * sizeof *s->rgb);
+    }
+    s->code[s->n] = code;
+    s->rgb[s->n++] = rgb;
+}
+
+static void sparse_copy(sparse *dst, const sparse *src) {
+    size_t i;
+    memset(dst, 0, sizeof *dst);
+    for (i = 0; i < src->n; i++) sparse_push(dst, src->code[i], src->rgb[i]);
+}
+
+static void sparse_free(sparse *s) {
+    free(s->code);
+    free(s->rgb);
+    memset(s, 0, sizeof *s);
+}
+
+/* The index of CODE, or -1. */
+static long sparse_find(const sparse *s, uint64_t code) {
+    size_t lo = 0, hi = s->n;
+    while (lo < hi) {
+        size_t mid = (lo + hi) / 2;
+        if (s->code[mid] < code) lo = mid + 1;
+        else hi = mid;
+    }
+    return lo < s->n && s->code[lo] == code ? (long)lo : -1;
+}
+
+typedef struct code_rgb {
+    uint64_t code;
+    uint32_t rgb;
+} code_rgb;
+
+static int code_rgb_cmp(const void *a, const void *b) {
+    uint64_t x = ((const code_rgb *)a)->code, y = ((const code_rgb *)b)->code;
+    return (x > y) - (x < y);
+}
+
+/* Replaces S by the voxels of LIST (any order, distinct codes). */
+static void sparse_from(sparse *s, code_rgb *list, size_t n) {
+    size_t i;
+    qsort(list, n, sizeof *list, code_rgb_cmp);
+    s->n = 0;
+    for (i = 0; i < n; i++) sparse_push(s, list[i].code, list[i].rgb);
+}
+
+/* The voxels of S after OP with SHAPE (BRUSH as voxdag_editor_fill / _paint). */
+static void sparse_shape(sparse *s, uint32_t n, int op, const voxdag_shape *sh, const voxdag_brush *b) {
+    code_rgb *list;
+    size_t i, k = 0, room = s->n + 1;
+    int64_t lo[3], hi[3], x, y, z;
+    int a;
+    for (a = 0; a < 3; a++) { /* the shape's box inside the grid */
+        lo[a] = sh->kind == VOXDAG_SHAPE_BOX ? sh->lo[a] : sh->center[a] - sh->radius;
+        hi[a] = sh->kind == VOXDAG_SHAPE_BOX ? sh->hi[a] : sh->center[a] + sh->radius + 1;
+        if (lo[a] < 0) lo[a] = 0;
+        if (hi[a] > (int64_t)n) hi[a] = n;
+        if (hi[a] < lo[a]) hi[a] = lo[a];
+    }
+    if (op == OP_FILL) room += (size_t)((hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]));
+    list = (code_rgb *)malloc(room * sizeof *list);
+    for (i = 0; i < s->n; i++) { /* the voxels there: carved, painted or kept */
+        uint32_t v[3];
+        voxdag_morton_decode(s->code[i], &v[0], &v[1], &v[2]);
+        if (in_shape(sh, v[0], v[1], v[2])) {
+            if (op == OP_CARVE) continue;
+            if (op == OP_PAINT || (op == OP_FILL && b)) {
+                list[k].code = s->code[i], list[k++].rgb = brush_color(b, v[0], v[1], v[2]);
+                continue;
+            }
+        }
+        list[k].code = s->code[i], list[k++].rgb = s->rgb[i];
+    }
+    if (op == OP_FILL) /* the new voxels */
+        for (z = lo[2]; z < hi[2]; z++)
+            for (y = lo[1]; y < hi[1]; y++)
+                for (x = lo[0]; x < hi[0]; x++) {
+                    uint64_t c = voxdag_morton_encode((uint32_t)x, (uint32_t)y, (uint32_t)z);
+                    if (!in_shape(sh, x, y, z) || sparse_find(s, c) >= 0) continue;
+                    list[k].code = c;
+                    list[k++].rgb = b ? brush_color(b, (uint32_t)x, (uint32_t)y, (uint32_t)z) : WHITE;
+                }
+    sparse_from(s, list, k);
+    free(list);
+}
+
+static int box_has(const int64_t lo[3], const int64_t hi[3], const int64_t v[3], uint32_t n) {
+    int a;
+    for (a = 0; a < 3; a++)
+        if (v[a] < lo[a] || v[a] >= hi[a] || v[a] < 0 || v[a] >= (int64_t)n) return 0;
+    return 1;
+}
+
+/* voxdag_editor_copy on S: each in-grid voxel position of LO..HI, full or
+   empty, written at itself + D when that lies in the grid. */
+static void sparse_copy_box(sparse *s, uint32_t n, const int64_t lo[3], const int64_t hi[3], const int64_t d[3]) {
+    code_rgb *list = (code_rgb *)malloc((2 * s->n + 1) * sizeof *list);
+    size_t i, k = 0;
+    int a;
+    for (i = 0; i < s->n; i++) {
+        uint32_t u[3];
+        int64_t v[3], from[3], to[3];
+        voxdag_morton_decode(s->code[i], &u[0], &u[1], &u[2]);
+        for (a = 0; a < 3; a++) v[a] = u[a], from[a] = v[a] - d[a], to[a] = v[a] + d[a];
+        if (!box_has(lo, hi, from, n)) list[k].code = s->code[i], list[k++].rgb = s->rgb[i]; /* not overwritten */
+        if (box_has(lo, hi, v, n) && to[0] >= 0 && to[1] >= 0 && to[2] >= 0 &&
+            to[0] < (int64_t)n && to[1] < (int64_t)n && to[2] < (int64_t)n) {
+            list[k].code = voxdag_morton_encode((uint32_t)to[0], (uint32_t)to[1], (uint32_t)to[2]);
+            list[k++].rgb = s->rgb[i];
+        }
+    }
+    sparse_from(s, list, k);
+    free(list);
+}
+
+static voxdag *sparse_build(const sparse *s, uint32_t levels, voxdag_symmetry sym, int colors) {
+    voxdag_build_opts o;
+    voxdag_builder *b;
+    voxdag *d = NULL;
+    uint32_t *xyz = (uint32_t *)malloc((3 * s->n + 1) * sizeof *xyz);
+    uint8_t *rgb = (uint8_t *)malloc(3 * s->n + 1);
+    size_t i;
+    memset(&o, 0, sizeof o);
+    o.levels = levels, o.symmetry = sym, o.colors = colors;
+    for (i = 0; i < s->n; i++) {
+        voxdag_morton_decode(s->code[i], &xyz[3 * i], &xyz[3 * i + 1], &xyz[3 * i + 2]);
+        rgb[3 * i] = (uint8_t)(s->rgb[i] >> 16), rgb[3 * i + 1] = (uint8_t)(s->rgb[i] >> 8);
+        rgb[3 * i + 2] = (uint8_t)s->rgb[i];
+    }
+    if (voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK && voxdag_builder_add(b, xyz, rgb, s->n, NULL) == VOXDAG_OK)
+        voxdag_builder_finish(b, &d, NULL, NULL);
+    free(xyz);
+    free(rgb);
+    return d;
+}
+
+typedef struct sparse_seen {
+    const sparse *s;
+    const voxdag_editor *ed;
+    int colors;
+    uint64_t count;
+    int bad;
+} sparse_seen;
+
+static int sparse_seen_voxel(void *user, uint32_t x, uint32_t y, uint32_t z, uint64_t index) {
+    sparse_seen *v = (sparse_seen *)user;
+    uint8_t rgb[3];
+    if (index != v->count || index >= v->s->n || v->s->code[index] != voxdag_morton_encode(x, y, z) ||
+        voxdag_editor_color(v->ed, index, rgb) != v->colors || (v->colors && pack(rgb) != v->s->rgb[index]))
+        v->bad = 1;
+    v->count++;
+    return v->bad;
+}
+
+/* The editor against S: count, every voxel with its index and colour in
+   order, lookups near the voxels; with COMMIT, the commit against a fresh
+   build. */
+static const char *sparse_compare(voxdag_editor *ed, const sparse *s, uint32_t levels, voxdag_symmetry sym,
+                                  int colors, uint64_t *rng, int commit) {
+    sparse_seen v;
+    voxdag *built, *mine = NULL;
+    const char *why = NULL;
+    int k;
+    memset(&v, 0, sizeof v);
+    v.s = s, v.ed = ed, v.colors = colors;
+    if (voxdag_editor_voxels(ed) != s->n) return "voxel count";
+    voxdag_editor_for_each_voxel(ed, sparse_seen_voxel, &v);
+    if (v.bad || v.count != s->n) return "for_each_voxel: voxels, indices or colours";
+    for (k = 0; k < 400 && !why; k++) { /* near a voxel, or anywhere */
+        uint32_t p[3];
+        uint64_t index = UINT64_MAX, c;
+        long at;
+        int a;
+        if (s->n && k % 2) {
+            voxdag_morton_decode(s->code[test_rand(rng) % s->n], &p[0], &p[1], &p[2]);
+            for (a = 0; a < 3; a++) p[a] = (p[a] + test_rand_below(rng, 3) + (1u << levels) - 1) % (1u << levels);
+        } else {
+            for (a = 0; a < 3; a++) p[a] = test_rand_below(rng, 1u << levels);
+        }
+        c = voxdag_morton_encode(p[0], p[1], p[2]);
+        at = sparse_find(s, c);
+        if (voxdag_editor_lookup(ed, p[0], p[1], p[2], &index) != (at >= 0)) why = "lookup: full or empty";
+        else if (at >= 0 && index != (uint64_t)at) why = "lookup: voxel index";
+    }
+    if (why || !commit) return why;
+    built = sparse_build(s, levels, sym, colors);
+    if (!why && (!built || voxdag_editor_commit(ed, &mine, NULL) != VOXDAG_OK)) why = "build or commit failed";
+    if (!why) {
+        size_t a, b;
+        const void *pa = voxdag_image(built, &a), *pb = voxdag_image(mine, &b);
+        if (a != b || memcmp(pa, pb, a)) why = "commit: not the builder's bytes";
+    }
+    voxdag_free(built);
+    voxdag_free(mine);
+    return why;
+}
+
+/* A point P near something: a voxel of S, a grid border, or anywhere. */
+static void sparse_near(const sparse *s, uint32_t n, uint64_t *rng, int64_t p[3]) {
+    uint32_t v[3];
+    int a, mode = (int)test_rand_below(rng, 4) / 2 + 1; /* 1, 1, 2, 2 ... */
+    if (test_rand(rng) & 1) mode = 0;                     /* ... or 0, half the time */
+    if (mode == 0 && s->n) voxdag_morton_decode(s->code[test_rand(rng) % s->n], &v[0], &v[1], &v[2]);
+    for (a = 0; a < 3; a++) {
+        if (mode == 0 && s->n) p[a] = (int64_t)v[a] + (int64_t)test_rand_below(rng, 17) - 8;
+        else if (mode == 1 && test_rand(rng) % 3) p[a] = (test_rand(rng) & 1 ? (int64_t)n : 0) + (int64_t)test_rand_below(rng, 21) - 10;
+        else p[a] = test_rand_below(rng, n);
+    }
+}
+
+/* voxdag_editor_set / _clear of one voxel on S (RGB < 0: no colour given). */
+static void sparse_set(sparse *s, uint64_t code, long rgb, int full) {
+    long at = sparse_find(s, code);
+    size_t i;
+    if (at >= 0 && !full) { /* clear */
+        memmove(s->code + at, s->code + at + 1, (s->n - (size_t)at - 1) * sizeof *s->code);
+        memmove(s->rgb + at, s->rgb + at + 1, (s->n - (size_t)at - 1) * sizeof *s->rgb);
+        s->n--;
+    } else if (at >= 0) {
+        if (rgb >= 0) s->rgb[at] = (uint32_t)rgb;
+    } else if (full) {
+        sparse_push(s, code, rgb >= 0 ? (uint32_t)rgb : WHITE);
+        for (i = s->n - 1; i > 0 && s->code[i - 1] > code; i--) { /* into its place */
+            uint64_t c = s->code[i];
+            uint32_t r = s->rgb[i];
+            s->code[i] = s->code[i - 1], s->rgb[i] = s->rgb[i - 1];
+            s->code[i - 1] = c, s->rgb[i - 1] = r;
+        }
+    }
+}
+
+/* One random sequence of EDITS operations at L = LEVELS (9, 10) from an
+   empty scene: fills, carves, paints, copies, voxel lists, undo and redo,
+   with shapes of up to 24 voxels near voxels and grid borders, each checked
+   against the sparse model. */
+static void run_sparse_sequence(uint64_t seed, uint32_t levels, voxdag_symmetry sym, int colors, int edits) {
+    uint64_t rng = seed;
+    uint32_t n = 1u << levels, salt = (uint32_t)seed;
+    sparse *state = (sparse *)calloc((size_t)edits + 1, sizeof *state);
+    size_t done = 0, kept = 1, i;
+    voxdag_editor_opts o;
+    voxdag_editor *ed = NULL;
+    const char *why = NULL;
+    int e = 0;
+    memset(&o, 0, sizeof o);
+    o.levels = levels, o.symmetry = sym, o.colors = colors;
+    CHECK(voxdag_editor_create(NULL, &o, &ed, NULL) == VOXDAG_OK);
+    for (e = 1; ed && !why && e <= edits; e++) {
+        uint32_t kind = test_rand_below(&rng, 10), xyz[3 * 16];
+        uint8_t rgb[3 * 16];
+        voxdag_shape sh;
+        voxdag_brush brush;
+        const voxdag_brush *fill_brush;
+        sparse next;
+        voxdag_status st = VOXDAG_OK;
+        int a, k, count;
+        if (kind == 9) { /* undo or redo */
+            if (test_rand(&rng) & 1) {
+                if (voxdag_editor_undo(ed) != (done > 0)) why = "undo";
+                else if (done) done--;
+            } else {
+                if (voxdag_editor_redo(ed) != (done + 1 < kept)) why = "redo";
+                else if (done + 1 < kept) done++;
+            }
+            if (!why) why = sparse_compare(ed, &state[done], levels, sym, colors, &rng, e == edits);
+            continue;
+        }
+        memset(&sh, 0, sizeof sh);
+        memset(&brush, 0, sizeof brush);
+        brush.rgb[0] = (uint8_t)test_rand(&rng), brush.rgb[1] = (uint8_t)test_rand(&rng);
+        brush.rgb[2] = (uint8_t)test_rand(&rng);
+        if (test_rand(&rng) & 1) brush.fn = brush_at, brush.user = &salt;
+        fill_brush = test_rand(&rng) % 3 ? &brush : NULL;
+        salt++;
+        sh.kind = test_rand(&rng) & 1 ? VOXDAG_SHAPE_SPHERE : VOXDAG_SHAPE_BOX;
+        sh.radius = test_rand_below(&rng, 25);
+        sparse_near(&state[done], n, &rng, sh.center);
+        for (a = 0; a < 3; a++) {
+            sh.lo[a] = sh.center[a] - test_rand_below(&rng, 24);
+            sh.hi[a] = sh.center[a] + test_rand_below(&rng, 24);
+        }
+        sparse_copy(&next, &state[done]);
+        if (kind < 3) {
+            st = voxdag_editor_fill(ed, &sh, fill_brush, NULL);
+            sparse_shape(&next, n, OP_FILL, &sh, fill_brush);
+        } else if (kind < 5) {
+            st = voxdag_editor_carve(ed, &sh, NULL);
+            sparse_shape(&next, n, OP_CARVE, &sh, NULL);
+        } else if (kind < 7) {
+            st = voxdag_editor_paint(ed, &sh, &brush, NULL);
+            sparse_shape(&next, n, OP_PAINT, &sh, &brush);
+        } else if (kind == 7) {
+            int64_t d[3];
+            sparse_near(&state[done], n, &rng, d);
+            for (a = 0; a < 3; a++) d[a] -= sh.lo[a];
+            st = voxdag_editor_copy(ed, sh.lo, sh.hi, d, NULL);
+            sparse_copy_box(&next, n, sh.lo, sh.hi, d);
+        } else { /* a voxel list, repeats included */
+            int full = test_rand(&rng) & 1, with_rgb = test_rand(&rng) & 1;
+            count = 1 + (int)test_rand_below(&rng, 16);
+            for (k = 0; k < count; k++) {
+                int64_t v[3];
+                sparse_near(&state[done], n, &rng, v);
+                for (a = 0; a < 3; a++) xyz[3 * k + a] = (uint32_t)(v[a] < 0 ? 0 : v[a] >= (int64_t)n ? n - 1 : v[a]);
+                if (k && test_rand(&rng) % 4 == 0) memcpy(xyz + 3 * k, xyz + 3 * (k - 1), 3 * sizeof *xyz);
+                for (a = 0; a < 3; a++) rgb[3 * k + a] = (uint8_t)test_rand(&rng);
+                sparse_set(&next, voxdag_morton_encode(xyz[3 * k], xyz[3 * k + 1], xyz[3 * k + 2]),
+                           with_rgb ? (long)pack(rgb + 3 * k) : -1, full);
+            }
+            st = full ? voxdag_editor_set(ed, xyz, with_rgb ? rgb : NULL, (size_t)count, NULL)
+                      : voxdag_editor_clear(ed, xyz, (size_t)count, NULL);
+        }
+        if (st != VOXDAG_OK) {
+            why = voxdag_status_string(st);
+            sparse_free(&next);
+            break;
+        }
+        while (kept > done + 1) sparse_free(&state[--kept]); /* the edits that could be redone */
+        state[++done] = next;
+        kept = done + 1;
+        why = sparse_compare(ed, &state[done], levels, sym, colors, &rng, e % 4 == 0 || e == edits);
+    }
+    CHECK_MSG(!why, "seed %llu L %u symmetry %d colours %d: %s after step %d", (unsigned long long)seed, levels,
+              (int)sym, colors, why, e - 1);
+    voxdag_editor_free(ed);
+    for (i = 0; i < kept; i++) sparse_free(&state[i]);
+    free(state);
+}
+
+/* L = 9 and 10: every group, with and without colours. */
+static void test_edit_sequences_deep(void) {
+    uint64_t seed = 5000;
+    uint32_t levels;
+    int g;
+    for (levels = 9; levels <= 10; levels++)
+        for (g = 0; g < 3; g++) run_sparse_sequence(seed++, levels, groups[g], g != 1, 30);
 }
 
 /* A failed edit (every allocation in turn fails) changes nothing: the scene
@@ -285,6 +639,7 @@ static void test_edit_sharing(void) {
 const test_case test_edit_cases[] = {
     {"edit sequences small grids", test_edit_sequences_small},
     {"edit sequences large grids", test_edit_sequences_large},
+    {"edit sequences L = 9 and 10", test_edit_sequences_deep},
     {"edit allocation failures", test_edit_alloc_failures},
     {"edit errors", test_edit_errors},
     {"edit sharing", test_edit_sharing},
