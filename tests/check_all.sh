@@ -558,7 +558,9 @@ else
     fail=$((fail + 1))
 fi
 
-echo "check-all took $(($(date +%s) - start)) s" >&2
+echo "check-all took $(($(date +%s) - start)) s; the slowest jobs:" >&2
+for s in "$jobs"/*.sh; do echo "$(cat "${s%.sh}.time" 2>/dev/null || echo 0) s $(cat "${s%.sh}.name")"; done |
+    sort -rn | head -n 8 | sed 's/^/    /' >&2
 if [ "$skipped" -gt 0 ]; then echo "$pass passed, $fail failed, $skipped skipped"
 else echo "$pass passed, $fail failed"; fi
 [ "$fail" = 0 ]
