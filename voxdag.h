@@ -8119,7 +8119,9 @@ static uint32_t voxdagi_ed_apply_list(voxdag_editor *ed, uint32_t level, uint32_
 
 /* Applies the list V (N voxels, sorted here) as part of the current edit. */
 static uint32_t voxdagi_ed_list(voxdag_editor *ed, uint32_t root, voxdagi_ed_voxel *v, size_t n) {
-    if (n) qsort(v, n, sizeof *v, voxdagi_ed_voxel_cmp);
+    size_t i = 1;
+    while (i < n && v[i - 1].code < v[i].code) i++; /* lists in Morton order need no sort */
+    if (i < n) qsort(v, n, sizeof *v, voxdagi_ed_voxel_cmp);
     return voxdagi_ed_apply_list(ed, 0, root, 0, v, n);
 }
 
