@@ -22,7 +22,10 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
     echo "== $name" >&2
     t0=$(date +%s)
     out=$("$@")
-    status=$?
+    tally "$name" $? "$out" "$t0"
+}
+tally() {  # tally NAME EXIT_STATUS OUTPUT START_SECONDS
+    name=$1 status=$2 out=$3 t0=$4
     line=$(printf '%s\n' "$out" | tail -n 1)
     p=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed.*/\1/p')
     f=$(printf '%s\n' "$line" | sed -n 's/^\([0-9]*\) passed, \([0-9]*\) failed.*/\2/p')
@@ -37,7 +40,13 @@ run() {  # run NAME COMMAND...: a program whose last line is "N passed, N failed
     total_pass=$((total_pass + p))
     total_fail=$((total_fail + f))
 }
-run unit "$build/test" $unit_args
+# The unit tests (one thread, the longest program) run beside the programs
+# up to the fuzz corpora, on the second CPU; their log follows when they end.
+# check-all, which keeps two CPUs busy, runs after both.
+echo "== unit (beside the next programs)" >&2
+unit_t0=$(date +%s)
+("$build/test" $unit_args >"$build/unit.out" 2>"$build/unit.log"; echo $? >"$build/unit.status") &
+unit_job=$!
 run voxcolor-ndebug "$build/test_voxcolor_ndebug"
 run voxdag-ndebug "$build/test_voxdag_ndebug"
 run vulkan "$build/test_vk"
@@ -50,6 +59,10 @@ run fuzz-voxcolor "$build/fuzz_voxcolor" $sweep tests/data/fuzz/voxcolor
 run fuzz-load "$build/fuzz_load" $sweep tests/data/fuzz/load
 run fuzz-roundtrip "$build/fuzz_roundtrip" $sweep tests/data/fuzz/roundtrip
 run fuzz-edit "$build/fuzz_edit" $sweep tests/data/fuzz/edit
+wait $unit_job
+echo "== unit: its log" >&2
+cat "$build/unit.log" >&2
+tally unit "$(cat "$build/unit.status")" "$(cat "$build/unit.out")" "$unit_t0"
 run check-all sh tests/check_all.sh "$build"
 echo "all: $(( $(date +%s) - start )) s" >&2
 echo "$total_pass passed, $total_fail failed"
