@@ -991,6 +991,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, build_args *a) {
     int rc;
     memset(&o, 0, sizeof o);
     o.no_lod_colors = a->no_lod_colors;
+    o.threads = a->threads; /* the level-of-detail means */
     if (!a->quiet && spill->n)
         fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
                 spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
