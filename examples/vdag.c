@@ -35,6 +35,7 @@
 #include <time.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <pthread.h>
 #include <unistd.h>
 #ifdef _WIN32
 #include <io.h>
@@ -289,6 +290,42 @@ static double now_seconds(void) {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* A batch of jobs on threads made for it: JOB(USER, i) for every i in
+   [0, COUNT). */
+typedef struct job_batch {
+    void (*job)(void *user, uint32_t index);
+    void *user;
+    uint32_t count, next;
+    pthread_mutex_t lock;
+} job_batch;
+
+static void *job_batch_work(void *arg) {
+    job_batch *b = (job_batch *)arg;
+    for (;;) {
+        uint32_t i;
+        pthread_mutex_lock(&b->lock);
+        i = b->next < b->count ? b->next++ : b->count;
+        pthread_mutex_unlock(&b->lock);
+        if (i == b->count) return NULL;
+        b->job(b->user, i);
+    }
+}
+
+/* vdag_import_limits.run: COUNT jobs on up to *USER threads (the calling one
+   too, which does them all when no thread can be made); returns when all
+   are done. */
+static void run_jobs(void *user, void (*job)(void *job_user, uint32_t index), void *job_user, uint32_t count) {
+    pthread_t tid[64];
+    uint32_t threads = *(const uint32_t *)user, t = 0;
+    job_batch b;
+    b.job = job, b.user = job_user, b.count = count, b.next = 0;
+    pthread_mutex_init(&b.lock, NULL);
+    while (t + 1 < threads && t + 1 < count && t < 64 && !pthread_create(&tid[t], NULL, job_batch_work, &b)) t++;
+    job_batch_work(&b);
+    while (t > 0) pthread_join(tid[--t], NULL);
+    pthread_mutex_destroy(&b.lock);
 }
 
 static int parse_u32(const char *s, uint32_t *out) {
@@ -1369,6 +1406,9 @@ static int cmd_build(int argc, char **argv) {
     guard.clash[0] = 0;
     limits.on_file = guard_read;
     limits.on_file_user = &guard;
+    limits.run = run_jobs; /* textures decoded --threads at a time */
+    limits.run_user = &a.threads;
+    limits.threads = a.threads;
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) {
         if (guard.clash[0])
             return vdag_fail("%s: is %s, a file the build reads; refusing to write over it", a.out, guard.clash);
