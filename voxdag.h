@@ -4416,8 +4416,23 @@ static uint64_t voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi
     return nc ? best_cost : 0;
 }
 
+/* A job of voxdagi_choose_level over the nodes [BEGIN, END) of level L:
+   stage 0 counts the stored transforms of the pointers (FREQ), stage 1 the
+   pointers by target and code bits (HIST; TOO_WIDE: one needs more than 57)
+   and, with private children, the bases (BASES, the largest MAX_BASE). */
+typedef struct voxdagi_level_job {
+    const struct voxdagi_encoder *e;
+    uint32_t l;
+    int stage, private_children, too_wide;
+    size_t begin, end;
+    uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], bases, max_base;
+} voxdagi_level_job;
+
 typedef struct voxdagi_encoder {
     voxdagi_mem *mem;
+    voxdagi_team *team;                  /* the builder's threads */
+    voxdagi_level_job *level_job;        /* voxdagi_choose_level's, LEVEL_JOBS of them */
+    unsigned level_jobs;
     const voxdagi_reducer *r;
     const voxdagi_group *group;
     uint32_t levels;
@@ -4446,6 +4461,7 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
         if (e->tag[l]) voxdagi_free(e->mem, e->tag[l], 8 * n);
         voxdagi_free(e->mem, e->single[l], n);
     }
+    voxdagi_free(e->mem, e->level_job, e->level_jobs * sizeof *e->level_job);
 }
 
 /* The stored transform of the reference from a node stored as RP(canonical)
@@ -4626,17 +4642,57 @@ static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id
    children, with the base width) for the fewest bits; *BITS: the bits of
    its records without padding (the level's bytes are at least an eighth of
    them). Returns 0 when a pointer or a base needs more than 57 bits. */
+static void *voxdagi_level_run(void *arg) {
+    voxdagi_level_job *j = (voxdagi_level_job *)arg;
+    const voxdagi_encoder *e = j->e;
+    const voxdagi_store *s = &e->r->store[j->l];
+    uint32_t l = j->l;
+    size_t i;
+    if (j->stage == 0) {
+        memset(j->freq, 0, sizeof j->freq);
+        for (i = 8 * j->begin; i < 8 * j->end; i++)
+            if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) j->freq[e->tag[l][i]]++;
+        return NULL;
+    }
+    memset(j->hist, 0, sizeof j->hist);
+    j->too_wide = 0, j->bases = j->max_base = 0;
+    for (i = 8 * j->begin; i < 8 * j->end; i++) {
+        uint32_t x = s->child[i];
+        unsigned ob, kb;
+        if (x == VOXDAGI_NONE || voxdagi_is_private(e, l, x)) continue;
+        ob = voxdagi_bit_length(e->pos[l + 1][x >> 6]);
+        kb = voxdagi_bit_length(e->code[l][e->tag[l][i]]);
+        if (ob + kb > 57) {
+            j->too_wide = 1;
+            return NULL;
+        }
+        j->hist[ob][kb]++;
+    }
+    for (i = j->begin; j->private_children && i < j->end; i++) {
+        uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
+        if (base != UINT64_MAX) j->bases++;
+        if (base != UINT64_MAX && base > j->max_base) j->max_base = base;
+    }
+    return NULL;
+}
+
 static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint64_t *bits) {
     const voxdagi_store *s = &e->r->store[l];
     voxdagi_classes *cls = &e->cls[l];
+    voxdagi_level_job *job = e->level_job;
     uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0, bases = 0;
-    unsigned tf, k, len = 0;
-    size_t i;
+    unsigned tf, k, len = 0, jobs = s->n < 4096 ? 1 : e->level_jobs, ob, kb;
+    int too_wide = 0;
     cls->classes = (unsigned char)n;
+    for (k = 0; k < jobs; k++) {
+        job[k].e = e, job[k].l = l, job[k].stage = 0, job[k].private_children = n == 2;
+        job[k].begin = s->n * k / jobs, job[k].end = s->n * (k + 1) / jobs;
+    }
+    voxdagi_run_parallel(e->team, voxdagi_level_run, job, sizeof job[0], jobs);
     memset(freq, 0, sizeof freq);
-    for (i = 0; i < 8 * s->n; i++) /* the table: stored transforms by decreasing frequency, ties by value */
-        if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) freq[e->tag[l][i]]++;
-    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
+    for (k = 0; k < jobs; k++)
+        for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) freq[tf] += job[k].freq[tf];
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) { /* the table: stored transforms by decreasing frequency, ties by value */
         if (!freq[tf]) continue;
         for (k = len; k > 0 && freq[e->table[l][k - 1]] < freq[tf]; k--) e->table[l][k] = e->table[l][k - 1];
         e->table[l][k] = (uint8_t)tf;
@@ -4645,37 +4701,79 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint
     if (!len) e->table[l][len++] = 0; /* only private children: a table is never empty */
     for (k = 0; k < len; k++) e->code[l][e->table[l][k]] = (uint8_t)k;
     e->table_len[l] = len;
+    for (k = 0; k < jobs; k++) job[k].stage = 1;
+    voxdagi_run_parallel(e->team, voxdagi_level_run, job, sizeof job[0], jobs);
     memset(hist, 0, sizeof hist);
-    for (i = 0; i < 8 * s->n; i++) {
-        uint32_t x = s->child[i];
-        unsigned ob, kb;
-        if (x == VOXDAGI_NONE || voxdagi_is_private(e, l, x)) continue;
-        ob = voxdagi_bit_length(e->pos[l + 1][x >> 6]);
-        kb = voxdagi_bit_length(e->code[l][e->tag[l][i]]);
-        if (ob + kb > 57) return 0;
-        hist[ob][kb]++;
+    for (k = 0; k < jobs; k++) {
+        too_wide |= job[k].too_wide;
+        for (ob = 0; ob < 58; ob++)
+            for (kb = 0; kb < 7; kb++) hist[ob][kb] += job[k].hist[ob][kb];
+        bases += job[k].bases;
+        if (job[k].max_base > max_base) max_base = job[k].max_base;
     }
+    if (too_wide) return 0;
     *bits = (16 + e->count_bits[l]) * (uint64_t)s->n + voxdagi_choose_classes(hist, n, cls);
     cls->classes = (unsigned char)n;
     for (k = 0; k < 58 * 7; k++) e->class_of[l][k / 7][k % 7] = (uint8_t)voxdagi_class_for(cls, k / 7, k % 7);
-    for (i = 0; n == 2 && i < s->n; i++) {
-        uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
-        if (base != UINT64_MAX) bases++;
-        if (base != UINT64_MAX && base > max_base) max_base = base;
-    }
     cls->base_bits = (unsigned char)voxdagi_bit_length(max_base);
     *bits += bases * cls->base_bits;
     return cls->base_bits <= 57;
+}
+
+/* Most jobs a level's records are split in. */
+#define VOXDAGI_ENCODE_JOBS (4 * VOXDAGI_MAX_THREADS)
+
+/* A job of the encoder: the records (or bricks) of level L at storage
+   positions [BEGIN, END). OUT NULL: each record's bytes to its e->pos
+   entry; else the records written at OUT (zeroed) + their e->pos. */
+typedef struct voxdagi_record_job {
+    const voxdagi_encoder *e;
+    uint64_t *pos;
+    uint8_t *out;
+    size_t begin, end;
+    uint32_t l;
+} voxdagi_record_job;
+
+static void *voxdagi_record_run(void *arg) {
+    voxdagi_record_job *j = (voxdagi_record_job *)arg;
+    const voxdagi_encoder *e = j->e;
+    const voxdagi_store *s = &e->r->store[j->l];
+    size_t i;
+    for (i = j->begin; i < j->end; i++) {
+        uint32_t id = e->order[j->l][i];
+        if (j->l == e->levels - 2) /* bricks */
+            voxdagi_put_le(j->out + 8 * i, voxdagi_transform_brick(e->group, s->node[id].key, e->orient[j->l][id]), 8);
+        else if (!j->out)
+            j->pos[id] = (voxdagi_record(e, j->l, id, NULL) + 7) / 8;
+        else
+            voxdagi_record(e, j->l, id, j->out + j->pos[id]);
+    }
+    return NULL;
+}
+
+/* Runs voxdagi_record_run over the N nodes of level L on the builder's
+   threads (one job for small levels). */
+static void voxdagi_records(const voxdagi_encoder *e, uint32_t l, uint8_t *out) {
+    voxdagi_record_job job[VOXDAGI_ENCODE_JOBS];
+    size_t n = e->r->store[l].n, k;
+    unsigned jobs = e->team->threads < 2 || n < 4096 ? 1 : 4 * e->team->threads;
+    if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+    for (k = 0; k < jobs; k++) {
+        job[k].e = e, job[k].pos = e->pos[l], job[k].out = out, job[k].l = l;
+        job[k].begin = n * k / jobs, job[k].end = n * (k + 1) / jobs;
+    }
+    voxdagi_run_parallel(e->team, voxdagi_record_run, job, sizeof job[0], jobs);
 }
 
 /* Record offsets of inner level L in storage order; returns its bytes. */
 static uint64_t voxdagi_level_offsets(voxdagi_encoder *e, uint32_t l) {
     uint64_t at = 0;
     size_t i;
+    voxdagi_records(e, l, NULL); /* each record's bytes, then their offsets */
     for (i = 0; i < e->r->store[l].n; i++) {
-        uint32_t id = e->order[l][i];
-        e->pos[l][id] = at;
-        at += (voxdagi_record(e, l, id, NULL) + 7) / 8;
+        uint64_t *pos = &e->pos[l][e->order[l][i]], bytes = *pos;
+        *pos = at;
+        at += bytes;
     }
     return at;
 }
@@ -4780,6 +4878,9 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     uint32_t *refs[VOXDAG_MAX_LEVELS];
     int ok = 1, candidates[VOXDAG_MAX_LEVELS];
     memset(refs, 0, sizeof refs);
+    e->level_jobs = e->team->threads < 2 ? 1 : 2 * e->team->threads;
+    e->level_job = (voxdagi_level_job *)voxdagi_alloc(e->mem, e->level_jobs * sizeof *e->level_job);
+    if (!e->level_job) ok = 0;
     for (l = 0; l <= brick_level; l++) {
         size_t n = r->store[l].n;
         refs[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
@@ -4835,7 +4936,6 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
     const voxdagi_reducer *r = e->r;
     uint32_t brick_level = e->levels - 2, l;
     uint64_t level_at = 0;
-    size_t i;
     for (l = 0; l < brick_level; l++) {
         const voxdagi_classes *cls = &e->cls[l];
         uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
@@ -4852,13 +4952,10 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
         te[28] = cls->classes == 2;
         te[29] = cls->base_bits;
         memcpy(te + 32, e->table[l], e->table_len[l]);
-        for (i = 0; i < r->store[l].n; i++) p += (voxdagi_record(e, l, e->order[l][i], p) + 7) / 8;
+        voxdagi_records(e, l, p); /* each at its offset */
         level_at += e->size[l];
     }
-    for (i = 0; i < r->store[brick_level].n; i++) {
-        uint32_t id = e->order[brick_level][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->group, r->store[brick_level].node[id].key, e->orient[brick_level][id]), 8);
-    }
+    voxdagi_records(e, brick_level, bricks);
 }
 
 #endif /* VOXDAG_NO_BUILD */
@@ -6178,41 +6275,69 @@ static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned
     }
 }
 
+/* A job of voxdagi_voxel_box: the boxes CUR of the nodes [BEGIN, END) of
+   level L, from the boxes BELOW of the next level. */
+typedef struct voxdagi_box_job {
+    const voxdagi_reducer *r;
+    const voxdagi_cube *c;
+    const uint32_t *below;
+    uint32_t *cur, l;
+    size_t begin, end;
+} voxdagi_box_job;
+
+static void *voxdagi_box_run(void *arg) {
+    const voxdagi_box_job *j = (const voxdagi_box_job *)arg;
+    const voxdagi_store *s = &j->r->store[j->l];
+    uint32_t half = 1u << (j->r->levels - j->l - 1), cb[6];
+    size_t i, k;
+    for (i = j->begin; i < j->end; i++) {
+        uint32_t *o = j->cur + 6 * i;
+        o[0] = o[1] = o[2] = UINT32_MAX;
+        o[3] = o[4] = o[5] = 0;
+        if (j->l == j->r->levels - 2) {
+            voxdagi_brick_box(s->node[i].key, o);
+            continue;
+        }
+        for (k = 0; k < 8; k++) { /* each child's box, transformed and moved to its octant */
+            uint32_t x = s->child[8 * i + k];
+            unsigned a;
+            if (x == VOXDAGI_NONE) continue;
+            memcpy(cb, j->below + 6 * (size_t)(x >> 6), sizeof cb);
+            voxdagi_box_transform(j->c, cb, x & 63, half);
+            for (a = 0; a < 3; a++) {
+                if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
+                if (cb[a] < o[a]) o[a] = cb[a];
+                if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
+            }
+        }
+    }
+    return NULL;
+}
+
 /* The occupied voxel box of the scene, bottom-up over the unique nodes (each
-   box in its node's canonical frame). Returns 0 when out of memory. */
-static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const voxdagi_cube *c, uint32_t box[6]) {
+   box in its node's canonical frame), a level's nodes split over team T.
+   Returns 0 when out of memory. */
+static int voxdagi_voxel_box(voxdagi_mem *m, voxdagi_team *t, const voxdagi_reducer *r, const voxdagi_cube *c,
+                             uint32_t box[6]) {
+    voxdagi_box_job job[VOXDAGI_ENCODE_JOBS];
     uint32_t brick_level = r->levels - 2, l, *below = NULL, *cur = NULL;
-    size_t below_n = 0, i, k;
+    size_t below_n = 0, k;
     memset(box, 0, 6 * sizeof *box);
     if (r->root == VOXDAGI_NONE) return 1;
     for (l = brick_level + 1; l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
+        unsigned jobs = t->threads < 2 || s->n < 4096 ? 1 : 4 * t->threads;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
         cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur);
         if (!cur) {
             voxdagi_free(m, below, 6 * below_n * sizeof *below);
             return 0;
         }
-        for (i = 0; i < s->n; i++) {
-            uint32_t *o = cur + 6 * i, half = 1u << (r->levels - l - 1), cb[6];
-            o[0] = o[1] = o[2] = UINT32_MAX;
-            o[3] = o[4] = o[5] = 0;
-            if (l == brick_level) {
-                voxdagi_brick_box(s->node[i].key, o);
-                continue;
-            }
-            for (k = 0; k < 8; k++) { /* each child's box, transformed and moved to its octant */
-                uint32_t x = s->child[8 * i + k];
-                unsigned a;
-                if (x == VOXDAGI_NONE) continue;
-                memcpy(cb, below + 6 * (size_t)(x >> 6), sizeof cb);
-                voxdagi_box_transform(c, cb, x & 63, half);
-                for (a = 0; a < 3; a++) {
-                    if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
-                    if (cb[a] < o[a]) o[a] = cb[a];
-                    if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
-                }
-            }
+        for (k = 0; k < jobs; k++) {
+            job[k].r = r, job[k].c = c, job[k].below = below, job[k].cur = cur, job[k].l = l;
+            job[k].begin = s->n * k / jobs, job[k].end = s->n * (k + 1) / jobs;
         }
+        voxdagi_run_parallel(t, voxdagi_box_run, job, sizeof job[0], jobs);
         voxdagi_free(m, below, 6 * below_n * sizeof *below);
         below = cur, below_n = s->n;
     }
@@ -6234,6 +6359,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     voxdag_status st;
     memset(&e, 0, sizeof e);
     e.mem = &b->mem;
+    e.team = &b->team;
     e.r = r;
     e.group = &b->group[0];
     e.levels = b->levels;
@@ -6253,7 +6379,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     sc.root_transform = e.root_transform;
     sc.symmetry = b->symmetry;
     sc.voxels = b->voxels;
-    if (!voxdagi_voxel_box(&b->mem, r, &voxdagi_cube_tables, sc.voxel_box)) {
+    if (!voxdagi_voxel_box(&b->mem, &b->team, r, &voxdagi_cube_tables, sc.voxel_box)) {
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
