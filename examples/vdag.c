@@ -1001,7 +1001,7 @@ static int verify_spill(color_spill *spill, const grow_buf *g, const build_args 
         return vdag_fail("colour check: the stream holds %llu colours, the spill %llu", (unsigned long long)view.count,
                          (unsigned long long)spill->n);
     rewind(spill->f);
-    if (!vdag_check_colors(&view, spill->f, a->color_error, &c))
+    if (!vdag_check_colors_on(&view, spill->f, a->color_error, run_jobs, (void *)&a->threads, a->threads, &c))
         return vdag_fail("colour check: cannot read the raw colours back (or out of memory)");
     if (c.over)
         return vdag_fail("colour check FAILED: %llu of %llu colours are off by more than e_t %g (first: colour %llu; "
