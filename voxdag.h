@@ -257,8 +257,9 @@ typedef struct voxdag_build_opts {
                                     2^18 voxels or more, sort a flush of 2^16 or
                                     more voxels that are not in Morton order, and
                                     reduce a flush spanning enough subtrees;
-                                    dropping repeats, colours and the final
-                                    encoding run on the calling thread. The
+                                    dropping repeats and colours run on the
+                                    calling thread. The final encoding (its
+                                    records, bricks, box and counts) and the
                                     level-of-detail colours of the file (and
                                     of voxdag_with_colors_opts) use the
                                     threads too. */
