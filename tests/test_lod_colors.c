@@ -576,6 +576,19 @@ static void lod_pool_wait(void *user) {
     p->count = 0;
 }
 
+/* Options for VARIANT 0..3: 2, 3 or 4 threads of the built-in pool, or 3
+   jobs a batch on the host pool P. */
+static void lod_variant(int variant, voxdag_build_opts *o, lod_pool *p) {
+    memset(o, 0, sizeof *o);
+    memset(p, 0, sizeof *p);
+    o->threads = variant < 3 ? (uint32_t)variant + 2 : 3;
+    if (variant == 3) {
+        o->thread_pool.run = lod_pool_run;
+        o->thread_pool.wait = lod_pool_wait;
+        o->thread_pool.user = p;
+    }
+}
+
 /* Whether A and B are the same file image. */
 static int same_image(const voxdag *a, const voxdag *b) {
     size_t na, nb;
@@ -653,14 +666,7 @@ static void test_lod_colors_threads(void) {
                         voxdag_build_opts o;
                         lod_pool p;
                         voxdag *w = NULL;
-                        memset(&o, 0, sizeof o);
-                        memset(&p, 0, sizeof p);
-                        o.threads = variant < 3 ? variant + 2 : 3;
-                        if (variant == 3) {
-                            o.thread_pool.run = lod_pool_run;
-                            o.thread_pool.wait = lod_pool_wait;
-                            o.thread_pool.user = &p;
-                        }
+                        lod_variant(variant, &o, &p);
                         CHECK(voxdag_with_colors_opts(kind ? v : d, ck, pc, pn, &o, &w, NULL) == VOXDAG_OK);
                         CHECK_MSG(same_image(kind ? v : d, w), "L = %u, kind %d: %u threads%s differ", levels, kind,
                                   o.threads, variant == 3 ? " (host pool)" : "");
@@ -680,14 +686,7 @@ static void test_lod_colors_threads(void) {
                     voxdag_build_opts o;
                     lod_pool p;
                     voxdag *w;
-                    memset(&o, 0, sizeof o);
-                    memset(&p, 0, sizeof p);
-                    o.threads = variant < 3 ? variant + 2 : 3;
-                    if (variant == 3) {
-                        o.thread_pool.run = lod_pool_run;
-                        o.thread_pool.wait = lod_pool_wait;
-                        o.thread_pool.user = &p;
-                    }
+                    lod_variant(variant, &o, &p);
                     w = recolored(d, &s, kind ? VOXDAG_COLORS_VOXCOLOR : VOXDAG_COLORS_RGB8, &o);
                     CHECK_MSG(same_image(one[kind], w), "L = %u, scene %u, kind %d: %u threads%s differ", levels,
                               (unsigned)k, kind, o.threads, variant == 3 ? " (host pool)" : "");
