@@ -4481,6 +4481,44 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
     return best;
 }
 
+/* Most jobs a level is split in by the encoder. */
+#define VOXDAGI_ENCODE_JOBS (4 * VOXDAGI_MAX_THREADS)
+
+/* A job of voxdagi_orient: the orientations of nodes [BEGIN, END) of level
+   L from the transforms SEEN by the references into them (node i's from
+   FIRST[i] to FIRST[i + 1]). */
+typedef struct voxdagi_orient_job {
+    voxdagi_encoder *e;
+    const uint64_t *first;
+    const uint8_t *seen;
+    size_t begin, end;
+    uint32_t l;
+} voxdagi_orient_job;
+
+static void *voxdagi_orient_run(void *arg) {
+    const voxdagi_orient_job *j = (const voxdagi_orient_job *)arg;
+    const voxdagi_cube *c = &voxdagi_cube_tables;
+    const voxdagi_store *s = &j->e->r->store[j->l];
+    uint64_t votes[VOXDAGI_TRANSFORMS];
+    size_t i;
+    memset(votes, 0, sizeof votes);
+    for (i = j->begin; i < j->end; i++) { /* BEST: the smallest transform with the most votes so far */
+        unsigned best = 0;
+        uint64_t k, stabs;
+        for (k = j->first[i]; k < j->first[i + 1]; k++)
+            for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1) {
+                unsigned tf = c->comp[j->seen[k]][voxdagi_lowest_bit(stabs)];
+                votes[tf]++;
+                if (votes[tf] > votes[best] || (votes[tf] == votes[best] && tf < best)) best = tf;
+            }
+        j->e->orient[j->l][i] = (uint8_t)best;
+        for (k = j->first[i]; k < j->first[i + 1]; k++) /* back to no votes */
+            for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1)
+                votes[c->comp[j->seen[k]][voxdagi_lowest_bit(stabs)]] = 0;
+    }
+    return NULL;
+}
+
 /* Orientations, top-down: a node is stored as R(canonical) for the R that
    makes the most references to it carry the identity (ties: the smallest R).
    A reference (n, t) from a parent stored as RP does so for every R in
@@ -4488,8 +4526,9 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
 static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     const voxdagi_cube *c = &voxdagi_cube_tables;
+    voxdagi_orient_job job[VOXDAGI_ENCODE_JOBS];
     uint32_t brick_level = e->levels - 2, l;
-    uint64_t votes[VOXDAGI_TRANSFORMS];
+    unsigned jobs, k;
     for (l = 0; l <= brick_level; l++) {
         const voxdagi_store *s = &r->store[l], *ps = l ? &r->store[l - 1] : NULL;
         size_t n = s->n, i, p, total = l ? 0 : 1;
@@ -4518,21 +4557,13 @@ static int voxdagi_orient(voxdagi_encoder *e) {
         }
         for (i = n; i > 0; i--) first[i] = first[i - 1]; /* back to the starts */
         first[0] = 0;
-        memset(votes, 0, sizeof votes);
-        for (i = 0; i < n; i++) { /* BEST: the smallest transform with the most votes so far */
-            unsigned best = 0;
-            uint64_t k, stabs;
-            for (k = first[i]; k < first[i + 1]; k++)
-                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1) {
-                    unsigned tf = c->comp[seen[k]][voxdagi_lowest_bit(stabs)];
-                    votes[tf]++;
-                    if (votes[tf] > votes[best] || (votes[tf] == votes[best] && tf < best)) best = tf;
-                }
-            e->orient[l][i] = (uint8_t)best;
-            for (k = first[i]; k < first[i + 1]; k++) /* back to no votes */
-                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1)
-                    votes[c->comp[seen[k]][voxdagi_lowest_bit(stabs)]] = 0;
+        jobs = e->team->threads < 2 || n < 4096 ? 1 : 4 * e->team->threads;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+        for (k = 0; k < jobs; k++) {
+            job[k].e = e, job[k].first = first, job[k].seen = seen, job[k].l = l;
+            job[k].begin = n * k / jobs, job[k].end = n * (k + 1) / jobs;
         }
+        voxdagi_run_parallel(e->team, voxdagi_orient_run, job, sizeof job[0], jobs);
         voxdagi_free(e->mem, seen, total);
         voxdagi_free(e->mem, first, (n + 1) * sizeof *first);
     }
@@ -4720,9 +4751,6 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint
     *bits += bases * cls->base_bits;
     return cls->base_bits <= 57;
 }
-
-/* Most jobs a level's records are split in. */
-#define VOXDAGI_ENCODE_JOBS (4 * VOXDAGI_MAX_THREADS)
 
 /* A job of the encoder: the records (or bricks) of level L at storage
    positions [BEGIN, END). OUT NULL: each record's bytes to its e->pos
