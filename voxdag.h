@@ -4867,25 +4867,44 @@ static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
     return 1;
 }
 
+/* A job of voxdagi_private_order (FIRST and SEEN unused): the stored
+   transforms of the child references of nodes [BEGIN, END) of level L. */
+static void *voxdagi_tag_run(void *arg) {
+    const voxdagi_orient_job *j = (const voxdagi_orient_job *)arg;
+    const voxdagi_store *s = &j->e->r->store[j->l];
+    size_t i;
+    for (i = 8 * j->begin; i < 8 * j->end; i++)
+        if (s->child[i] != VOXDAGI_NONE)
+            j->e->tag[j->l][i] = (uint8_t)voxdagi_stored_tag(j->e, j->l, j->e->orient[j->l][i >> 3], s->child[i]);
+    return NULL;
+}
+
 /* Stored transforms of every pointer, the private-child candidates (nodes
    referenced once through the identity: their orientation is their one
    referrer's), and each level's order of them: after the shared nodes, by
    parent in storage order, then by stored octant, so that the private
    children of a record follow each other. Top-down. */
 static void voxdagi_private_order(voxdagi_encoder *e, uint32_t *const *refs, int *candidates) {
+    voxdagi_orient_job job[VOXDAGI_ENCODE_JOBS];
     const voxdagi_reducer *r = e->r;
     uint32_t brick_level = e->levels - 2, l;
     for (l = 0; l < brick_level; l++) {
         const voxdagi_store *s = &r->store[l];
         uint32_t *o = e->order[l + 1];
         size_t i, k = 0, n1 = r->store[l + 1].n;
+        unsigned jobs = e->team->threads < 2 || s->n < 4096 ? 1 : 4 * e->team->threads, t;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+        for (t = 0; t < jobs; t++) {
+            job[t].e = e, job[t].l = l;
+            job[t].begin = s->n * t / jobs, job[t].end = s->n * (t + 1) / jobs;
+        }
+        voxdagi_run_parallel(e->team, voxdagi_tag_run, job, sizeof job[0], jobs);
         memset(e->single[l + 1], 0, n1);
         candidates[l] = 0;
         for (i = 0; i < 8 * s->n; i++) {
             uint32_t x = s->child[i];
-            if (x == VOXDAGI_NONE) continue;
-            e->tag[l][i] = (uint8_t)voxdagi_stored_tag(e, l, e->orient[l][i >> 3], x);
-            if (refs[l + 1][x >> 6] == 1 && e->tag[l][i] == 0) e->single[l + 1][x >> 6] = 1, candidates[l] = 1;
+            if (x != VOXDAGI_NONE && refs[l + 1][x >> 6] == 1 && e->tag[l][i] == 0)
+                e->single[l + 1][x >> 6] = 1, candidates[l] = 1;
         }
         for (i = 0; i < n1; i++)
             if (!e->single[l + 1][o[i]]) o[k++] = o[i];
