@@ -1,10 +1,11 @@
 #!/bin/sh
 # Thread scaling of a mesh build with colours: `vdag build --timings` on 1
 # and 2 threads, RUNS pairs run alternately (1 then 2, then 2 then 1, ...),
-# the median of each phase's wall and CPU seconds. Prints a markdown
-# section: every phase, the serial share, the CPU of 2 threads against 1,
-# and an Amdahl projection to 16 threads (labelled projected: this machine
-# has fewer cores).
+# the median of each phase's wall, CPU and main-thread CPU seconds. Prints
+# a markdown section: every phase, the serial share (from the CPU seconds
+# the building thread spent alone, which other processes on the machine do
+# not skew), the CPU of 2 threads against 1, and an Amdahl projection to 16
+# threads (labelled projected: this machine may have fewer cores).
 #   bench/threads.sh quick|full VDAG DATA_DIR
 # full: the abyss track at 4096^3 (--levels 12) with --color-error 0.02, 5
 # pairs; quick: the same at 1024^3 (or the tool's demo cloud when the game
@@ -34,10 +35,10 @@ build() { # build THREADS RUN
         --quiet 2>"$work/log" || { cat "$work/log" >&2; exit 1; }
     awk -v t="$1" -v r="$2" '
         /timings +wall s/ { on = 1; next }
-        on && NF >= 5 {
+        on && NF >= 6 {
             n = NF; name = $2
-            for (i = 3; i <= n - 3; i++) name = name " " $i
-            print t " " r " " name "|" $(n - 2) "|" $(n - 1)
+            for (i = 3; i <= n - 4; i++) name = name " " $i
+            print t " " r " " name "|" $(n - 3) "|" $(n - 2) "|" $n
         }' "$work/log" >>"$work/rows"
 }
 : >"$work/rows"
@@ -65,30 +66,34 @@ awk -F'|' -v runs="$runs" '
         if (!(phase in seen)) { seen[phase] = 1; order[++np] = phase }
         key = t SUBSEP phase SUBSEP "wall"; val[key, ++cnt[key]] = $2
         key = t SUBSEP phase SUBSEP "cpu"; val[key, ++cnt[key]] = $3
+        key = t SUBSEP phase SUBSEP "main"; val[key, ++cnt[key]] = $4
     }
     END {
-        print "| phase | 1 thread: wall s | CPU s | 2 threads: wall s | CPU s | CPU/wall | speed-up | CPU 2 / CPU 1 | serial s (Amdahl, from wall) |"
-        print "|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+        print "| phase | 1 thread: wall s | CPU s | 2 threads: wall s | CPU s | CPU/wall | main-thread CPU s | alone s | speed-up | CPU 2 / CPU 1 |"
+        print "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
         for (p = 1; p <= np; p++) {
             ph = order[p]
             w1 = median(1 SUBSEP ph SUBSEP "wall"); c1 = median(1 SUBSEP ph SUBSEP "cpu")
             w2 = median(2 SUBSEP ph SUBSEP "wall"); c2 = median(2 SUBSEP ph SUBSEP "cpu")
-            if (ph == "total") { W1 = w1; C1 = c1; W2 = w2; C2 = c2; continue }
-            # the serial part s of a phase: w2 = s + (w1 - s) / 2
-            s = 2 * w2 - w1; if (s < 0) s = 0; if (s > w1) s = w1
-            serial += s
-            # a phase that ran on one thread at 2 (CPU/wall under 1.1)
-            if (w2 > 0 && c2 / w2 < 1.1) single += c1
-            printf "| %s | %.3f | %.3f | %.3f | %.3f | %.2f | %s | %s | %.3f |\n", ph, w1, c1, w2, c2, (w2 > 0 ? c2 / w2 : 0),
-                   (w2 > 0 ? sprintf("%.2fx", w1 / w2) : "-"), (c1 > 0 ? sprintf("%.2fx", c2 / c1) : "-"), s
+            m2 = median(2 SUBSEP ph SUBSEP "main")
+            if (ph == "total") { W1 = w1; C1 = c1; W2 = w2; C2 = c2; M2 = m2; continue }
+            # what the building thread did alone: its CPU less the other thread'"'"'s
+            a = m2 - (c2 - m2); if (a < 0) a = 0
+            alone += a
+            # a phase where the other thread did under 5% of the CPU ran on one thread
+            if (c2 - m2 < 0.05 * c2) single += c1
+            printf "| %s | %.3f | %.3f | %.3f | %.3f | %.2f | %.3f | %.3f | %s | %s |\n", ph, w1, c1, w2, c2, (w2 > 0 ? c2 / w2 : 0), m2, a,
+                   (w2 > 0 ? sprintf("%.2fx", w1 / w2) : "-"), (c1 > 0 ? sprintf("%.2fx", c2 / c1) : "-")
         }
-        printf "| **total** | **%.3f** | **%.3f** | **%.3f** | **%.3f** | **%.2f** | **%.2fx** | **%.2fx** | **%.3f** |\n",
-               W1, C1, W2, C2, C2 / W2, W1 / W2, C2 / C1, serial
-        f = serial / W1
+        printf "| **total** | **%.3f** | **%.3f** | **%.3f** | **%.3f** | **%.2f** | **%.3f** | **%.3f** | **%.2fx** | **%.2fx** |\n",
+               W1, C1, W2, C2, C2 / W2, M2, alone, W1 / W2, C2 / C1
+        f = alone / C1
         print ""
-        printf "- Serial share (CPU seconds of the phases that ran on one thread at 2 threads, CPU/wall under 1.1, over one thread'"'"'s total CPU seconds): **%.1f%%** (%.3f of %.3f s).\n", 100 * single / C1, single, C1
-        printf "- Amdahl serial fraction from the walls (each phase'"'"'s s = 2 x wall(2) - wall(1), clipped to 0..wall(1); noisy on a shared machine): **%.1f%%** (%.3f of %.3f s).\n", 100 * f, serial, W1
+        print "Main-thread CPU: the building (calling) thread'"'"'s CPU seconds in the phase; alone: that less the other thread'"'"'s, the CPU seconds it spent with the other thread idle (at most; clipped at 0). CPU seconds count only the time a thread ran, so unlike the speed-up they hold when other processes share the cores."
+        print ""
+        printf "- Serial share, by phase (the CPU seconds, on 1 thread, of the phases where the second thread did under 5%% of the CPU, over one thread'"'"'s total): **%.1f%%** (%.3f of %.3f s).\n", 100 * single / C1, single, C1
+        printf "- Serial share, by part (the alone seconds, over one thread'"'"'s total CPU seconds): **%.1f%%** (%.3f of %.3f s).\n", 100 * f, alone, C1
         printf "- CPU seconds of 2 threads over 1 thread'"'"'s: **%.2fx** (%.3f / %.3f s).\n", C2 / C1, C2, C1
-        printf "- *Projected* (Amdahl, from that fraction, not measured: this machine has %s logical CPUs): 16 threads %.2fx faster than 1, a %.2f s build; 8 threads %.2fx.\n", ENVIRON["NPROC"], 1 / (f + (1 - f) / 16), W1 * (f + (1 - f) / 16), 1 / (f + (1 - f) / 8)
+        printf "- *Projected*, not measured (Amdahl from the serial share by part, this machine having %s logical CPUs): 16 threads %.1fx faster than 1 (a %.2f s build), 8 threads %.1fx.\n", ENVIRON["NPROC"], 1 / (f + (1 - f) / 16), W1 * (f + (1 - f) / 16), 1 / (f + (1 - f) / 8)
     }' "$work/rows"
 echo

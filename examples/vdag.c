@@ -186,7 +186,8 @@ static const struct {
      "  --no-lod-colors    write no level-of-detail colour section (default: write it: the mean\n"
      "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"
      "  --timings          print each phase's wall and CPU seconds at the end (read, voxelize,\n"
-     "                     reduce, encode, colours, colour check, colour attach, save)\n"},
+     "                     reduce, encode, colours, colour check, colour attach, save): the\n"
+     "                     process's CPU and the building thread's (main CPU)\n"},
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
@@ -367,13 +368,16 @@ static const char *symmetry_name(voxdag_symmetry s) {
 /* --timings: wall and CPU seconds of each phase of a build. A phase lasts
    from its first report to the next phase's; phases that alternate (a mesh
    is voxelized and reduced chunk by chunk) add up. The CPU seconds are the
-   whole process's, so CPU / wall is the phase's parallelism. */
+   whole process's, so CPU / wall is the phase's parallelism; main CPU is
+   the building thread's alone (on 2 threads, main CPU less the rest is
+   what that thread did alone: a measure that other processes on the
+   machine do not skew). */
 enum { PHASES = 12 };
 typedef struct phase_times {
     const char *name[PHASES];
-    double wall[PHASES], cpu[PHASES];
+    double wall[PHASES], cpu[PHASES], main[PHASES]; /* MAIN: the building thread's CPU */
     int count, current; /* current: the running phase, -1 none */
-    double wall0, cpu0; /* when it last started */
+    double wall0, cpu0, main0; /* when it last started */
 } phase_times;
 
 static double cpu_seconds(void) {
@@ -384,11 +388,21 @@ static double cpu_seconds(void) {
 
 /* Ends the running phase and starts NAME (a string that outlives P; NULL:
    none). */
+/* CPU seconds of the calling thread. */
+static double thread_cpu_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 static void phase_enter(phase_times *p, const char *name) {
-    double wall = now_seconds(), cpu = cpu_seconds();
+    double wall = now_seconds(), cpu = cpu_seconds(), main = thread_cpu_seconds();
     int i;
-    if (p->current >= 0) p->wall[p->current] += wall - p->wall0, p->cpu[p->current] += cpu - p->cpu0;
-    p->wall0 = wall, p->cpu0 = cpu, p->current = -1;
+    if (p->current >= 0) {
+        p->wall[p->current] += wall - p->wall0, p->cpu[p->current] += cpu - p->cpu0;
+        p->main[p->current] += main - p->main0;
+    }
+    p->wall0 = wall, p->cpu0 = cpu, p->main0 = main, p->current = -1;
     if (!name) return;
     for (i = 0; i < p->count && strcmp(p->name[i], name); i++) continue;
     if (i == PHASES) return; /* more phases than slots: the rest go uncounted */
@@ -397,15 +411,15 @@ static void phase_enter(phase_times *p, const char *name) {
 }
 
 static void phase_print(const phase_times *p) {
-    double wall = 0, cpu = 0;
+    double wall = 0, cpu = 0, main = 0;
     int i;
-    fprintf(stderr, "vdag: timings      wall s    CPU s  CPU/wall\n");
+    fprintf(stderr, "vdag: timings      wall s    CPU s  CPU/wall  main CPU s\n");
     for (i = 0; i < p->count; i++) {
-        fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", p->name[i], p->wall[i], p->cpu[i],
-                p->wall[i] > 0 ? p->cpu[i] / p->wall[i] : 0.0);
-        wall += p->wall[i], cpu += p->cpu[i];
+        fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f %8.3f\n", p->name[i], p->wall[i], p->cpu[i],
+                p->wall[i] > 0 ? p->cpu[i] / p->wall[i] : 0.0, p->main[i]);
+        wall += p->wall[i], cpu += p->cpu[i], main += p->main[i];
     }
-    fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", "total", wall, cpu, wall > 0 ? cpu / wall : 0.0);
+    fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f %8.3f\n", "total", wall, cpu, wall > 0 ? cpu / wall : 0.0, main);
 }
 
 typedef struct build_args {
