@@ -57,7 +57,8 @@
    query one at a time. A builder belongs to one thread at a time; with
    opts.threads > 1 it spreads its work over a pool of its own (pthreads, or
    Win32 threads on Windows; workers started once and reused) or over the
-   host's (opts.thread_pool: run a batch of jobs, wait), with the same bytes.
+   host's (opts.thread_pool: run a batch of jobs, wait), with the same bytes;
+   so does voxdag_with_colors_opts, with a pool that lives for the call.
 
    ERRORS, reported in three shapes, by what a function does:
    - Work that can fail on its own (memory, files, limits, bad data: build,
@@ -256,8 +257,12 @@ typedef struct voxdag_build_opts {
                                     2^18 voxels or more, sort a flush of 2^16 or
                                     more voxels that are not in Morton order, and
                                     reduce a flush spanning enough subtrees;
-                                    dropping repeats, colours and the final
-                                    encoding run on the calling thread. */
+                                    dropping repeats and colours run on the
+                                    calling thread. The final encoding (its
+                                    records, bricks, box and counts) and the
+                                    level-of-detail colours of the file (and
+                                    of voxdag_with_colors_opts) use the
+                                    threads too. */
     uint64_t max_memory;         /* bytes the builder may hold (buffered voxels,
                                     nodes, the file image); 0: no limit; more
                                     is VOXDAG_ERR_LIMIT */
@@ -560,9 +565,14 @@ VOXDAG_API voxdag_status voxdag_with_colors(const voxdag *src, voxdag_color_kind
                                             voxdag **out, voxdag_error *err);
 
 /* voxdag_with_colors with options: OPTS (NULL: defaults) is read for
-   zero_begin / zero_end (nonzero: VOXDAG_ERR_INVALID_ARGUMENT) and
-   no_lod_colors (1: no level-of-detail colour section); its other fields
-   are ignored. */
+   zero_begin / zero_end (nonzero: VOXDAG_ERR_INVALID_ARGUMENT),
+   no_lod_colors (1: no level-of-detail colour section), and threads and
+   thread_pool, as the builder reads them (0 or 1: the calling thread only):
+   the level-of-detail means, and their voxcolor encoding, run on T threads
+   of a built-in pool that lives for the call, or on the host's pool, with
+   the same bytes whatever T (a thread_pool with run but no wait, or wait
+   but no run: VOXDAG_ERR_INVALID_ARGUMENT). Its other fields are ignored.
+   Thread-safe on a shared SRC. */
 VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color_kind kind,
                                                  const void *payload, size_t size,
                                                  const voxdag_build_opts *opts, voxdag **out,
@@ -1277,6 +1287,243 @@ static int voxdagi_grow(voxdagi_mem *m, void **p, size_t *cap, size_t need, size
     *p = q;
     *cap = n;
     return 1;
+}
+#endif
+
+// -- Threads: the built-in pool, teams and batches of jobs
+
+#define VOXDAGI_MAX_THREADS 64
+
+/* A batch of jobs: FN on each of the COUNT SIZE-byte elements of JOBS (the
+   JOB_USER of voxdag_job_fn). */
+typedef struct voxdagi_batch {
+    void *(*fn)(void *);
+    char *jobs;
+    size_t size;
+    uint32_t count;
+    int pooled; /* running on a pool (else the wait runs it) */
+} voxdagi_batch;
+
+static void voxdagi_batch_job(void *user, uint32_t index) {
+    voxdagi_batch *bt = (voxdagi_batch *)user;
+    bt->fn(bt->jobs + (size_t)index * bt->size);
+}
+
+#ifndef VOXDAG_NO_THREADS
+/* The built-in pool: THREADS - 1 workers started on the first batch and kept
+   until the builder is freed. RUN hands a batch to the workers; WAIT takes the
+   jobs no worker has taken yet, then waits for the rest. */
+typedef struct voxdagi_pool {
+    voxdagi_lock_t lock;
+    voxdagi_cond_t wake, done;
+    voxdag_job_fn job;
+    void *job_user;
+    uint32_t count, next, finished, batch, workers;
+    int quit;
+    voxdagi_thread_t tid[VOXDAGI_MAX_THREADS - 1];
+} voxdagi_pool;
+
+/* Runs jobs of the current batch until none is left; called and returns with
+   the lock held. */
+static void voxdagi_pool_take(voxdagi_pool *p) {
+    while (p->next < p->count) {
+        uint32_t i = p->next++;
+        voxdagi_unlock(&p->lock);
+        p->job(p->job_user, i);
+        voxdagi_lock(&p->lock);
+        if (++p->finished == p->count) voxdagi_cond_wake_all(&p->done);
+    }
+}
+
+static void voxdagi_pool_worker(voxdagi_pool *p) {
+    uint32_t seen = 0;
+    voxdagi_lock(&p->lock);
+    while (!p->quit) {
+        if (p->batch == seen) {
+            voxdagi_cond_wait(&p->wake, &p->lock);
+            continue;
+        }
+        seen = p->batch;
+        voxdagi_pool_take(p);
+    }
+    voxdagi_unlock(&p->lock);
+}
+
+#if defined(_WIN32)
+static DWORD WINAPI voxdagi_pool_main(LPVOID p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return 0;
+}
+#else
+static void *voxdagi_pool_main(void *p) {
+    voxdagi_pool_worker((voxdagi_pool *)p);
+    return NULL;
+}
+#endif
+
+/* Starts up to WORKERS threads (those the system refuses are left to WAIT). */
+static void voxdagi_pool_start(voxdagi_pool *p, uint32_t workers) {
+    memset(p, 0, sizeof *p);
+    voxdagi_lock_init(&p->lock);
+    voxdagi_cond_init(&p->wake);
+    voxdagi_cond_init(&p->done);
+    for (; p->workers < workers; p->workers++) {
+#if defined(_WIN32)
+        p->tid[p->workers] = CreateThread(NULL, 0, voxdagi_pool_main, p, 0, NULL);
+        if (!p->tid[p->workers]) break;
+#else
+        if (pthread_create(&p->tid[p->workers], NULL, voxdagi_pool_main, p) != 0) break;
+#endif
+    }
+}
+
+static void voxdagi_pool_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    p->job = job;
+    p->job_user = job_user;
+    p->count = count;
+    p->next = p->finished = 0;
+    p->batch++;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_wait(void *user) {
+    voxdagi_pool *p = (voxdagi_pool *)user;
+    voxdagi_lock(&p->lock);
+    voxdagi_pool_take(p);
+    while (p->finished < p->count) voxdagi_cond_wait(&p->done, &p->lock);
+    voxdagi_unlock(&p->lock);
+}
+
+static void voxdagi_pool_stop(voxdagi_pool *p) {
+    uint32_t t;
+    voxdagi_lock(&p->lock);
+    p->quit = 1;
+    voxdagi_cond_wake_all(&p->wake);
+    voxdagi_unlock(&p->lock);
+    for (t = 0; t < p->workers; t++) {
+#if defined(_WIN32)
+        WaitForSingleObject(p->tid[t], INFINITE);
+        CloseHandle(p->tid[t]);
+#else
+        pthread_join(p->tid[t], NULL);
+#endif
+    }
+    voxdagi_cond_destroy(&p->wake);
+    voxdagi_cond_destroy(&p->done);
+    voxdagi_lock_destroy(&p->lock);
+}
+#endif
+
+/* A team of threads for one call: THREADS (1: the calling thread only) on
+   the host's POOL or on the built-in pool, started on the first batch and
+   kept until voxdagi_team_stop. */
+typedef struct voxdagi_team {
+    uint32_t threads;
+    voxdag_thread_pool pool;     /* the host's (run NULL: the built-in one) */
+    voxdagi_batch batch;         /* between voxdagi_batch_start and _wait */
+    voxdagi_mem *mem;            /* where the built-in pool is allocated */
+#ifndef VOXDAG_NO_THREADS
+    voxdagi_pool *builtin;       /* started on the first batch */
+#endif
+} voxdagi_team;
+
+/* A team of THREADS (clamped to 1..VOXDAGI_MAX_THREADS; 1 under
+   VOXDAG_NO_THREADS) on POOL (NULL or run NULL: the built-in one). */
+static void voxdagi_team_init(voxdagi_team *t, voxdagi_mem *mem, uint32_t threads, const voxdag_thread_pool *pool) {
+    memset(t, 0, sizeof *t);
+    t->mem = mem;
+    t->threads = threads < 1 ? 1 : threads > VOXDAGI_MAX_THREADS ? VOXDAGI_MAX_THREADS : threads;
+#ifdef VOXDAG_NO_THREADS
+    t->threads = 1;
+    (void)pool;
+#else
+    if (pool) t->pool = *pool;
+#endif
+}
+
+static void voxdagi_team_stop(voxdagi_team *t) {
+#ifndef VOXDAG_NO_THREADS
+    if (t->builtin) {
+        voxdagi_pool_stop(t->builtin);
+        voxdagi_free(t->mem, t->builtin, sizeof *t->builtin);
+        t->builtin = NULL;
+    }
+#else
+    (void)t;
+#endif
+}
+
+#ifndef VOXDAG_NO_THREADS
+/* Whether team T has a pool: the host's, or the built-in one, started here
+   on first use (0 when that cannot be allocated). */
+static int voxdagi_team_ready(voxdagi_team *t) {
+    if (t->pool.run || t->builtin) return 1;
+    t->builtin = (voxdagi_pool *)voxdagi_alloc(t->mem, sizeof *t->builtin);
+    if (t->builtin) voxdagi_pool_start(t->builtin, t->threads - 1);
+    return t->builtin != NULL;
+}
+#endif
+
+/* Starts FN on each of the COUNT SIZE-byte elements of JOBS on the thread
+   pool of team T, the host's or the built-in one (started on the first batch),
+   while the calling thread does other work; voxdagi_batch_wait ends the batch.
+   With one thread (or no pool) the wait runs the jobs itself. */
+static void voxdagi_batch_start(voxdagi_team *t, void *(*fn)(void *), void *jobs, size_t size,
+                                unsigned count) {
+    t->batch.fn = fn;
+    t->batch.jobs = (char *)jobs;
+    t->batch.size = size;
+    t->batch.count = count;
+    t->batch.pooled = 0;
+#ifndef VOXDAG_NO_THREADS
+    if (t->threads < 2 || !count || !voxdagi_team_ready(t)) return; /* the wait does it all */
+    if (t->pool.run) t->pool.run(t->pool.user, voxdagi_batch_job, &t->batch, count);
+    else voxdagi_pool_run(t->builtin, voxdagi_batch_job, &t->batch, count);
+    t->batch.pooled = 1;
+#endif
+}
+
+static void voxdagi_batch_wait(voxdagi_team *t) {
+    uint32_t i;
+#ifndef VOXDAG_NO_THREADS
+    if (t->batch.pooled) {
+        if (t->pool.wait) t->pool.wait(t->pool.user);
+        else voxdagi_pool_wait(t->builtin);
+        t->batch.pooled = 0;
+        return;
+    }
+#endif
+    for (i = 0; i < t->batch.count; i++) voxdagi_batch_job(&t->batch, i);
+}
+
+/* Runs FN on the COUNT jobs, in parallel when the team has threads. */
+static void voxdagi_run_parallel(voxdagi_team *t, void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
+    voxdagi_batch_start(t, fn, jobs, size, count);
+    voxdagi_batch_wait(t);
+}
+
+#ifdef VOXDAGI_VOXCOLOR
+/* voxcolor_thread_pool.run on team T (USER): COUNT jobs on its pool, then
+   their wait, or on the calling thread when it has one thread. */
+static void voxdagi_team_voxcolor_run(void *user, voxcolor_job_fn job, void *job_user, uint32_t count) {
+    voxdagi_team *t = (voxdagi_team *)user;
+    uint32_t i;
+#ifndef VOXDAG_NO_THREADS
+    if (t->threads > 1 && count && voxdagi_team_ready(t)) {
+        if (t->pool.run) {
+            t->pool.run(t->pool.user, job, job_user, count);
+            t->pool.wait(t->pool.user);
+        } else {
+            voxdagi_pool_run(t->builtin, job, job_user, count);
+            voxdagi_pool_wait(t->builtin);
+        }
+        return;
+    }
+#endif
+    for (i = 0; i < count; i++) job(job_user, i);
 }
 #endif
 
@@ -2243,131 +2490,6 @@ static void voxdagi_radix_sort(uint64_t *code, uint32_t *rgb, uint64_t *tmp_code
 
 // -- Builder
 
-#define VOXDAGI_MAX_THREADS 64
-
-/* A batch of jobs: FN on each of the COUNT SIZE-byte elements of JOBS (the
-   JOB_USER of voxdag_job_fn). */
-typedef struct voxdagi_batch {
-    void *(*fn)(void *);
-    char *jobs;
-    size_t size;
-    uint32_t count;
-    int pooled; /* running on a pool (else the wait runs it) */
-} voxdagi_batch;
-
-static void voxdagi_batch_job(void *user, uint32_t index) {
-    voxdagi_batch *bt = (voxdagi_batch *)user;
-    bt->fn(bt->jobs + (size_t)index * bt->size);
-}
-
-#ifndef VOXDAG_NO_THREADS
-/* The built-in pool: THREADS - 1 workers started on the first batch and kept
-   until the builder is freed. RUN hands a batch to the workers; WAIT takes the
-   jobs no worker has taken yet, then waits for the rest. */
-typedef struct voxdagi_pool {
-    voxdagi_lock_t lock;
-    voxdagi_cond_t wake, done;
-    voxdag_job_fn job;
-    void *job_user;
-    uint32_t count, next, finished, batch, workers;
-    int quit;
-    voxdagi_thread_t tid[VOXDAGI_MAX_THREADS - 1];
-} voxdagi_pool;
-
-/* Runs jobs of the current batch until none is left; called and returns with
-   the lock held. */
-static void voxdagi_pool_take(voxdagi_pool *p) {
-    while (p->next < p->count) {
-        uint32_t i = p->next++;
-        voxdagi_unlock(&p->lock);
-        p->job(p->job_user, i);
-        voxdagi_lock(&p->lock);
-        if (++p->finished == p->count) voxdagi_cond_wake_all(&p->done);
-    }
-}
-
-static void voxdagi_pool_worker(voxdagi_pool *p) {
-    uint32_t seen = 0;
-    voxdagi_lock(&p->lock);
-    while (!p->quit) {
-        if (p->batch == seen) {
-            voxdagi_cond_wait(&p->wake, &p->lock);
-            continue;
-        }
-        seen = p->batch;
-        voxdagi_pool_take(p);
-    }
-    voxdagi_unlock(&p->lock);
-}
-
-#if defined(_WIN32)
-static DWORD WINAPI voxdagi_pool_main(LPVOID p) {
-    voxdagi_pool_worker((voxdagi_pool *)p);
-    return 0;
-}
-#else
-static void *voxdagi_pool_main(void *p) {
-    voxdagi_pool_worker((voxdagi_pool *)p);
-    return NULL;
-}
-#endif
-
-/* Starts up to WORKERS threads (those the system refuses are left to WAIT). */
-static void voxdagi_pool_start(voxdagi_pool *p, uint32_t workers) {
-    memset(p, 0, sizeof *p);
-    voxdagi_lock_init(&p->lock);
-    voxdagi_cond_init(&p->wake);
-    voxdagi_cond_init(&p->done);
-    for (; p->workers < workers; p->workers++) {
-#if defined(_WIN32)
-        p->tid[p->workers] = CreateThread(NULL, 0, voxdagi_pool_main, p, 0, NULL);
-        if (!p->tid[p->workers]) break;
-#else
-        if (pthread_create(&p->tid[p->workers], NULL, voxdagi_pool_main, p) != 0) break;
-#endif
-    }
-}
-
-static void voxdagi_pool_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
-    voxdagi_pool *p = (voxdagi_pool *)user;
-    voxdagi_lock(&p->lock);
-    p->job = job;
-    p->job_user = job_user;
-    p->count = count;
-    p->next = p->finished = 0;
-    p->batch++;
-    voxdagi_cond_wake_all(&p->wake);
-    voxdagi_unlock(&p->lock);
-}
-
-static void voxdagi_pool_wait(void *user) {
-    voxdagi_pool *p = (voxdagi_pool *)user;
-    voxdagi_lock(&p->lock);
-    voxdagi_pool_take(p);
-    while (p->finished < p->count) voxdagi_cond_wait(&p->done, &p->lock);
-    voxdagi_unlock(&p->lock);
-}
-
-static void voxdagi_pool_stop(voxdagi_pool *p) {
-    uint32_t t;
-    voxdagi_lock(&p->lock);
-    p->quit = 1;
-    voxdagi_cond_wake_all(&p->wake);
-    voxdagi_unlock(&p->lock);
-    for (t = 0; t < p->workers; t++) {
-#if defined(_WIN32)
-        WaitForSingleObject(p->tid[t], INFINITE);
-        CloseHandle(p->tid[t]);
-#else
-        pthread_join(p->tid[t], NULL);
-#endif
-    }
-    voxdagi_cond_destroy(&p->wake);
-    voxdagi_cond_destroy(&p->done);
-    voxdagi_lock_destroy(&p->lock);
-}
-#endif
-
 struct voxdag_builder {
     voxdagi_mem mem;
     voxdag_build_opts opts;
@@ -2389,11 +2511,7 @@ struct voxdag_builder {
     uint64_t colors_base;        /* with a colour sink: the first colour not yet sent */
     uint64_t voxels;
     voxdag_status failed;        /* sticky error */
-    voxdag_thread_pool pool;     /* the host's (run NULL: the built-in one) */
-    voxdagi_batch batch;         /* between voxdagi_batch_start and _wait */
-#ifndef VOXDAG_NO_THREADS
-    voxdagi_pool *builtin;       /* started on the first batch */
-#endif
+    voxdagi_team team;           /* its threads */
 };
 
 VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
@@ -2441,12 +2559,8 @@ VOXDAG_API voxdag_status voxdag_builder_create(const voxdag_build_opts *opts,
     b->mem = mem; /* the mutex is moved before any other use */
     b->opts = o;
     b->levels = o.levels;
-    b->threads = o.threads < 1 ? 1 : o.threads > VOXDAGI_MAX_THREADS ? VOXDAGI_MAX_THREADS : o.threads;
-#ifdef VOXDAG_NO_THREADS
-    b->threads = 1;
-#else
-    b->pool = o.thread_pool;
-#endif
+    voxdagi_team_init(&b->team, &b->mem, o.threads, &o.thread_pool);
+    b->threads = b->team.threads;
     if (o.bounds) {
         b->has_bounds = 1;
         memcpy(b->bounds, o.bounds, sizeof b->bounds);
@@ -2471,58 +2585,10 @@ VOXDAG_API void voxdag_builder_free(voxdag_builder *b) {
     voxdagi_free(&b->mem, b->pend_code, b->pend_cap * sizeof *b->pend_code);
     voxdagi_free(&b->mem, b->pend_rgb, b->opts.colors ? b->pend_cap * sizeof *b->pend_rgb : 0);
     voxdagi_free(&b->mem, b->colors, b->colors_cap * 3);
-#ifndef VOXDAG_NO_THREADS
-    if (b->builtin) {
-        voxdagi_pool_stop(b->builtin);
-        voxdagi_free(&b->mem, b->builtin, sizeof *b->builtin);
-    }
-#endif
+    voxdagi_team_stop(&b->team);
     mem = b->mem;
     voxdagi_free(&mem, b, sizeof *b);
     voxdagi_mem_destroy(&mem);
-}
-
-/* Starts FN on each of the COUNT SIZE-byte elements of JOBS on the thread
-   pool, the host's or the built-in one (started on the first batch), while
-   the calling thread does other work; voxdagi_batch_wait ends the batch.
-   With one thread (or no pool) the wait runs the jobs itself. */
-static void voxdagi_batch_start(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size,
-                                unsigned count) {
-    b->batch.fn = fn;
-    b->batch.jobs = (char *)jobs;
-    b->batch.size = size;
-    b->batch.count = count;
-    b->batch.pooled = 0;
-#ifndef VOXDAG_NO_THREADS
-    if (b->threads < 2 || !count) return;
-    if (!b->pool.run && !b->builtin) {
-        b->builtin = (voxdagi_pool *)voxdagi_alloc(&b->mem, sizeof *b->builtin);
-        if (!b->builtin) return; /* the calling thread does it all */
-        voxdagi_pool_start(b->builtin, b->threads - 1);
-    }
-    if (b->pool.run) b->pool.run(b->pool.user, voxdagi_batch_job, &b->batch, count);
-    else voxdagi_pool_run(b->builtin, voxdagi_batch_job, &b->batch, count);
-    b->batch.pooled = 1;
-#endif
-}
-
-static void voxdagi_batch_wait(voxdag_builder *b) {
-    uint32_t i;
-#ifndef VOXDAG_NO_THREADS
-    if (b->batch.pooled) {
-        if (b->pool.wait) b->pool.wait(b->pool.user);
-        else voxdagi_pool_wait(b->builtin);
-        b->batch.pooled = 0;
-        return;
-    }
-#endif
-    for (i = 0; i < b->batch.count; i++) voxdagi_batch_job(&b->batch, i);
-}
-
-/* Runs FN on the COUNT jobs, in parallel when the builder has threads. */
-static void voxdagi_run_parallel(voxdag_builder *b, void *(*fn)(void *), void *jobs, size_t size, unsigned count) {
-    voxdagi_batch_start(b, fn, jobs, size, count);
-    voxdagi_batch_wait(b);
 }
 
 /* One job of a parallel radix sort pass: counts the digits of elements
@@ -2583,7 +2649,7 @@ static void voxdagi_sort(voxdag_builder *b, uint64_t *code, uint32_t *rgb, uint6
             job[t].shift = shift;
             job[t].scatter = 0;
         }
-        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        voxdagi_run_parallel(&b->team, voxdagi_sort_run, job, sizeof job[0], jobs);
         for (d = 0, sum = 0; d < VOXDAGI_RADIX_BUCKETS; d++) /* digit by digit, slices in order */
             for (t = 0; t < jobs; t++) {
                 size_t k = job[t].count[d];
@@ -2591,7 +2657,7 @@ static void voxdagi_sort(voxdag_builder *b, uint64_t *code, uint32_t *rgb, uint6
                 sum += k;
             }
         for (t = 0; t < jobs; t++) job[t].scatter = 1;
-        voxdagi_run_parallel(b, voxdagi_sort_run, job, sizeof job[0], jobs);
+        voxdagi_run_parallel(&b->team, voxdagi_sort_run, job, sizeof job[0], jobs);
         c = code; code = tmp_code; tmp_code = c;
         r = rgb; rgb = tmp_rgb; tmp_rgb = r;
     }
@@ -2685,7 +2751,7 @@ VOXDAG_API voxdag_status voxdag_builder_add(voxdag_builder *b, const uint32_t *x
             job[t].begin = n / jobs * t;
             job[t].end = t + 1 == jobs ? n : n / jobs * (t + 1);
         }
-        voxdagi_run_parallel(b, voxdagi_encode_run, job, sizeof job[0], jobs);
+        voxdagi_run_parallel(&b->team, voxdagi_encode_run, job, sizeof job[0], jobs);
         for (t = 0; t < jobs && st == VOXDAG_OK; t++)
             if (job[t].status != VOXDAG_OK) {
                 st = job[t].status;
@@ -2881,7 +2947,7 @@ static voxdag_status voxdagi_reduce_parallel(voxdag_builder *b, const uint64_t *
         for (k = 0; k < b->red_count; k++)
             voxdagi_reducer_init(&worker[t].red[k], &b->mem, &b->group[k], nlevels, split);
     }
-    voxdagi_run_parallel(b, voxdagi_worker_run, worker, sizeof *worker, b->threads);
+    voxdagi_run_parallel(&b->team, voxdagi_worker_run, worker, sizeof *worker, b->threads);
 
     /* Merge in worker order, then feed voxels and subtrees in Morton order. */
     for (t = 0; t < b->threads && st == VOXDAG_OK; t++)
@@ -4082,20 +4148,20 @@ VOXDAG_API voxdag_status voxdag_builder_add_mesh(voxdag_builder *b, const voxdag
         if (!voxdagi_chunk_init(&chunk[jobs], b, mesh, shift, mesh->solid ? &solid : NULL)) st = VOXDAG_ERR_OUT_OF_MEMORY;
     p = 0;
     t = st == VOXDAG_OK ? voxdagi_chunk_assign(chunk, b->threads, pair_chunk, pair_tri, pairs, &p) : 0;
-    voxdagi_run_parallel(b, voxdagi_chunk_run, chunk, sizeof *chunk, t);
+    voxdagi_run_parallel(&b->team, voxdagi_chunk_run, chunk, sizeof *chunk, t);
     while (t) { /* chunk[cur..cur + t) are voxelized */
         voxdagi_chunk *next = sets == 2 ? chunk + (b->threads - cur) : chunk;
         unsigned m = 0;
         if (sets == 2) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_batch_start(b, voxdagi_chunk_run, next, sizeof *chunk, st == VOXDAG_OK ? m : 0);
+            voxdagi_batch_start(&b->team, voxdagi_chunk_run, next, sizeof *chunk, st == VOXDAG_OK ? m : 0);
         }
         for (k = 0; k < t && st == VOXDAG_OK; k++) st = voxdagi_builder_take(b, &chunk[cur + k]);
         if (sets == 2) {
-            voxdagi_batch_wait(b);
+            voxdagi_batch_wait(&b->team);
         } else if (st == VOXDAG_OK) {
             m = voxdagi_chunk_assign(next, b->threads, pair_chunk, pair_tri, pairs, &p);
-            voxdagi_run_parallel(b, voxdagi_chunk_run, next, sizeof *chunk, m);
+            voxdagi_run_parallel(&b->team, voxdagi_chunk_run, next, sizeof *chunk, m);
         }
         if (st == VOXDAG_OK) st = voxdagi_progress(b, "voxelize", (double)p / (double)pairs);
         cur = (unsigned)(next - chunk);
@@ -4353,8 +4419,23 @@ static uint64_t voxdagi_choose_classes(uint64_t hist[58][7], unsigned n, voxdagi
     return nc ? best_cost : 0;
 }
 
+/* A job of voxdagi_choose_level over the nodes [BEGIN, END) of level L:
+   stage 0 counts the stored transforms of the pointers (FREQ), stage 1 the
+   pointers by target and code bits (HIST; TOO_WIDE: one needs more than 57)
+   and, with private children, the bases (BASES, the largest MAX_BASE). */
+typedef struct voxdagi_level_job {
+    const struct voxdagi_encoder *e;
+    uint32_t l;
+    int stage, private_children, too_wide;
+    size_t begin, end;
+    uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], bases, max_base;
+} voxdagi_level_job;
+
 typedef struct voxdagi_encoder {
     voxdagi_mem *mem;
+    voxdagi_team *team;                  /* the builder's threads */
+    voxdagi_level_job *level_job;        /* voxdagi_choose_level's, LEVEL_JOBS of them */
+    unsigned level_jobs;
     const voxdagi_reducer *r;
     const voxdagi_group *group;
     uint32_t levels;
@@ -4383,6 +4464,7 @@ static void voxdagi_encoder_free(voxdagi_encoder *e) {
         if (e->tag[l]) voxdagi_free(e->mem, e->tag[l], 8 * n);
         voxdagi_free(e->mem, e->single[l], n);
     }
+    voxdagi_free(e->mem, e->level_job, e->level_jobs * sizeof *e->level_job);
 }
 
 /* The stored transform of the reference from a node stored as RP(canonical)
@@ -4401,6 +4483,44 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
     return best;
 }
 
+/* Most jobs a level is split in by the encoder. */
+#define VOXDAGI_ENCODE_JOBS (4 * VOXDAGI_MAX_THREADS)
+
+/* A job of voxdagi_orient: the orientations of nodes [BEGIN, END) of level
+   L from the transforms SEEN by the references into them (node i's from
+   FIRST[i] to FIRST[i + 1]). */
+typedef struct voxdagi_orient_job {
+    voxdagi_encoder *e;
+    const uint64_t *first;
+    const uint8_t *seen;
+    size_t begin, end;
+    uint32_t l;
+} voxdagi_orient_job;
+
+static void *voxdagi_orient_run(void *arg) {
+    const voxdagi_orient_job *j = (const voxdagi_orient_job *)arg;
+    const voxdagi_cube *c = &voxdagi_cube_tables;
+    const voxdagi_store *s = &j->e->r->store[j->l];
+    uint64_t votes[VOXDAGI_TRANSFORMS];
+    size_t i;
+    memset(votes, 0, sizeof votes);
+    for (i = j->begin; i < j->end; i++) { /* BEST: the smallest transform with the most votes so far */
+        unsigned best = 0;
+        uint64_t k, stabs;
+        for (k = j->first[i]; k < j->first[i + 1]; k++)
+            for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1) {
+                unsigned tf = c->comp[j->seen[k]][voxdagi_lowest_bit(stabs)];
+                votes[tf]++;
+                if (votes[tf] > votes[best] || (votes[tf] == votes[best] && tf < best)) best = tf;
+            }
+        j->e->orient[j->l][i] = (uint8_t)best;
+        for (k = j->first[i]; k < j->first[i + 1]; k++) /* back to no votes */
+            for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1)
+                votes[c->comp[j->seen[k]][voxdagi_lowest_bit(stabs)]] = 0;
+    }
+    return NULL;
+}
+
 /* Orientations, top-down: a node is stored as R(canonical) for the R that
    makes the most references to it carry the identity (ties: the smallest R).
    A reference (n, t) from a parent stored as RP does so for every R in
@@ -4408,8 +4528,9 @@ static unsigned voxdagi_stored_tag(const voxdagi_encoder *e, uint32_t l, unsigne
 static int voxdagi_orient(voxdagi_encoder *e) {
     const voxdagi_reducer *r = e->r;
     const voxdagi_cube *c = &voxdagi_cube_tables;
+    voxdagi_orient_job job[VOXDAGI_ENCODE_JOBS];
     uint32_t brick_level = e->levels - 2, l;
-    uint64_t votes[VOXDAGI_TRANSFORMS];
+    unsigned jobs, k;
     for (l = 0; l <= brick_level; l++) {
         const voxdagi_store *s = &r->store[l], *ps = l ? &r->store[l - 1] : NULL;
         size_t n = s->n, i, p, total = l ? 0 : 1;
@@ -4438,21 +4559,13 @@ static int voxdagi_orient(voxdagi_encoder *e) {
         }
         for (i = n; i > 0; i--) first[i] = first[i - 1]; /* back to the starts */
         first[0] = 0;
-        memset(votes, 0, sizeof votes);
-        for (i = 0; i < n; i++) { /* BEST: the smallest transform with the most votes so far */
-            unsigned best = 0;
-            uint64_t k, stabs;
-            for (k = first[i]; k < first[i + 1]; k++)
-                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1) {
-                    unsigned tf = c->comp[seen[k]][voxdagi_lowest_bit(stabs)];
-                    votes[tf]++;
-                    if (votes[tf] > votes[best] || (votes[tf] == votes[best] && tf < best)) best = tf;
-                }
-            e->orient[l][i] = (uint8_t)best;
-            for (k = first[i]; k < first[i + 1]; k++) /* back to no votes */
-                for (stabs = s->node[i].stab; stabs; stabs &= stabs - 1)
-                    votes[c->comp[seen[k]][voxdagi_lowest_bit(stabs)]] = 0;
+        jobs = e->team->threads < 2 || n < 4096 ? 1 : 4 * e->team->threads;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+        for (k = 0; k < jobs; k++) {
+            job[k].e = e, job[k].first = first, job[k].seen = seen, job[k].l = l;
+            job[k].begin = n * k / jobs, job[k].end = n * (k + 1) / jobs;
         }
+        voxdagi_run_parallel(e->team, voxdagi_orient_run, job, sizeof job[0], jobs);
         voxdagi_free(e->mem, seen, total);
         voxdagi_free(e->mem, first, (n + 1) * sizeof *first);
     }
@@ -4563,17 +4676,57 @@ static uint64_t voxdagi_record(const voxdagi_encoder *e, uint32_t l, uint32_t id
    children, with the base width) for the fewest bits; *BITS: the bits of
    its records without padding (the level's bytes are at least an eighth of
    them). Returns 0 when a pointer or a base needs more than 57 bits. */
+static void *voxdagi_level_run(void *arg) {
+    voxdagi_level_job *j = (voxdagi_level_job *)arg;
+    const voxdagi_encoder *e = j->e;
+    const voxdagi_store *s = &e->r->store[j->l];
+    uint32_t l = j->l;
+    size_t i;
+    if (j->stage == 0) {
+        memset(j->freq, 0, sizeof j->freq);
+        for (i = 8 * j->begin; i < 8 * j->end; i++)
+            if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) j->freq[e->tag[l][i]]++;
+        return NULL;
+    }
+    memset(j->hist, 0, sizeof j->hist);
+    j->too_wide = 0, j->bases = j->max_base = 0;
+    for (i = 8 * j->begin; i < 8 * j->end; i++) {
+        uint32_t x = s->child[i];
+        unsigned ob, kb;
+        if (x == VOXDAGI_NONE || voxdagi_is_private(e, l, x)) continue;
+        ob = voxdagi_bit_length(e->pos[l + 1][x >> 6]);
+        kb = voxdagi_bit_length(e->code[l][e->tag[l][i]]);
+        if (ob + kb > 57) {
+            j->too_wide = 1;
+            return NULL;
+        }
+        j->hist[ob][kb]++;
+    }
+    for (i = j->begin; j->private_children && i < j->end; i++) {
+        uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
+        if (base != UINT64_MAX) j->bases++;
+        if (base != UINT64_MAX && base > j->max_base) j->max_base = base;
+    }
+    return NULL;
+}
+
 static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint64_t *bits) {
     const voxdagi_store *s = &e->r->store[l];
     voxdagi_classes *cls = &e->cls[l];
+    voxdagi_level_job *job = e->level_job;
     uint64_t freq[VOXDAGI_TRANSFORMS], hist[58][7], max_base = 0, bases = 0;
-    unsigned tf, k, len = 0;
-    size_t i;
+    unsigned tf, k, len = 0, jobs = s->n < 4096 ? 1 : e->level_jobs, ob, kb;
+    int too_wide = 0;
     cls->classes = (unsigned char)n;
+    for (k = 0; k < jobs; k++) {
+        job[k].e = e, job[k].l = l, job[k].stage = 0, job[k].private_children = n == 2;
+        job[k].begin = s->n * k / jobs, job[k].end = s->n * (k + 1) / jobs;
+    }
+    voxdagi_run_parallel(e->team, voxdagi_level_run, job, sizeof job[0], jobs);
     memset(freq, 0, sizeof freq);
-    for (i = 0; i < 8 * s->n; i++) /* the table: stored transforms by decreasing frequency, ties by value */
-        if (s->child[i] != VOXDAGI_NONE && !voxdagi_is_private(e, l, s->child[i])) freq[e->tag[l][i]]++;
-    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) {
+    for (k = 0; k < jobs; k++)
+        for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) freq[tf] += job[k].freq[tf];
+    for (tf = 0; tf < VOXDAGI_TRANSFORMS; tf++) { /* the table: stored transforms by decreasing frequency, ties by value */
         if (!freq[tf]) continue;
         for (k = len; k > 0 && freq[e->table[l][k - 1]] < freq[tf]; k--) e->table[l][k] = e->table[l][k - 1];
         e->table[l][k] = (uint8_t)tf;
@@ -4582,37 +4735,76 @@ static int voxdagi_choose_level(voxdagi_encoder *e, uint32_t l, unsigned n, uint
     if (!len) e->table[l][len++] = 0; /* only private children: a table is never empty */
     for (k = 0; k < len; k++) e->code[l][e->table[l][k]] = (uint8_t)k;
     e->table_len[l] = len;
+    for (k = 0; k < jobs; k++) job[k].stage = 1;
+    voxdagi_run_parallel(e->team, voxdagi_level_run, job, sizeof job[0], jobs);
     memset(hist, 0, sizeof hist);
-    for (i = 0; i < 8 * s->n; i++) {
-        uint32_t x = s->child[i];
-        unsigned ob, kb;
-        if (x == VOXDAGI_NONE || voxdagi_is_private(e, l, x)) continue;
-        ob = voxdagi_bit_length(e->pos[l + 1][x >> 6]);
-        kb = voxdagi_bit_length(e->code[l][e->tag[l][i]]);
-        if (ob + kb > 57) return 0;
-        hist[ob][kb]++;
+    for (k = 0; k < jobs; k++) {
+        too_wide |= job[k].too_wide;
+        for (ob = 0; ob < 58; ob++)
+            for (kb = 0; kb < 7; kb++) hist[ob][kb] += job[k].hist[ob][kb];
+        bases += job[k].bases;
+        if (job[k].max_base > max_base) max_base = job[k].max_base;
     }
+    if (too_wide) return 0;
     *bits = (16 + e->count_bits[l]) * (uint64_t)s->n + voxdagi_choose_classes(hist, n, cls);
     cls->classes = (unsigned char)n;
     for (k = 0; k < 58 * 7; k++) e->class_of[l][k / 7][k % 7] = (uint8_t)voxdagi_class_for(cls, k / 7, k % 7);
-    for (i = 0; n == 2 && i < s->n; i++) {
-        uint64_t base = voxdagi_private_base(e, l, (uint32_t)i);
-        if (base != UINT64_MAX) bases++;
-        if (base != UINT64_MAX && base > max_base) max_base = base;
-    }
     cls->base_bits = (unsigned char)voxdagi_bit_length(max_base);
     *bits += bases * cls->base_bits;
     return cls->base_bits <= 57;
+}
+
+/* A job of the encoder: the records (or bricks) of level L at storage
+   positions [BEGIN, END). OUT NULL: each record's bytes to its e->pos
+   entry; else the records written at OUT (zeroed) + their e->pos. */
+typedef struct voxdagi_record_job {
+    const voxdagi_encoder *e;
+    uint64_t *pos;
+    uint8_t *out;
+    size_t begin, end;
+    uint32_t l;
+} voxdagi_record_job;
+
+static void *voxdagi_record_run(void *arg) {
+    voxdagi_record_job *j = (voxdagi_record_job *)arg;
+    const voxdagi_encoder *e = j->e;
+    const voxdagi_store *s = &e->r->store[j->l];
+    size_t i;
+    for (i = j->begin; i < j->end; i++) {
+        uint32_t id = e->order[j->l][i];
+        if (j->l == e->levels - 2) /* bricks */
+            voxdagi_put_le(j->out + 8 * i, voxdagi_transform_brick(e->group, s->node[id].key, e->orient[j->l][id]), 8);
+        else if (!j->out)
+            j->pos[id] = (voxdagi_record(e, j->l, id, NULL) + 7) / 8;
+        else
+            voxdagi_record(e, j->l, id, j->out + j->pos[id]);
+    }
+    return NULL;
+}
+
+/* Runs voxdagi_record_run over the N nodes of level L on the builder's
+   threads (one job for small levels). */
+static void voxdagi_records(const voxdagi_encoder *e, uint32_t l, uint8_t *out) {
+    voxdagi_record_job job[VOXDAGI_ENCODE_JOBS];
+    size_t n = e->r->store[l].n, k;
+    unsigned jobs = e->team->threads < 2 || n < 4096 ? 1 : 4 * e->team->threads;
+    if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+    for (k = 0; k < jobs; k++) {
+        job[k].e = e, job[k].pos = e->pos[l], job[k].out = out, job[k].l = l;
+        job[k].begin = n * k / jobs, job[k].end = n * (k + 1) / jobs;
+    }
+    voxdagi_run_parallel(e->team, voxdagi_record_run, job, sizeof job[0], jobs);
 }
 
 /* Record offsets of inner level L in storage order; returns its bytes. */
 static uint64_t voxdagi_level_offsets(voxdagi_encoder *e, uint32_t l) {
     uint64_t at = 0;
     size_t i;
+    voxdagi_records(e, l, NULL); /* each record's bytes, then their offsets */
     for (i = 0; i < e->r->store[l].n; i++) {
-        uint32_t id = e->order[l][i];
-        e->pos[l][id] = at;
-        at += (voxdagi_record(e, l, id, NULL) + 7) / 8;
+        uint64_t *pos = &e->pos[l][e->order[l][i]], bytes = *pos;
+        *pos = at;
+        at += bytes;
     }
     return at;
 }
@@ -4677,25 +4869,44 @@ static int voxdagi_plan_level(voxdagi_encoder *e, uint32_t l, int candidates) {
     return 1;
 }
 
+/* A job of voxdagi_private_order (FIRST and SEEN unused): the stored
+   transforms of the child references of nodes [BEGIN, END) of level L. */
+static void *voxdagi_tag_run(void *arg) {
+    const voxdagi_orient_job *j = (const voxdagi_orient_job *)arg;
+    const voxdagi_store *s = &j->e->r->store[j->l];
+    size_t i;
+    for (i = 8 * j->begin; i < 8 * j->end; i++)
+        if (s->child[i] != VOXDAGI_NONE)
+            j->e->tag[j->l][i] = (uint8_t)voxdagi_stored_tag(j->e, j->l, j->e->orient[j->l][i >> 3], s->child[i]);
+    return NULL;
+}
+
 /* Stored transforms of every pointer, the private-child candidates (nodes
    referenced once through the identity: their orientation is their one
    referrer's), and each level's order of them: after the shared nodes, by
    parent in storage order, then by stored octant, so that the private
    children of a record follow each other. Top-down. */
 static void voxdagi_private_order(voxdagi_encoder *e, uint32_t *const *refs, int *candidates) {
+    voxdagi_orient_job job[VOXDAGI_ENCODE_JOBS];
     const voxdagi_reducer *r = e->r;
     uint32_t brick_level = e->levels - 2, l;
     for (l = 0; l < brick_level; l++) {
         const voxdagi_store *s = &r->store[l];
         uint32_t *o = e->order[l + 1];
         size_t i, k = 0, n1 = r->store[l + 1].n;
+        unsigned jobs = e->team->threads < 2 || s->n < 4096 ? 1 : 4 * e->team->threads, t;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
+        for (t = 0; t < jobs; t++) {
+            job[t].e = e, job[t].l = l;
+            job[t].begin = s->n * t / jobs, job[t].end = s->n * (t + 1) / jobs;
+        }
+        voxdagi_run_parallel(e->team, voxdagi_tag_run, job, sizeof job[0], jobs);
         memset(e->single[l + 1], 0, n1);
         candidates[l] = 0;
         for (i = 0; i < 8 * s->n; i++) {
             uint32_t x = s->child[i];
-            if (x == VOXDAGI_NONE) continue;
-            e->tag[l][i] = (uint8_t)voxdagi_stored_tag(e, l, e->orient[l][i >> 3], x);
-            if (refs[l + 1][x >> 6] == 1 && e->tag[l][i] == 0) e->single[l + 1][x >> 6] = 1, candidates[l] = 1;
+            if (x != VOXDAGI_NONE && refs[l + 1][x >> 6] == 1 && e->tag[l][i] == 0)
+                e->single[l + 1][x >> 6] = 1, candidates[l] = 1;
         }
         for (i = 0; i < n1; i++)
             if (!e->single[l + 1][o[i]]) o[k++] = o[i];
@@ -4717,6 +4928,9 @@ static int voxdagi_encoder_plan(voxdagi_encoder *e) {
     uint32_t *refs[VOXDAG_MAX_LEVELS];
     int ok = 1, candidates[VOXDAG_MAX_LEVELS];
     memset(refs, 0, sizeof refs);
+    e->level_jobs = e->team->threads < 2 ? 1 : 2 * e->team->threads;
+    e->level_job = (voxdagi_level_job *)voxdagi_alloc(e->mem, e->level_jobs * sizeof *e->level_job);
+    if (!e->level_job) ok = 0;
     for (l = 0; l <= brick_level; l++) {
         size_t n = r->store[l].n;
         refs[l] = (uint32_t *)voxdagi_alloc(e->mem, n * sizeof(uint32_t));
@@ -4772,7 +4986,6 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
     const voxdagi_reducer *r = e->r;
     uint32_t brick_level = e->levels - 2, l;
     uint64_t level_at = 0;
-    size_t i;
     for (l = 0; l < brick_level; l++) {
         const voxdagi_classes *cls = &e->cls[l];
         uint8_t *p = nodes + level_at, *te = levels_table + l * VOXDAG_FILE_LEVEL_ENTRY_SIZE;
@@ -4789,13 +5002,10 @@ static void voxdagi_encoder_write(const voxdagi_encoder *e, uint8_t *levels_tabl
         te[28] = cls->classes == 2;
         te[29] = cls->base_bits;
         memcpy(te + 32, e->table[l], e->table_len[l]);
-        for (i = 0; i < r->store[l].n; i++) p += (voxdagi_record(e, l, e->order[l][i], p) + 7) / 8;
+        voxdagi_records(e, l, p); /* each at its offset */
         level_at += e->size[l];
     }
-    for (i = 0; i < r->store[brick_level].n; i++) {
-        uint32_t id = e->order[brick_level][i];
-        voxdagi_put_le(bricks + 8 * i, voxdagi_transform_brick(e->group, r->store[brick_level].node[id].key, e->orient[brick_level][id]), 8);
-    }
+    voxdagi_records(e, brick_level, bricks);
 }
 
 #endif /* VOXDAG_NO_BUILD */
@@ -5804,25 +6014,45 @@ static int voxdagi_colors_readable(const voxdag *d) {
 #endif
 }
 
-/* The level-of-detail slots of D (FORMAT.md, LOD_COLORS) for levels 0..L-3,
-   to SLOTS (3 bytes each, level by level, PER_LEVEL a level): slot j of level
-   q is the mean colour of the level-q cell holding voxel 64 j. One walk in
-   voxel order down to level L-3, whose cells sum their colour ranges; each
-   finished cell adds its sums to its parent's. */
-static void voxdagi_lod_means(const voxdag *d, uint8_t *slots, uint64_t per_level) {
+/* A cell of the level-of-detail walk: the node at byte AT of its level in
+   the frame MI, holding voxels [A, A + N), and the sums of their colours. */
+typedef struct voxdagi_lod_cell {
+    uint64_t at, a, n, sum[3];
+    unsigned mi;
+} voxdagi_lod_cell;
+
+/* The level-of-detail walk over the cell TOP (of level DEPTH): its cells in
+   voxel order down to level L-3, whose cells sum their colour ranges, each
+   finished cell adding its sums to its parent's and writing its slots to
+   SLOTS (3 bytes each, level by level, PER_LEVEL a level): slot j of level q
+   is the mean colour of the level-q cell holding voxel 64 j. Cells of level
+   CUT (> DEPTH; 0: none) are not entered: with COLLECT they are appended to
+   CELLS (*NCELLS of them) unsummed, and their parents get no slots; else
+   CELLS holds them, summed, in this order. Returns TOP's sums in TOP. */
+static void voxdagi_lod_walk(const voxdag *d, uint8_t *slots, uint64_t per_level, voxdagi_lod_cell *top,
+                             uint32_t depth0, uint32_t cut, int collect, voxdagi_lod_cell *cells, size_t *ncells) {
     struct frame {
         uint64_t at, a, end, sum[3]; /* END: the first voxel after the children done */
         unsigned mi, next;
     } stack[VOXDAG_MAX_LEVELS];
-    uint32_t leaf = d->levels - 3;
-    int depth = 0;
+    uint32_t leaf = d->levels - 3, depth = depth0;
     memset(stack, 0, sizeof stack);
-    stack[0].mi = voxdagi_cube_tables.inv[d->root_transform];
-    while (depth >= 0) {
+    stack[depth].at = top->at;
+    stack[depth].mi = top->mi;
+    stack[depth].a = stack[depth].end = top->a;
+    for (;;) {
         struct frame *f = &stack[depth];
         uint64_t j, first, last;
         uint8_t rgb[3];
-        if ((uint32_t)depth == leaf) {
+        if (cut && depth == cut) {
+            voxdagi_lod_cell *c = &cells[(*ncells)++];
+            if (collect) {
+                c->at = f->at, c->mi = f->mi, c->a = f->a;
+                c->n = voxdagi_node_count(d, depth, f->at);
+            } else
+                memcpy(f->sum, c->sum, sizeof f->sum);
+            f->end = f->a + c->n;
+        } else if (depth == leaf) {
             uint64_t n = voxdagi_node_count(d, leaf, f->at);
             voxdagi_sum_colors(d, f->a, n, f->sum);
             f->end = f->a + n;
@@ -5833,7 +6063,7 @@ static void voxdagi_lod_means(const voxdag *d, uint8_t *slots, uint64_t per_leve
             while (f->next < 8 && !(occ >> f->next & 1)) f->next++;
             if (f->next < 8) {
                 unsigned w = f->next++;
-                uint64_t ref = voxdagi_child_ref(d, (uint32_t)depth, rec, header, voxdagi_cube_tables.act[f->mi][w], 1);
+                uint64_t ref = voxdagi_child_ref(d, depth, rec, header, voxdagi_cube_tables.act[f->mi][w], 1);
                 struct frame *c = &stack[depth + 1];
                 memset(c, 0, sizeof *c);
                 c->at = ref >> 6;
@@ -5844,23 +6074,87 @@ static void voxdagi_lod_means(const voxdag *d, uint8_t *slots, uint64_t per_leve
             }
         }
         /* the cell [a, end) of level DEPTH is done: its slots, then its parent */
-        voxdagi_mean_rgb(f->sum, f->end - f->a, rgb);
-        first = (f->a + 63) >> 6, last = (f->end + 63) >> 6;
-        for (j = first; j < last; j++) memcpy(slots + 3 * ((uint64_t)depth * per_level + j), rgb, 3);
-        if (depth > 0) {
-            struct frame *pa = &stack[depth - 1];
-            pa->sum[0] += f->sum[0], pa->sum[1] += f->sum[1], pa->sum[2] += f->sum[2];
-            pa->end = f->end;
+        if (!cut || (collect ? depth > cut : depth != cut)) { /* cells of CUT: their jobs write them */
+            voxdagi_mean_rgb(f->sum, f->end - f->a, rgb);
+            first = (f->a + 63) >> 6, last = (f->end + 63) >> 6;
+            for (j = first; j < last; j++) memcpy(slots + 3 * ((uint64_t)depth * per_level + j), rgb, 3);
         }
+        if (depth == depth0) break;
+        stack[depth - 1].sum[0] += f->sum[0], stack[depth - 1].sum[1] += f->sum[1];
+        stack[depth - 1].sum[2] += f->sum[2];
+        stack[depth - 1].end = f->end;
         depth--;
     }
+    memcpy(top->sum, stack[depth0].sum, sizeof top->sum);
+    top->n = stack[depth0].end - top->a;
+}
+
+/* A job of the level-of-detail means: the walks under cells [BEGIN, END). */
+typedef struct voxdagi_lod_job {
+    const voxdag *d;
+    uint8_t *slots;
+    uint64_t per_level;
+    voxdagi_lod_cell *cells;
+    size_t begin, end;
+    uint32_t cut;
+} voxdagi_lod_job;
+
+static void *voxdagi_lod_run(void *arg) {
+    voxdagi_lod_job *j = (voxdagi_lod_job *)arg;
+    size_t i;
+    for (i = j->begin; i < j->end; i++) voxdagi_lod_walk(j->d, j->slots, j->per_level, &j->cells[i], j->cut, 0, 0, NULL, NULL);
+    return NULL;
+}
+
+/* Most jobs of the level-of-detail means. */
+#define VOXDAGI_LOD_JOBS (4 * VOXDAGI_MAX_THREADS)
+
+/* The level-of-detail slots of D (FORMAT.md, LOD_COLORS) for levels 0..L-3,
+   to SLOTS (see voxdagi_lod_walk), on team T: one walk collects the cells of
+   a level a few below the root, jobs of about equal voxel counts sum them
+   and write their slots, and a last walk over the levels above them. The
+   sums are integers, so the slots are the same whatever the threads. Returns
+   0 when out of memory (from M). */
+static int voxdagi_lod_means(const voxdag *d, uint8_t *slots, uint64_t per_level, voxdagi_team *t, voxdagi_mem *m) {
+    voxdagi_lod_job job[VOXDAGI_LOD_JOBS];
+    voxdagi_lod_cell root, *cells;
+    uint32_t leaf = d->levels - 3, cut = leaf > 5 ? 5 : leaf ? leaf - 1 : 0; /* up to 8^5 cells */
+    size_t ncells = 0, cap, i, jobs = 0;
+    uint64_t per, load = 0;
+    memset(&root, 0, sizeof root);
+    root.mi = voxdagi_cube_tables.inv[d->root_transform];
+    if (cut == 0 || t->threads < 2) {
+        voxdagi_lod_walk(d, slots, per_level, &root, 0, 0, 0, NULL, NULL);
+        return 1;
+    }
+    cap = (size_t)1 << (3 * cut);
+    if (cap > d->voxels) cap = (size_t)d->voxels; /* each cell holds a voxel */
+    cells = (voxdagi_lod_cell *)voxdagi_alloc(m, cap * sizeof *cells);
+    if (!cells) return 0;
+    voxdagi_lod_walk(d, slots, per_level, &root, 0, cut, 1, cells, &ncells);
+    per = d->voxels / (VOXDAGI_LOD_JOBS < 8 * t->threads ? VOXDAGI_LOD_JOBS : 8 * t->threads) + 1;
+    for (i = 0; i < ncells; i++) { /* runs of cells with about PER voxels */
+        if (!jobs || (load >= per && jobs < VOXDAGI_LOD_JOBS)) {
+            memset(&job[jobs], 0, sizeof job[jobs]);
+            job[jobs].d = d, job[jobs].slots = slots, job[jobs].per_level = per_level;
+            job[jobs].cells = cells, job[jobs].begin = i, job[jobs].cut = cut;
+            jobs++, load = 0;
+        }
+        job[jobs - 1].end = i + 1;
+        load += cells[i].n;
+    }
+    voxdagi_run_parallel(t, voxdagi_lod_run, job, sizeof job[0], (unsigned)jobs);
+    ncells = 0;
+    voxdagi_lod_walk(d, slots, per_level, &root, 0, cut, 0, cells, &ncells);
+    voxdagi_free(m, cells, cap * sizeof *cells);
+    return 1;
 }
 
 /* The level-of-detail colour section for D's colours (levels 0..L-3), in
    *OUT (allocated from M, *OUT_SIZE bytes), or *OUT = NULL when D gets none
    (no readable colours, L = 2 or at most 64 voxels). Returns 0 when out of
    memory or the voxcolor encoder fails. */
-static int voxdagi_lod_section(const voxdag *d, voxdagi_mem *m, uint8_t **out, size_t *out_size) {
+static int voxdagi_lod_section(const voxdag *d, voxdagi_mem *m, voxdagi_team *t, uint8_t **out, size_t *out_size) {
     uint64_t per_level, total;
     size_t cap;
     uint8_t *slots, *sec;
@@ -5871,7 +6165,10 @@ static int voxdagi_lod_section(const voxdag *d, voxdagi_mem *m, uint8_t **out, s
     if (total > ((size_t)-1 - VOXDAG_FILE_LOD_HEADER_SIZE) / 4) return 0;
     slots = (uint8_t *)voxdagi_alloc(m, (size_t)(3 * total));
     if (!slots) return 0;
-    voxdagi_lod_means(d, slots, per_level);
+    if (!voxdagi_lod_means(d, slots, per_level, t, m)) {
+        voxdagi_free(m, slots, (size_t)(3 * total));
+        return 0;
+    }
     cap = VOXDAG_FILE_LOD_HEADER_SIZE + (size_t)(3 * total);
 #ifdef VOXDAGI_VOXCOLOR
     if (d->color_kind == VOXDAG_COLORS_VOXCOLOR) {
@@ -5900,6 +6197,9 @@ static int voxdagi_lod_section(const voxdag *d, voxdagi_mem *m, uint8_t **out, s
         size_t len;
         memset(&vo, 0, sizeof vo);
         vo.max_error = 0.016;
+        vo.threads = t->threads; /* the same bytes whatever the count */
+        vo.thread_pool.run = voxdagi_team_voxcolor_run;
+        vo.thread_pool.user = t;
         len = voxcolor_encode(sec + VOXDAG_FILE_LOD_HEADER_SIZE, cap - VOXDAG_FILE_LOD_HEADER_SIZE, slots,
                               (size_t)total, &vo, NULL);
         *out_size = VOXDAG_FILE_LOD_HEADER_SIZE + len;
@@ -5947,7 +6247,7 @@ static void voxdagi_scene_of(const voxdag *d, voxdagi_scene *sc) {
    its level-of-detail colour section, placed after the colour section (an
    old one is dropped), when its colours get one; *PD is kept otherwise.
    Returns VOXDAG_OK or VOXDAG_ERR_OUT_OF_MEMORY (*PD is then unchanged). */
-static voxdag_status voxdagi_attach_lod(voxdag **pd, voxdagi_mem *m, voxdag_error *err) {
+static voxdag_status voxdagi_attach_lod(voxdag **pd, voxdagi_mem *m, voxdagi_team *t, voxdag_error *err) {
     voxdag *d = *pd, *n = NULL;
     voxdagi_layout lay;
     const uint8_t *from[VOXDAG_FILE_MAX_SECTIONS];
@@ -5956,7 +6256,7 @@ static voxdag_status voxdagi_attach_lod(voxdag **pd, voxdagi_mem *m, voxdag_erro
     uint32_t count, k;
     voxdagi_scene sc;
     voxdag_status st;
-    if (!voxdagi_lod_section(d, m, &sec, &sec_size))
+    if (!voxdagi_lod_section(d, m, t, &sec, &sec_size))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "cannot make the level-of-detail colours");
     if (!sec) return VOXDAG_OK;
     memset(&lay, 0, sizeof lay);
@@ -6025,41 +6325,69 @@ static void voxdagi_box_transform(const voxdagi_cube *c, uint32_t b[6], unsigned
     }
 }
 
+/* A job of voxdagi_voxel_box: the boxes CUR of the nodes [BEGIN, END) of
+   level L, from the boxes BELOW of the next level. */
+typedef struct voxdagi_box_job {
+    const voxdagi_reducer *r;
+    const voxdagi_cube *c;
+    const uint32_t *below;
+    uint32_t *cur, l;
+    size_t begin, end;
+} voxdagi_box_job;
+
+static void *voxdagi_box_run(void *arg) {
+    const voxdagi_box_job *j = (const voxdagi_box_job *)arg;
+    const voxdagi_store *s = &j->r->store[j->l];
+    uint32_t half = 1u << (j->r->levels - j->l - 1), cb[6];
+    size_t i, k;
+    for (i = j->begin; i < j->end; i++) {
+        uint32_t *o = j->cur + 6 * i;
+        o[0] = o[1] = o[2] = UINT32_MAX;
+        o[3] = o[4] = o[5] = 0;
+        if (j->l == j->r->levels - 2) {
+            voxdagi_brick_box(s->node[i].key, o);
+            continue;
+        }
+        for (k = 0; k < 8; k++) { /* each child's box, transformed and moved to its octant */
+            uint32_t x = s->child[8 * i + k];
+            unsigned a;
+            if (x == VOXDAGI_NONE) continue;
+            memcpy(cb, j->below + 6 * (size_t)(x >> 6), sizeof cb);
+            voxdagi_box_transform(j->c, cb, x & 63, half);
+            for (a = 0; a < 3; a++) {
+                if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
+                if (cb[a] < o[a]) o[a] = cb[a];
+                if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
+            }
+        }
+    }
+    return NULL;
+}
+
 /* The occupied voxel box of the scene, bottom-up over the unique nodes (each
-   box in its node's canonical frame). Returns 0 when out of memory. */
-static int voxdagi_voxel_box(voxdagi_mem *m, const voxdagi_reducer *r, const voxdagi_cube *c, uint32_t box[6]) {
+   box in its node's canonical frame), a level's nodes split over team T.
+   Returns 0 when out of memory. */
+static int voxdagi_voxel_box(voxdagi_mem *m, voxdagi_team *t, const voxdagi_reducer *r, const voxdagi_cube *c,
+                             uint32_t box[6]) {
+    voxdagi_box_job job[VOXDAGI_ENCODE_JOBS];
     uint32_t brick_level = r->levels - 2, l, *below = NULL, *cur = NULL;
-    size_t below_n = 0, i, k;
+    size_t below_n = 0, k;
     memset(box, 0, 6 * sizeof *box);
     if (r->root == VOXDAGI_NONE) return 1;
     for (l = brick_level + 1; l-- > 0;) {
         const voxdagi_store *s = &r->store[l];
+        unsigned jobs = t->threads < 2 || s->n < 4096 ? 1 : 4 * t->threads;
+        if (jobs > VOXDAGI_ENCODE_JOBS) jobs = VOXDAGI_ENCODE_JOBS;
         cur = (uint32_t *)voxdagi_alloc(m, 6 * s->n * sizeof *cur);
         if (!cur) {
             voxdagi_free(m, below, 6 * below_n * sizeof *below);
             return 0;
         }
-        for (i = 0; i < s->n; i++) {
-            uint32_t *o = cur + 6 * i, half = 1u << (r->levels - l - 1), cb[6];
-            o[0] = o[1] = o[2] = UINT32_MAX;
-            o[3] = o[4] = o[5] = 0;
-            if (l == brick_level) {
-                voxdagi_brick_box(s->node[i].key, o);
-                continue;
-            }
-            for (k = 0; k < 8; k++) { /* each child's box, transformed and moved to its octant */
-                uint32_t x = s->child[8 * i + k];
-                unsigned a;
-                if (x == VOXDAGI_NONE) continue;
-                memcpy(cb, below + 6 * (size_t)(x >> 6), sizeof cb);
-                voxdagi_box_transform(c, cb, x & 63, half);
-                for (a = 0; a < 3; a++) {
-                    if (k >> a & 1) cb[a] += half, cb[a + 3] += half;
-                    if (cb[a] < o[a]) o[a] = cb[a];
-                    if (cb[a + 3] > o[a + 3]) o[a + 3] = cb[a + 3];
-                }
-            }
+        for (k = 0; k < jobs; k++) {
+            job[k].r = r, job[k].c = c, job[k].below = below, job[k].cur = cur, job[k].l = l;
+            job[k].begin = s->n * k / jobs, job[k].end = s->n * (k + 1) / jobs;
         }
+        voxdagi_run_parallel(t, voxdagi_box_run, job, sizeof job[0], jobs);
         voxdagi_free(m, below, 6 * below_n * sizeof *below);
         below = cur, below_n = s->n;
     }
@@ -6081,6 +6409,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     voxdag_status st;
     memset(&e, 0, sizeof e);
     e.mem = &b->mem;
+    e.team = &b->team;
     e.r = r;
     e.group = &b->group[0];
     e.levels = b->levels;
@@ -6100,7 +6429,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     sc.root_transform = e.root_transform;
     sc.symmetry = b->symmetry;
     sc.voxels = b->voxels;
-    if (!voxdagi_voxel_box(&b->mem, r, &voxdagi_cube_tables, sc.voxel_box)) {
+    if (!voxdagi_voxel_box(&b->mem, &b->team, r, &voxdagi_cube_tables, sc.voxel_box)) {
         voxdagi_encoder_free(&e);
         return VOXDAGI_FAIL(err, VOXDAG_ERR_OUT_OF_MEMORY, "out of memory while encoding");
     }
@@ -6131,7 +6460,7 @@ static voxdag_status voxdagi_builder_encode(voxdag_builder *b, voxdag **out, vox
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &b->mem, err);
-    if (st == VOXDAG_OK && !b->opts.no_lod_colors) st = voxdagi_attach_lod(&d, &b->mem, err);
+    if (st == VOXDAG_OK && !b->opts.no_lod_colors) st = voxdagi_attach_lod(&d, &b->mem, &b->team, err);
     if (st != VOXDAG_OK) {
         voxdag_free(d);
         return st;
@@ -6273,6 +6602,8 @@ VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color
     *out = NULL;
     if (opts && (opts->zero_begin || opts->zero_end))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "build options not zero-initialized");
+    if (opts && (opts->thread_pool.run == NULL) != (opts->thread_pool.wait == NULL))
+        return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "thread_pool needs both run and wait");
     if (kind == VOXDAG_COLORS_RGB8 && (src->voxels > UINT64_MAX / 3 || size != 3 * src->voxels))
         return VOXDAGI_FAIL(err, VOXDAG_ERR_INVALID_ARGUMENT, "RGB8 colours need 3 bytes per voxel");
     parts[0] = src->image + VOXDAG_FILE_HEADER_SIZE; /* placeholder, replaced below */
@@ -6317,8 +6648,12 @@ VOXDAG_API voxdag_status voxdag_with_colors_opts(const voxdag *src, voxdag_color
     d->owned = img;
     d->owned_size = (size_t)lay.total;
     st = voxdagi_open(d, img, d->owned_size, 0, VOXDAG_MAX_LEVELS, 0, &m, err);
-    if (st == VOXDAG_OK && kind != VOXDAG_COLORS_NONE && !(opts && opts->no_lod_colors))
-        st = voxdagi_attach_lod(&d, &m, err);
+    if (st == VOXDAG_OK && kind != VOXDAG_COLORS_NONE && !(opts && opts->no_lod_colors)) {
+        voxdagi_team team;
+        voxdagi_team_init(&team, &m, opts ? opts->threads : 1, opts ? &opts->thread_pool : NULL);
+        st = voxdagi_attach_lod(&d, &m, &team, err);
+        voxdagi_team_stop(&team);
+    }
     voxdagi_mem_destroy(&m);
     if (st != VOXDAG_OK) {
         voxdag_free(d);

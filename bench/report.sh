@@ -43,6 +43,7 @@ section() {
 optional() { $make -n "bench-$1" >/dev/null 2>&1; }
 
 section build "$build/bench/bench_build" bench/data $flag
+section threads sh bench/threads.sh "$mode" "$build/vdag" bench/data
 section geometry "$build/bench/bench_geometry" bench/data $flag
 if optional rays; then
     section rays $make -s --no-print-directory bench-rays BUILD="$build" BENCH_FLAGS="$flag"
@@ -75,6 +76,7 @@ tmp=$out/BENCHMARKS.md.tmp
     echo "## Build"
     echo
     cat "$out/build.md"
+    cat "$out/threads.md"
     echo "## Geometry"
     echo
     cat "$out/geometry.md"

@@ -22,4 +22,13 @@ typedef struct vdag_color_check {
    be read, or out of memory (OUT then undefined). */
 int vdag_check_colors(const voxcolor_view *view, FILE *raw, double bound, vdag_color_check *out);
 
+/* vdag_check_colors with each slice decoded and compared in THREADS jobs:
+   RUN (NULL: the calling thread) calls JOB(JOB_USER, i) once for every i in
+   [0, COUNT), on any threads, and returns when all have returned. The
+   result is the same whatever THREADS. */
+int vdag_check_colors_on(const voxcolor_view *view, FILE *raw, double bound,
+                         void (*run)(void *user, void (*job)(void *job_user, uint32_t index), void *job_user,
+                                     uint32_t count),
+                         void *run_user, uint32_t threads, vdag_color_check *out);
+
 #endif

@@ -57,6 +57,7 @@ typedef struct vi_ctx {
     uint64_t ear_budget;  /* point tests left for triangulating concave polygons */
     uint64_t polys_bad;   /* polygons fan-triangulated: degenerate or self-intersecting */
     uint64_t polys_costly; /* polygons fan-triangulated: past ear_budget */
+    struct vi_defer *defer; /* textures decoded in batches on limits.run; NULL: at once */
 } vi_ctx;
 
 /* C for one import: the message target and LIMITS with defaults filled in. */
@@ -68,6 +69,7 @@ static void vi_ctx_init(vi_ctx *c, const char *format, char *err, size_t err_siz
     c->base_dir = NULL;
     c->ear_budget = VI_EAR_BUDGET;
     c->polys_bad = c->polys_costly = 0;
+    c->defer = NULL;
     memset(&c->limits, 0, sizeof c->limits);
     if (limits) c->limits = *limits;
     if (!c->limits.max_input_bytes) c->limits.max_input_bytes = VDAG_IMPORT_MAX_INPUT_BYTES;
@@ -1547,6 +1549,98 @@ static void vi_tex_free(vi_texcache *cache) {
     cache->pixels = 0;
 }
 
+/* Textures decoded in batches on the caller's threads (limits.run): each
+   texture met gets a provisional image, -2 - N for the Nth, resolved once
+   the import is done (vi_defer_resolve); the batch is decoded when it holds
+   limits.threads textures, and at the end (vi_defer_flush), in order as
+   vi_texture would: the same images, warnings, pixel budget and errors. */
+typedef struct vi_defer_tex {
+    FILE *f;        /* open at the image's first byte; NULL once decoded */
+    char *path;
+    vdag_image img;
+    uint64_t max_pixels;
+    int got;        /* vdag_image_load_file's result */
+    char why[512];
+} vi_defer_tex;
+
+typedef struct vi_defer {
+    vi_buf batch;   /* vi_defer_tex */
+    vi_buf images;  /* int32_t per texture met: its image, or -1 */
+    uint64_t pixels; /* of the textures decoded so far */
+} vi_defer;
+
+static void vi_defer_job(void *user, uint32_t index) {
+    vi_defer_tex *t = (vi_defer_tex *)((vi_buf *)user)->data + index;
+    t->got = vdag_image_load_file(t->f, t->path, t->max_pixels, &t->img, t->why, sizeof t->why);
+    fclose(t->f);
+    t->f = NULL;
+}
+
+/* Drops the batch: files closed, images and names freed. */
+static void vi_defer_drop(vi_defer *d) {
+    size_t i;
+    for (i = 0; i < d->batch.count; i++) {
+        vi_defer_tex *t = (vi_defer_tex *)d->batch.data + i;
+        if (t->f) fclose(t->f);
+        vdag_image_free(&t->img);
+        free(t->path);
+    }
+    d->batch.count = 0;
+}
+
+/* Decodes the batch on the caller's threads and adds its images to S in
+   order. Returns 0 after reporting a failure. */
+static int vi_defer_flush(vi_ctx *c, vdag_scene *s) {
+    vi_defer *d = c->defer;
+    size_t i;
+    int ok = 1;
+    if (!d->batch.count) return 1;
+    for (i = 0; i < d->batch.count; i++)
+        ((vi_defer_tex *)d->batch.data)[i].max_pixels = c->limits.max_texture_pixels - d->pixels;
+    c->limits.run(c->limits.run_user, vi_defer_job, &d->batch, (uint32_t)d->batch.count);
+    for (i = 0; ok && i < d->batch.count; i++) {
+        vi_defer_tex *t = (vi_defer_tex *)d->batch.data + i;
+        int32_t *image = (int32_t *)vi_push(c, &d->images, sizeof *image, 1);
+        uint64_t pixels = (uint64_t)t->img.width * t->img.height;
+        if (!image) {
+            ok = 0;
+        } else if (t->got < 0 || (t->got > 0 && pixels > c->limits.max_texture_pixels - d->pixels)) {
+            vi_ctx named = *c;
+            named.format = t->path;
+            ok = vi_fail(&named, "a %lux%lu texture takes the textures past max_texture_pixels (%llu) pixels in all "
+                                 "(vdag build --max-texture-pixels N)",
+                         (unsigned long)t->img.width, (unsigned long)t->img.height,
+                         (vi_ull)c->limits.max_texture_pixels);
+        } else if (t->got) {
+            vdag_image *grown = (vdag_image *)VDAG_IMPORT_REALLOC(s->images, (s->image_count + 1) * sizeof *grown);
+            if (!grown) {
+                ok = vi_fail(c, "out of memory");
+            } else {
+                s->images = grown;
+                s->images[s->image_count] = t->img;
+                memset(&t->img, 0, sizeof t->img);
+                *image = (int32_t)s->image_count++;
+                d->pixels += pixels;
+            }
+        } else {
+            if (!c->limits.quiet) fprintf(stderr, "vdag: warning: %s; using the material colour\n", t->why);
+            *image = -1;
+        }
+    }
+    vi_defer_drop(d);
+    return ok;
+}
+
+/* Replaces the provisional images of S's materials by the decoded ones. */
+static void vi_defer_resolve(const vi_defer *d, vdag_scene *s) {
+    size_t i;
+    for (i = 0; i < s->material_count; i++) {
+        int32_t *image = &s->materials[i].image;
+        if (*image <= -2 && (size_t)(-2 - (int64_t)*image) < d->images.count)
+            *image = ((const int32_t *)d->images.data)[-2 - (int64_t)*image];
+    }
+}
+
 /* Sets *IMAGE to the scene image of texture FILE (named in a file in DIR),
    decoding it on first use; -1, with a warning, if it cannot be opened or
    decoded, or -1 when the caller skips textures: the material then keeps its
@@ -1590,6 +1684,21 @@ static int vi_texture(vi_ctx *c, vdag_scene *s, vi_texcache *cache, const char *
             *image = e->image = all[i].image;
             return 1;
         }
+    if (c->defer) { /* decoded with its batch; a provisional image until then */
+        vi_defer *d = c->defer;
+        vi_defer_tex *t = (vi_defer_tex *)vi_push(c, &d->batch, sizeof *t, 1);
+        size_t n = strlen(path) + 1;
+        if (!t) {
+            fclose(f);
+            return 0;
+        }
+        memset(t, 0, sizeof *t);
+        t->f = f;
+        if (!(t->path = (char *)vi_alloc(c, n, 1))) return 0; /* the batch closes F */
+        memcpy(t->path, path, n);
+        *image = e->image = -2 - (int32_t)(d->images.count + d->batch.count - 1);
+        return d->batch.count < c->limits.threads || vi_defer_flush(c, s);
+    }
     got = vdag_image_load_file(f, path, c->limits.max_texture_pixels - cache->pixels, &img, why, sizeof why);
     fclose(f);
     if (got < 0) {
@@ -2498,9 +2607,14 @@ static int vi_format(const char *ext) {
 /* Parses DATA as FORMAT into OUT (zeroed first; freed on failure). */
 static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_scene *out) {
     vi_text t;
+    vi_defer defer;
     int ok;
     memset(out, 0, sizeof *out);
     if (c->err_size) c->err[0] = 0;
+    memset(&defer, 0, sizeof defer);
+    if (c->limits.run && c->limits.threads > 1 && !c->limits.skip_textures &&
+        (format == VI_SPM || format == VI_OBJ || format == VI_MTL))
+        c->defer = &defer; /* the formats whose materials hold the images */
     switch (format) { /* text formats: past a UTF-8 byte order mark, UTF-16 refused */
     case VI_XYZ: ok = vi_text_start(c, data, size, &t) && vi_parse_xyz(c, &t, out); break;
     case VI_PLY: ok = vi_text_start(c, data, size, &t) && vi_parse_ply(c, &t, out); break;
@@ -2512,6 +2626,13 @@ static int vi_import(vi_ctx *c, int format, const char *data, size_t size, vdag_
     case VI_AC: ok = vi_text_start(c, data, size, &t) && vi_parse_ac(c, &t, out); break;
     case VI_STL: ok = vi_parse_stl(c, (const uint8_t *)data, size, out); break;
     default: ok = vi_fail(c, "unknown format (expected .xyz, .ply, .obj, .off, .stl, .vox, .mtl, .spm or .ac)"); break;
+    }
+    if (c->defer) {
+        if (ok && (ok = vi_defer_flush(c, out))) vi_defer_resolve(&defer, out);
+        vi_defer_drop(&defer);
+        vi_buf_free(&defer.batch);
+        vi_buf_free(&defer.images);
+        c->defer = NULL;
     }
     if (ok) vi_poly_warn(c);
     if (ok && out->point_count > c->limits.max_points)

@@ -113,6 +113,16 @@ typedef struct vdag_import_limits {
                                  input, .mtl libraries, textures): returning 0
                                  stops the import with an error */
     void *on_file_user;
+    /* Optional: textures decoded on the caller's threads. RUN calls
+       JOB(JOB_USER, i) once for every i in [0, COUNT), on any threads, and
+       returns when all have returned. With RUN and THREADS > 1, .spm, .obj
+       and .mtl imports decode textures THREADS at a time (the files are
+       still opened, and on_file called, as they are met; the scene,
+       warnings and errors are the same, warnings coming when each batch is
+       done); NULL, or THREADS 0 or 1: one by one as they are met. */
+    void (*run)(void *user, void (*job)(void *job_user, uint32_t index), void *job_user, uint32_t count);
+    void *run_user;
+    uint32_t threads;
 } vdag_import_limits;
 
 #ifndef VDAG_IMPORT_MAX_INPUT_BYTES

@@ -35,6 +35,7 @@
 #include <time.h>
 #include <sys/stat.h>
 #include <sys/statvfs.h>
+#include <pthread.h>
 #include <unistd.h>
 #ifdef _WIN32
 #include <io.h>
@@ -185,7 +186,8 @@ static const struct {
      "  --no-lod-colors    write no level-of-detail colour section (default: write it: the mean\n"
      "                     colour of cells of more than 64 voxels, about 1-25% of the colours)\n"
      "  --timings          print each phase's wall and CPU seconds at the end (read, voxelize,\n"
-     "                     reduce, encode, colours, colour check, colour attach, save)\n"},
+     "                     reduce, encode, colours, colour check, colour attach, save): the\n"
+     "                     process's CPU and the building thread's (main CPU)\n"},
     {"build", /* the rest (a C99 string holds at most 4095 characters; vdag_help prints both) */
      "  --no-alpha-test    texels of any alpha make voxels (default: a texel with alpha below one\n"
      "                     half makes none, as renderers discard it; foliage keeps its holes)\n"
@@ -291,6 +293,42 @@ static double now_seconds(void) {
     return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
+/* A batch of jobs on threads made for it: JOB(USER, i) for every i in
+   [0, COUNT). */
+typedef struct job_batch {
+    void (*job)(void *user, uint32_t index);
+    void *user;
+    uint32_t count, next;
+    pthread_mutex_t lock;
+} job_batch;
+
+static void *job_batch_work(void *arg) {
+    job_batch *b = (job_batch *)arg;
+    for (;;) {
+        uint32_t i;
+        pthread_mutex_lock(&b->lock);
+        i = b->next < b->count ? b->next++ : b->count;
+        pthread_mutex_unlock(&b->lock);
+        if (i == b->count) return NULL;
+        b->job(b->user, i);
+    }
+}
+
+/* vdag_import_limits.run: COUNT jobs on up to *USER threads (the calling one
+   too, which does them all when no thread can be made); returns when all
+   are done. */
+static void run_jobs(void *user, void (*job)(void *job_user, uint32_t index), void *job_user, uint32_t count) {
+    pthread_t tid[64];
+    uint32_t threads = *(const uint32_t *)user, t = 0;
+    job_batch b;
+    b.job = job, b.user = job_user, b.count = count, b.next = 0;
+    pthread_mutex_init(&b.lock, NULL);
+    while (t + 1 < threads && t + 1 < count && t < 64 && !pthread_create(&tid[t], NULL, job_batch_work, &b)) t++;
+    job_batch_work(&b);
+    while (t > 0) pthread_join(tid[--t], NULL);
+    pthread_mutex_destroy(&b.lock);
+}
+
 static int parse_u32(const char *s, uint32_t *out) {
     char *end;
     unsigned long v;
@@ -330,13 +368,16 @@ static const char *symmetry_name(voxdag_symmetry s) {
 /* --timings: wall and CPU seconds of each phase of a build. A phase lasts
    from its first report to the next phase's; phases that alternate (a mesh
    is voxelized and reduced chunk by chunk) add up. The CPU seconds are the
-   whole process's, so CPU / wall is the phase's parallelism. */
+   whole process's, so CPU / wall is the phase's parallelism; main CPU is
+   the building thread's alone (on 2 threads, main CPU less the rest is
+   what that thread did alone: a measure that other processes on the
+   machine do not skew). */
 enum { PHASES = 12 };
 typedef struct phase_times {
     const char *name[PHASES];
-    double wall[PHASES], cpu[PHASES];
+    double wall[PHASES], cpu[PHASES], main[PHASES]; /* MAIN: the building thread's CPU */
     int count, current; /* current: the running phase, -1 none */
-    double wall0, cpu0; /* when it last started */
+    double wall0, cpu0, main0; /* when it last started */
 } phase_times;
 
 static double cpu_seconds(void) {
@@ -347,11 +388,21 @@ static double cpu_seconds(void) {
 
 /* Ends the running phase and starts NAME (a string that outlives P; NULL:
    none). */
+/* CPU seconds of the calling thread. */
+static double thread_cpu_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
 static void phase_enter(phase_times *p, const char *name) {
-    double wall = now_seconds(), cpu = cpu_seconds();
+    double wall = now_seconds(), cpu = cpu_seconds(), main = thread_cpu_seconds();
     int i;
-    if (p->current >= 0) p->wall[p->current] += wall - p->wall0, p->cpu[p->current] += cpu - p->cpu0;
-    p->wall0 = wall, p->cpu0 = cpu, p->current = -1;
+    if (p->current >= 0) {
+        p->wall[p->current] += wall - p->wall0, p->cpu[p->current] += cpu - p->cpu0;
+        p->main[p->current] += main - p->main0;
+    }
+    p->wall0 = wall, p->cpu0 = cpu, p->main0 = main, p->current = -1;
     if (!name) return;
     for (i = 0; i < p->count && strcmp(p->name[i], name); i++) continue;
     if (i == PHASES) return; /* more phases than slots: the rest go uncounted */
@@ -360,15 +411,15 @@ static void phase_enter(phase_times *p, const char *name) {
 }
 
 static void phase_print(const phase_times *p) {
-    double wall = 0, cpu = 0;
+    double wall = 0, cpu = 0, main = 0;
     int i;
-    fprintf(stderr, "vdag: timings      wall s    CPU s  CPU/wall\n");
+    fprintf(stderr, "vdag: timings      wall s    CPU s  CPU/wall  main CPU s\n");
     for (i = 0; i < p->count; i++) {
-        fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", p->name[i], p->wall[i], p->cpu[i],
-                p->wall[i] > 0 ? p->cpu[i] / p->wall[i] : 0.0);
-        wall += p->wall[i], cpu += p->cpu[i];
+        fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f %8.3f\n", p->name[i], p->wall[i], p->cpu[i],
+                p->wall[i] > 0 ? p->cpu[i] / p->wall[i] : 0.0, p->main[i]);
+        wall += p->wall[i], cpu += p->cpu[i], main += p->main[i];
     }
-    fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f\n", "total", wall, cpu, wall > 0 ? cpu / wall : 0.0);
+    fprintf(stderr, "vdag:   %-13s %8.3f %8.3f %6.2f %8.3f\n", "total", wall, cpu, wall > 0 ? cpu / wall : 0.0, main);
 }
 
 typedef struct build_args {
@@ -964,7 +1015,7 @@ static int verify_spill(color_spill *spill, const grow_buf *g, const build_args 
         return vdag_fail("colour check: the stream holds %llu colours, the spill %llu", (unsigned long long)view.count,
                          (unsigned long long)spill->n);
     rewind(spill->f);
-    if (!vdag_check_colors(&view, spill->f, a->color_error, &c))
+    if (!vdag_check_colors_on(&view, spill->f, a->color_error, run_jobs, (void *)&a->threads, a->threads, &c))
         return vdag_fail("colour check: cannot read the raw colours back (or out of memory)");
     if (c.over)
         return vdag_fail("colour check FAILED: %llu of %llu colours are off by more than e_t %g (first: colour %llu; "
@@ -991,6 +1042,7 @@ static int attach_colors(voxdag **dag, color_spill *spill, build_args *a) {
     int rc;
     memset(&o, 0, sizeof o);
     o.no_lod_colors = a->no_lod_colors;
+    o.threads = a->threads; /* the level-of-detail means */
     if (!a->quiet && spill->n)
         fprintf(stderr, "vdag: colour spill: %s of temporary disk in %s (%llu colours)\n",
                 spill_size((double)size, text), spill->dir, (unsigned long long)spill->n);
@@ -1368,6 +1420,9 @@ static int cmd_build(int argc, char **argv) {
     guard.clash[0] = 0;
     limits.on_file = guard_read;
     limits.on_file_user = &guard;
+    limits.run = run_jobs; /* textures decoded --threads at a time */
+    limits.run_user = &a.threads;
+    limits.threads = a.threads;
     if (!vdag_import_file(a.in, &limits, &sc, msg, sizeof msg)) {
         if (guard.clash[0])
             return vdag_fail("%s: is %s, a file the build reads; refusing to write over it", a.out, guard.clash);

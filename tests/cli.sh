@@ -187,10 +187,10 @@ check "build --no-lod-colors: the same voxels and colours without the level-of-d
     '$VDAG' info '$T/lod.vdag' --json | grep -q '\"lod_colors\": [1-9]' &&
     '$VDAG' info '$T/nolod.vdag' --json | grep -q '\"lod_colors\": 0,' &&
     '$VDAG' export-voxels '$T/lod.vdag' >'$T/lod.txt' && '$VDAG' export-voxels '$T/nolod.vdag' | cmp -s - '$T/lod.txt'"
-check "build --timings: every phase of the build, and the total, in wall and CPU seconds" sh -c "
+check "build --timings: every phase of the build, and the total, in wall, CPU and main-thread CPU seconds" sh -c "
     '$VDAG' build '$T/demo6.xyz' '$T/timed.vdag' --color-error 0.02 --verify-colors --timings --quiet 2>'$T/err' &&
     for p in read encode colours 'colour check' 'colour attach' save total; do
-        grep -q \"^vdag:   \$p  *[0-9.]* *[0-9.]* *[0-9.]*\$\" '$T/err' || exit 1; done &&
+        grep -q \"^vdag:   \$p  *[0-9.]* *[0-9.]* *[0-9.]* *[0-9.]*\$\" '$T/err' || exit 1; done &&
     '$VDAG' build '$T/demo6.xyz' '$T/untimed.vdag' --color-error 0.02 --quiet && cmp -s '$T/timed.vdag' '$T/untimed.vdag'"
 check "thread count does not change the file" sh -c "'$VDAG' build '$T/in.xyz' '$T/t1.vdag' --levels 5 --threads 1 2>/dev/null &&
     '$VDAG' build '$T/in.xyz' '$T/t3.vdag' --levels 5 --threads 3 2>/dev/null && cmp -s '$T/t1.vdag' '$T/a.vdag' && cmp -s '$T/t3.vdag' '$T/a.vdag'"

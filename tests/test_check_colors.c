@@ -1,7 +1,8 @@
 /* vdag build --verify-colors (examples/check_colors.c): the streaming check
    against brute force (each colour decoded alone, its distance computed
    here), on a lossy stream of more than one slice, with the encoder's bound
-   and a too-tight one, on a corrupted stream and on a short raw file. */
+   and a too-tight one (also split in jobs), on a corrupted stream and on a
+   short raw file. */
 #include "test.h"
 #include "examples/check_colors.h"
 
@@ -67,6 +68,13 @@ static uint8_t *check_colors_encode(const uint8_t *rgb, size_t n, double e, size
     return s;
 }
 
+/* A RUN hook for vdag_check_colors_on: the jobs on the calling thread, last first. */
+static void check_colors_backwards(void *user, void (*job)(void *job_user, uint32_t index), void *job_user,
+                                   uint32_t count) {
+    (void)user;
+    while (count > 0) job(job_user, --count);
+}
+
 static void test_check_colors_bound(void) {
     const size_t n = ((size_t)1 << 20) + 777; /* two slices */
     uint8_t *rgb = check_colors_input(n, 1), *s;
@@ -95,6 +103,18 @@ static void test_check_colors_bound(void) {
                   (unsigned long long)got.first_over, want.max_error, (unsigned long long)want.worst,
                   (unsigned long long)want.over, (unsigned long long)want.first_over);
         CHECK(b ? got.over > 0 : got.over == 0 && got.max_error > 0.02);
+        { /* the same in 2, 3 and 7 jobs */
+            static const uint32_t threads[] = {2, 3, 7};
+            size_t t;
+            for (t = 0; t < sizeof threads / sizeof threads[0]; t++) {
+                vdag_color_check par;
+                rewind(f);
+                CHECK(vdag_check_colors_on(&v, f, bounds[b], check_colors_backwards, NULL, threads[t], &par));
+                CHECK_MSG(check_colors_same(&par, &want), "bound %g, %u jobs: max %g at %llu, %llu over from %llu",
+                          bounds[b], threads[t], par.max_error, (unsigned long long)par.worst,
+                          (unsigned long long)par.over, (unsigned long long)par.first_over);
+            }
+        }
     }
     if (f) fclose(f);
     free(s);

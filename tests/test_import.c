@@ -1022,11 +1022,21 @@ static void test_side_files(void) {
     rmdir(dir);
 }
 
+/* vdag_import_limits.run for the tests: the jobs on the calling thread,
+   last first. */
+static void run_backwards(void *user, void (*job)(void *job_user, uint32_t index), void *job_user, uint32_t count) {
+    (void)user;
+    while (count > 0) job(job_user, --count);
+}
+
 /* Textures are cached by file identity: one file named under several
    spellings is decoded once and counted once against max_texture_pixels,
-   the pixel budget of all textures of an import. */
+   the pixel budget of all textures of an import. The same with textures
+   decoded in batches of 2 and 3 on the caller's threads (limits.run), and
+   an undecodable texture among them keeps its material's colour. */
 static void test_texture_budget(void) {
-    char dir[] = "/tmp/vdag-tex-XXXXXX", path[256], lib[256], sub[256], tex[256], tex2[256], mtl[1024], err[512];
+    char dir[] = "/tmp/vdag-tex-XXXXXX", path[256], lib[256], sub[256], tex[256], tex2[256], bad[256], mtl[1024],
+         err[512];
     const char *obj = "mtllib lib.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
                       "usemtl a\nf 1/1 2/2 3/3\nusemtl b\nf 1/1 2/2 3/3\nusemtl c\nf 1/1 2/2 3/3\n"
                       "usemtl d\nf 1/1 2/2 3/3\n";
@@ -1034,7 +1044,7 @@ static void test_texture_budget(void) {
     vdag_import_limits lim;
     vdag_scene s;
     vdag_image probe;
-    int decodes, k;
+    int decodes, k, v;
     CHECK(mkdtemp(dir) != NULL);
     snprintf(path, sizeof path, "%s/scene.obj", dir);
     CHECK(write_file(path, obj, strlen(obj)));
@@ -1052,35 +1062,64 @@ static void test_texture_budget(void) {
     snprintf(mtl, sizeof mtl, "newmtl a\nmap_Kd a.ppm\nnewmtl b\nmap_Kd ./a.ppm\nnewmtl c\nmap_Kd sub/../a.ppm\n"
                               "newmtl d\nmap_Kd %s\n", tex);
     CHECK(write_file(lib, mtl, strlen(mtl)));
-    for (k = 0; k < 2; k++) { /* 6 pixels: within a budget of 6, not of 5 */
+    for (k = 0; k < 6; k++) { /* 6 pixels: within a budget of 6, not of 5 */
+        v = k >> 1; /* one by one, in batches of 2, of 3 */
         memset(&lim, 0, sizeof lim);
+        lim.run = run_backwards;
+        lim.threads = v ? (uint32_t)v + 1 : 0;
         lim.quiet = 1;
-        lim.max_texture_pixels = 6 - (uint64_t)k;
+        lim.max_texture_pixels = 6 - (uint64_t)(k & 1);
         if (!decodes) break;
         if (vdag_import_file(path, &lim, &s, err, sizeof err)) {
-            CHECK(!k);
+            CHECK(!(k & 1));
             CHECK_MSG(s.image_count == 1, "%zu images", s.image_count);
             CHECK(s.material_count == 4 && s.materials[0].image == 0 && s.materials[1].image == 0 &&
                   s.materials[2].image == 0 && s.materials[3].image == 0);
             vdag_scene_free(&s);
         } else {
-            CHECK_MSG(k && strstr(err, "max_texture_pixels") && strstr(err, "--max-texture-pixels"), "%s", err);
+            CHECK_MSG((k & 1) && strstr(err, "max_texture_pixels") && strstr(err, "--max-texture-pixels"), "%s", err);
         }
     }
     /* Two files of 6 pixels each: 12 in all. */
     snprintf(mtl, sizeof mtl, "newmtl a\nmap_Kd a.ppm\nnewmtl b\nmap_Kd b.ppm\nnewmtl c\nmap_Kd ./b.ppm\n");
     CHECK(write_file(lib, mtl, strlen(mtl)));
-    for (k = 0; decodes && k < 2; k++) {
+    for (k = 0; decodes && k < 6; k++) {
+        v = k >> 1;
         memset(&lim, 0, sizeof lim);
+        lim.run = run_backwards;
+        lim.threads = v ? (uint32_t)v + 1 : 0;
         lim.quiet = 1;
-        lim.max_texture_pixels = 12 - (uint64_t)k;
+        lim.max_texture_pixels = 12 - (uint64_t)(k & 1);
         if (vdag_import_file(path, &lim, &s, err, sizeof err)) {
-            CHECK(!k && s.image_count == 2);
+            CHECK(!(k & 1) && s.image_count == 2);
             vdag_scene_free(&s);
         } else {
-            CHECK_MSG(k && strstr(err, "b.ppm") && strstr(err, "max_texture_pixels (11)"), "%s", err);
+            CHECK_MSG((k & 1) && strstr(err, "b.ppm") && strstr(err, "max_texture_pixels (11)"), "%s", err);
         }
     }
+    /* A texture that does not decode between them: its material keeps its
+       colour, the others' images are numbered as they are met. */
+    snprintf(mtl, sizeof mtl, "newmtl a\nmap_Kd bad.ppm\nnewmtl b\nmap_Kd b.ppm\nnewmtl c\nmap_Kd a.ppm\n"
+                              "newmtl d\nmap_Kd ./b.ppm\n");
+    CHECK(write_file(lib, mtl, strlen(mtl)));
+    snprintf(bad, sizeof bad, "%s/bad.ppm", dir);
+    CHECK(write_file(bad, "not an image", 12));
+    for (v = 0; decodes && v < 4; v++) {
+        memset(&lim, 0, sizeof lim);
+        lim.run = run_backwards;
+        lim.threads = (uint32_t)v + (v > 0);
+        lim.quiet = 1;
+        if (vdag_import_file(path, &lim, &s, err, sizeof err)) {
+            CHECK_MSG(s.image_count == 2 && s.material_count == 4 && s.materials[0].image == -1 &&
+                          s.materials[1].image == 0 && s.materials[2].image == 1 && s.materials[3].image == 0,
+                      "batches of %u: %zu images, %d %d %d %d", lim.threads, s.image_count, s.materials[0].image,
+                      s.materials[1].image, s.materials[2].image, s.materials[3].image);
+            vdag_scene_free(&s);
+        } else {
+            CHECK_MSG(0, "%s", err);
+        }
+    }
+    remove(bad);
     remove(lib);
     remove(tex);
     remove(tex2);

@@ -554,8 +554,167 @@ done:
     free(cur);
 }
 
-/* Every allocation of voxdag_with_colors failing in turn, for both kinds:
-   VOXDAG_ERR_OUT_OF_MEMORY with nothing held, or the same file. */
+/* A host pool (voxdag_thread_pool) that runs a batch's jobs last first in
+   its WAIT, and counts the jobs. */
+typedef struct lod_pool {
+    voxdag_job_fn job;
+    void *job_user;
+    uint32_t count;
+    size_t jobs;
+} lod_pool;
+
+static void lod_pool_run(void *user, voxdag_job_fn job, void *job_user, uint32_t count) {
+    lod_pool *p = (lod_pool *)user;
+    p->job = job, p->job_user = job_user, p->count = count;
+}
+
+static void lod_pool_wait(void *user) {
+    lod_pool *p = (lod_pool *)user;
+    uint32_t i;
+    for (i = p->count; i-- > 0;) p->job(p->job_user, i);
+    p->jobs += p->count;
+    p->count = 0;
+}
+
+/* Options for VARIANT 0..3: 2, 3 or 4 threads of the built-in pool, or 3
+   jobs a batch on the host pool P. */
+static void lod_variant(int variant, voxdag_build_opts *o, lod_pool *p) {
+    memset(o, 0, sizeof *o);
+    memset(p, 0, sizeof *p);
+    o->threads = variant < 3 ? (uint32_t)variant + 2 : 3;
+    if (variant == 3) {
+        o->thread_pool.run = lod_pool_run;
+        o->thread_pool.wait = lod_pool_wait;
+        o->thread_pool.user = p;
+    }
+}
+
+/* Whether A and B are the same file image. */
+static int same_image(const voxdag *a, const voxdag *b) {
+    size_t na, nb;
+    const void *ia = voxdag_image(a, &na), *ib = voxdag_image(b, &nb);
+    return a && b && na == nb && !memcmp(ia, ib, na);
+}
+
+/* The level-of-detail means on threads: voxdag_with_colors_opts with 2, 3
+   and 4 threads of the built-in pool and on a host pool, and the builder
+   with 1 and 4 threads, give the bytes of one thread, for both colour
+   kinds: the dense scenes (L = 2..7) and a sphere shell at L = 10, whose
+   cells are split a few levels above the ones that sum their voxels. */
+static void test_lod_colors_threads(void) {
+    static const int kinds[] = {RS_SPARSE, RS_SPHERE, RS_BLOB};
+    uint32_t levels;
+    size_t k;
+    for (levels = 2; levels <= 10; levels += levels < 7 ? 1 : 3) /* 2..7, then 10 */
+        for (k = 0; k < (levels <= 7 ? sizeof kinds / sizeof kinds[0] : 1); k++) {
+            rscene s;
+            voxdag *d = NULL, *one[2];
+            int kind, variant;
+            if (levels <= 7) d = rscene_make(&s, kinds[k], levels, (int)(k % 3), 0x7D0 + 17 * levels + (uint32_t)k);
+            else { /* a sphere shell from voxels, on 1 and 4 threads */
+                uint32_t n = 1u << levels, i, count = 0, *xyz = (uint32_t *)malloc(12 * (size_t)200000);
+                uint8_t *rgb = (uint8_t *)malloc(3 * (size_t)200000);
+                uint64_t r = 0x5EED + levels;
+                voxdag *dt[2] = {NULL, NULL};
+                unsigned t;
+                for (i = 0; xyz && rgb && i < 200000; i++) {
+                    double u = (double)test_rand_below(&r, 1u << 20) / (1 << 20) * 2 - 1;
+                    double a = (double)test_rand_below(&r, 1u << 20) / (1 << 20) * 6.283185307179586;
+                    double rad = 0.45 * n, q = sqrt(1 - u * u);
+                    xyz[3 * count] = (uint32_t)(0.5 * n + rad * q * cos(a));
+                    xyz[3 * count + 1] = (uint32_t)(0.5 * n + rad * q * sin(a));
+                    xyz[3 * count + 2] = (uint32_t)(0.5 * n + rad * u);
+                    rgb[3 * count] = (uint8_t)test_rand(&r), rgb[3 * count + 1] = (uint8_t)(xyz[3 * count] >> 2);
+                    rgb[3 * count + 2] = (uint8_t)(xyz[3 * count + 2] >> 2);
+                    count++;
+                }
+                for (t = 0; t < 2 && xyz && rgb; t++) {
+                    voxdag_build_opts o;
+                    voxdag_builder *b = NULL;
+                    memset(&o, 0, sizeof o);
+                    o.levels = levels;
+                    o.colors = 1;
+                    o.threads = t ? 4 : 1;
+                    CHECK(voxdag_builder_create(&o, &b, NULL) == VOXDAG_OK);
+                    CHECK(voxdag_builder_add(b, xyz, rgb, count, NULL) == VOXDAG_OK);
+                    CHECK(voxdag_builder_finish(b, &dt[t], NULL, NULL) == VOXDAG_OK);
+                }
+                CHECK_MSG(same_image(dt[0], dt[1]), "L = %u: the builder's file differs on 4 threads", levels);
+                voxdag_free(dt[1]);
+                d = dt[0];
+                free(xyz);
+                free(rgb);
+                if (!d) continue;
+                for (kind = 0; kind < 2; kind++) {
+                    const void *pc;
+                    size_t pn;
+                    voxdag_color_kind ck = voxdag_colors(d, &pc, &pn);
+                    voxdag *v = NULL;
+                    if (kind) { /* a voxcolor copy of the colours */
+                        voxcolor_encode_opts vo;
+                        size_t cap = voxcolor_encode_bound(pn / 3), len;
+                        uint8_t *buf = (uint8_t *)malloc(cap);
+                        memset(&vo, 0, sizeof vo);
+                        vo.max_error = 0.02;
+                        len = buf ? voxcolor_encode(buf, cap, (const uint8_t *)pc, pn / 3, &vo, NULL) : 0;
+                        CHECK(len > 0 && voxdag_with_colors(d, VOXDAG_COLORS_VOXCOLOR, buf, len, &v, NULL) == VOXDAG_OK);
+                        free(buf);
+                        if (!v) continue;
+                        ck = voxdag_colors(v, &pc, &pn);
+                    }
+                    for (variant = 0; variant < 4; variant++) {
+                        voxdag_build_opts o;
+                        lod_pool p;
+                        voxdag *w = NULL;
+                        lod_variant(variant, &o, &p);
+                        CHECK(voxdag_with_colors_opts(kind ? v : d, ck, pc, pn, &o, &w, NULL) == VOXDAG_OK);
+                        CHECK_MSG(same_image(kind ? v : d, w), "L = %u, kind %d: %u threads%s differ", levels, kind,
+                                  o.threads, variant == 3 ? " (host pool)" : "");
+                        if (variant == 3) CHECK(p.jobs > 0);
+                        voxdag_free(w);
+                    }
+                    voxdag_free(v);
+                }
+                voxdag_free(d);
+                continue;
+            }
+            if (!d) continue;
+            one[0] = recolored(d, &s, VOXDAG_COLORS_RGB8, NULL);
+            one[1] = recolored(d, &s, VOXDAG_COLORS_VOXCOLOR, NULL);
+            for (kind = 0; kind < 2; kind++)
+                for (variant = 0; variant < 4 && one[kind]; variant++) {
+                    voxdag_build_opts o;
+                    lod_pool p;
+                    voxdag *w;
+                    lod_variant(variant, &o, &p);
+                    w = recolored(d, &s, kind ? VOXDAG_COLORS_VOXCOLOR : VOXDAG_COLORS_RGB8, &o);
+                    CHECK_MSG(same_image(one[kind], w), "L = %u, scene %u, kind %d: %u threads%s differ", levels,
+                              (unsigned)k, kind, o.threads, variant == 3 ? " (host pool)" : "");
+                    voxdag_free(w);
+                }
+            /* a pool with run but no wait is refused */
+            if (one[0]) {
+                voxdag_build_opts o;
+                lod_pool p;
+                const void *pc;
+                size_t pn;
+                voxdag *w = NULL;
+                voxdag_color_kind ck = voxdag_colors(one[0], &pc, &pn);
+                memset(&o, 0, sizeof o);
+                o.thread_pool.run = lod_pool_run;
+                o.thread_pool.user = &p;
+                CHECK(voxdag_with_colors_opts(one[0], ck, pc, pn, &o, &w, NULL) == VOXDAG_ERR_INVALID_ARGUMENT && !w);
+            }
+            voxdag_free(one[0]);
+            voxdag_free(one[1]);
+            voxdag_free(d);
+            rscene_free(&s);
+        }
+}
+
+/* Every allocation of voxdag_with_colors failing in turn, for both kinds,
+   on one thread and on two: VOXDAG_ERR_OUT_OF_MEMORY with nothing held, or
+   the same file. */
 static void test_lod_colors_allocation_failures(void) {
     rscene s;
     voxdag *d = rscene_make(&s, RS_SPHERE, 5, 1, 0xA110C), *v = NULL;
@@ -580,19 +739,22 @@ static void test_lod_colors_allocation_failures(void) {
         ck = voxdag_colors(dag, &pc, &pn);
         CHECK(voxdag_with_colors(dag, ck, pc, pn, &ref, NULL) == VOXDAG_OK);
         want = voxdag_image(ref, &want_size);
-        for (n = 0; !done && n < 1000; n++) {
+        for (n = 0; !done && n < 2000; n++) {
             uint64_t held = ca.held;
             voxdag *out = NULL;
             voxdag_status st;
-            ca.calls = 0, ca.fail_at = n;
-            st = voxdag_with_colors(dag, ck, pc, pn, &out, NULL);
+            voxdag_build_opts o;
+            memset(&o, 0, sizeof o);
+            o.threads = (uint32_t)(n & 1) + 1; /* the team's pool and its cells fail too */
+            ca.calls = 0, ca.fail_at = n >> 1;
+            st = voxdag_with_colors_opts(dag, ck, pc, pn, &o, &out, NULL);
             CHECK_MSG(st == VOXDAG_OK || (st == VOXDAG_ERR_OUT_OF_MEMORY && !out), "kind %d, allocation %ld: %d",
                       kind, n, (int)st);
             if (st == VOXDAG_OK) {
                 size_t got_size;
                 const void *got = voxdag_image(out, &got_size);
                 CHECK(got_size == want_size && !memcmp(got, want, want_size));
-                done = ca.calls <= n;
+                done = ca.calls <= (n >> 1) && (n & 1);
             }
             voxdag_free(out);
             CHECK_MSG(ca.held == held && !ca.bad_free, "kind %d, allocation %ld: %llu bytes left", kind, n,
@@ -615,6 +777,7 @@ const test_case test_lod_colors_cases[] = {
     {"lod_colors_option", test_lod_colors_option},
     {"lod_colors_corrupt", test_lod_colors_corrupt},
     {"lod_colors_older_file", test_lod_colors_older_file},
+    {"lod_colors_threads", test_lod_colors_threads},
     {"lod_colors_allocation_failures", test_lod_colors_allocation_failures},
     {NULL, NULL},
 };
