@@ -240,14 +240,20 @@ test-real: $(BUILD)/vdag $(BUILD)/import_dump
 
 TEST_PROGRAMS := $(BUILD)/test $(BUILD)/test_voxcolor_ndebug $(BUILD)/test_voxdag_ndebug $(BUILD)/vdag $(BUILD)/fuzz_import $(BUILD)/fuzz_voxcolor $(BUILD)/fuzz_load $(BUILD)/fuzz_roundtrip $(BUILD)/fuzz_edit $(BUILD)/import_dump $(BUILD)/edit_demo $(BUILD)/test_vk $(BUILD)/test_gpu_vk \
                  $(if $(VULKAN),$(VK_SMOKE:.h=.spv) $(VDAG_KERNEL:.h=.spv) $(README_SHADERS))
-test: deps $(TEST_PROGRAMS)
+# The test programs build on every CPU (a sub-make with -j), after deps.
+JOBS := $(shell nproc 2>/dev/null || echo 2)
+.PHONY: test-programs
+test-programs: deps
+	@$(MAKE) --no-print-directory -j$(JOBS) $(TEST_PROGRAMS)
+
+test: test-programs
 	@sh tests/run.sh $(BUILD)
 
 # The same with exhaustive sweeps: every byte of every golden file, colour
 # stream, importer sample and fuzz seed patched to each of its 255 other
 # values (about an hour of CPU).
 .PHONY: test-full
-test-full: deps $(TEST_PROGRAMS)
+test-full: test-programs
 	@sh tests/run.sh $(BUILD) --full
 
 clean:
