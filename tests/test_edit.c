@@ -593,6 +593,36 @@ static void test_edit_errors(void) {
 /* Sharing does not decay: after edits, the unique nodes the editor reaches
    per level are the canonical counts of the final voxels (the builder's),
    and carving a hole and filling it back gives the first scene's counts. */
+/* An edit after an undo reuses the colour blocks of the edit it discards:
+   fill, undo, fill again ... holds no more memory after the second round
+   than after the tenth (it grew by the fill's blocks every round before). */
+static void test_edit_memory_reused(void) {
+    voxdag_editor_opts o;
+    voxdag_editor *ed = NULL;
+    voxdag_shape s;
+    voxdag_brush b;
+    uint64_t second = 0;
+    int round;
+    memset(&o, 0, sizeof o);
+    o.levels = 7;
+    o.colors = 1;
+    memset(&s, 0, sizeof s);
+    s.kind = VOXDAG_SHAPE_SPHERE;
+    s.center[0] = s.center[1] = s.center[2] = 64;
+    s.radius = 40;
+    memset(&b, 0, sizeof b);
+    b.rgb[0] = 7;
+    CHECK(voxdag_editor_create(NULL, &o, &ed, NULL) == VOXDAG_OK);
+    for (round = 1; ed && round <= 10; round++) {
+        CHECK(voxdag_editor_fill(ed, &s, &b, NULL) == VOXDAG_OK);
+        CHECK(voxdag_editor_undo(ed) == 1);
+        if (round == 2) second = voxdag_editor_memory(ed);
+    }
+    CHECK_MSG(voxdag_editor_memory(ed) == second, "memory after 10 rounds %llu, after 2 %llu",
+              (unsigned long long)voxdag_editor_memory(ed), (unsigned long long)second);
+    voxdag_editor_free(ed);
+}
+
 static void test_edit_sharing(void) {
     int g;
     for (g = 0; g < 3; g++) {
@@ -643,5 +673,6 @@ const test_case test_edit_cases[] = {
     {"edit allocation failures", test_edit_alloc_failures},
     {"edit errors", test_edit_errors},
     {"edit sharing", test_edit_sharing},
+    {"edit memory reused after undo", test_edit_memory_reused},
     {NULL, NULL},
 };
