@@ -17,17 +17,17 @@ X=x/supertuxkart-data/usr/share/games/supertuxkart/data/tracks/abyss/abyss_track
 C=x/flightgear-data-models/usr/share/games/flightgear/Models/Maritime/Military/CG-57-high-detail/CG-57.ac
 # name|input (demo: the built-in scene)|L|G|eye|target|fov
 scenes="demo|demo|10|1024|2600 -1800 1500|512 512 200|30
-tree|tree.vox|0|256|700 -420 420|128 128 100|30"
+tree|tree.vox|0|256|1850 -1110 1060|128 128 100|30"
 [ "$mode" = full ] && scenes="$scenes
 abyss|$X|11|1024|1900 -600 1200|512 412 40|40
 CG-57|$C|11|1024|2300 -1500 900|512 61 110|30"
 
 echo "## Pictures at a distance"
 echo
-echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. A level-of-detail cell is drawn as the voxels it holds: their mean colour (the file's level-of-detail colour section for cells of more than 64 voxels), lit as a voxel staircase from the occupancy of its six neighbouring cells (README, \`vdag render\`). Last two columns: the level-of-detail colour section of the same scene built with \`--color-error 0.02\`, in bytes and as a share of that file's colour section."
+echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. A level-of-detail cell is drawn as the voxels it holds: their mean colour (the file's level-of-detail colour section for cells of more than 64 voxels), lit as a voxel staircase facing the normal of the occupancy around it, over the share of the pixel's 4 x 4 sub-rays its finer cells stop, the ray going on past it for the rest (README, \`vdag render\`); \`--lod-opaque\` (the GPU kernel's model) draws a cell over the whole pixel, lit from the occupancy gradient of its six neighbours. The tree's view puts about two voxels in a pixel (a nearer one, with voxels larger than pixels, has no cell for \`--lod 1\` to stop at). Last two columns: the level-of-detail colour section of the same scene built with \`--color-error 0.02\`, in bytes and as a share of that file's colour section."
 echo
-echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --samples 4 gain (dB) | --lod 1 gain (dB) | LOD colours (bytes) | share of colours at e_t 0.02 |"
-echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --lod 1 --lod-opaque | --samples 4 gain (dB) | --lod 1 gain (dB) | LOD colours (bytes) | share of colours at e_t 0.02 |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     echo "distance: $name" >&2
     if [ "$in" = demo ]; then
@@ -65,7 +65,8 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     shot s16 --samples 16 && p16=$(psnr s16)
     shot l1 --lod 1 && pl1=$(psnr l1)
     shot l2 --lod 2 && pl2=$(psnr l2)
-    awk -v n="$name" -v L="$levels" -v a="$p1" -v b="$p4" -v c="$p16" -v d="$pl1" -v e="$pl2" -v lb="$lodb" -v cb="$colb" \
-        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f | %d | %.1f %% |\n", n, L, a, b, c, d, e, b - a, d - a, lb, 100 * lb / cb }'
+    shot o1 --lod 1 --lod-opaque && po1=$(psnr o1)
+    awk -v n="$name" -v L="$levels" -v a="$p1" -v b="$p4" -v c="$p16" -v d="$pl1" -v e="$pl2" -v o="$po1" -v lb="$lodb" -v cb="$colb" \
+        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f | %d | %.1f %% |\n", n, L, a, b, c, d, e, o, b - a, d - a, lb, 100 * lb / cb }'
 done
 echo

@@ -29,13 +29,26 @@
      or P samples with --samples (2 s / (n H)). Such a cell (level q < L,
      side 2^(L-q)) is drawn as what it stands for, the voxels it holds: its
      colour is their mean (voxdag_cell_color), and max(0, n . l) becomes
-     the lighting of a voxel staircase (cell_lit: the occupancy gradient m,
-     m_k = count(cell - e_k) - count(cell + e_k) over the level's cells,
-     gives faces n_k = sign(m_k) e_k areas |m_k|, each seen in proportion
-     to max(0, -d . n_k) for ray direction d: the mean of max(0, n_k . l)
-     with weights |m_k| max(0, -d . n_k); the face's own value when all
-     weights are 0); its shadow ray starts past the cell's own staircase,
-     at t_min = its side. */
+     the lighting of a voxel staircase (cell_lit: a normal m gives faces
+     n_k = sign(m_k) e_k areas |m_k|, each seen in proportion to
+     max(0, -d . n_k) for ray direction d: the mean of max(0, n_k . l) with
+     weights |m_k| max(0, -d . n_k); the face's own value when all weights
+     are 0). m: the least-spread direction of the voxel counts of the cell
+     and its 26 neighbours of level q (their covariance's eigenvector of
+     least eigenvalue), turned against d. Its shadow ray starts past the
+     cell's own staircase, at t_min = its side. A cell covers its pixel in
+     part: 4 x 4 sub-rays parallel to the ray, across a square of side
+     P / 2 pixels at the first hit's distance, are tested against the
+     cell's cells two levels finer (footprint_cover); each cell met takes
+     the share of the sub-rays it newly stops, and the ray goes on past it
+     (t_min = where it leaves the cell) until every sub-ray is stopped, it
+     misses (the rest is BACKGROUND) or it has met LAYERS cells (the last
+     takes the rest). A cell entered less than RUN_GAP of the last cell's
+     chords after it shows the colour of the first cell of that run (the
+     same surface, not its inside). The sample is the weighted sum,
+     rounded. With --lod-opaque (the GPU kernel's model), a cell takes the
+     whole sample and m is the occupancy gradient,
+     m_k = count(cell - e_k) - count(cell + e_k). */
 #include <math.h>
 #include <pthread.h>
 #include <stdio.h>
@@ -271,6 +284,7 @@ typedef struct render_job {
     camera cam;
     voxdag_ray_opts opts;
     int shadows;
+    int lod_opaque; /* --lod-opaque: level-of-detail cells drawn whole, lit from the occupancy gradient */
     uint32_t side; /* samples per pixel: side x side */
     uint32_t levels;
     uint8_t *rgb;
@@ -280,29 +294,82 @@ typedef struct render_job {
     pthread_mutex_t lock;
 } render_job;
 
-enum { TILE = 32, BLOCK = 8, BLOCK_RAYS = BLOCK * BLOCK * 64 }; /* 64: --samples at most 8 x 8 */
+/* BLOCK_RAYS: --samples at most 8 x 8. LAYERS: cells a ray goes past at
+   most, in pixels that cells cover in part (level of detail). */
+enum { TILE = 32, BLOCK = 8, BLOCK_RAYS = BLOCK * BLOCK * 64, LAYERS = 8 };
+/* A cell that a ray meets less than RUN_GAP of the last cell's chords past
+   it continues that cell's run: the same surface, shown in the run's first
+   cell's colour (a cell behind a surface is lit and shadowed as the inside). */
+#define RUN_GAP 2.0
+
+/* The unit eigenvector of the symmetric 3 x 3 matrix A for its least
+   eigenvalue (cyclic Jacobi rotations; A is overwritten). */
+static void least_eigenvector(double a[3][3], double out[3]) {
+    double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    int sweep, p, q, k, least = 0;
+    for (sweep = 0; sweep < 12; sweep++)
+        for (p = 0; p < 2; p++)
+            for (q = p + 1; q < 3; q++) {
+                double theta, t, c, s;
+                if (!(fabs(a[p][q]) > 1e-12 * (fabs(a[p][p]) + fabs(a[q][q])))) continue;
+                theta = (a[q][q] - a[p][p]) / (2 * a[p][q]);
+                t = (theta >= 0 ? 1 : -1) / (fabs(theta) + sqrt(theta * theta + 1));
+                c = 1 / sqrt(t * t + 1), s = t * c;
+                for (k = 0; k < 3; k++) { /* A <- J^T A J, V <- V J */
+                    double akp = a[k][p], akq = a[k][q];
+                    a[k][p] = c * akp - s * akq, a[k][q] = s * akp + c * akq;
+                }
+                for (k = 0; k < 3; k++) {
+                    double apk = a[p][k], aqk = a[q][k];
+                    a[p][k] = c * apk - s * aqk, a[q][k] = s * apk + c * aqk;
+                }
+                for (k = 0; k < 3; k++) {
+                    double vkp = v[k][p], vkq = v[k][q];
+                    v[k][p] = c * vkp - s * vkq, v[k][q] = s * vkp + c * vkq;
+                }
+            }
+    for (k = 1; k < 3; k++)
+        if (a[k][k] < a[least][least]) least = k;
+    for (k = 0; k < 3; k++) out[k] = v[k][least];
+}
+
+/* Offset -1, 0 or 1 along axis K of neighbour I (0..26, x fastest) of a 3^3 block. */
+static int neighbour_offset(int i, int k) { return (k == 0 ? i : k == 1 ? i / 3 : i / 9) % 3 - 1; }
 
 /* Lighting of a level-of-detail cell that HIT stopped at: its voxels'
    faces, not the cell's box, as the supersampled full-detail picture sees
-   them. The surface normal m is the gradient of occupancy (the voxel counts
-   of the six neighbouring cells of the hit's level, fewer towards the
-   occupied side); a voxel surface with that normal is a staircase whose
-   faces of axis k have areas in proportion to |m_k|, each seen in
-   proportion to its facing the eye and lit as max(0, n_k . l). Returns that
-   mean, or FACE_LIT (the hit face's) where the cell has no gradient. */
+   them. A voxel surface with normal m is a staircase whose faces of axis k
+   have areas in proportion to |m_k|, each seen in proportion to its facing
+   the eye and lit as max(0, n_k . l); returns that mean, or FACE_LIT (the
+   hit face's) where there is no normal. The normal comes from the voxel
+   counts of the cell's 26 neighbours of the same level: by default the
+   direction in which the occupied cells around it (the cell included,
+   weighted by their counts) spread least, turned towards the eye, which
+   holds for solids and one-voxel shells alike; with --lod-opaque the
+   occupancy gradient, m_k = count(cell - e_k) - count(cell + e_k). */
 static double cell_lit(const render_job *job, const voxdag_hit *hit, const double dir[3], double face_lit) {
-    const voxdag *d = job->file->dag;
     const double *l = job->cam.light;
-    uint32_t size = 1u << (job->levels - hit->level), side[6][3];
-    uint64_t count[6];
-    double m[3], num = 0, den = 0;
-    int k;
-    for (k = 0; k < 3; k++) { /* the neighbours below and above along axis k */
-        memcpy(side[2 * k], hit->xyz, sizeof side[0]), memcpy(side[2 * k + 1], hit->xyz, sizeof side[0]);
-        side[2 * k][k] -= size, side[2 * k + 1][k] += size; /* wraps outside the grid: counted empty */
+    uint32_t size = 1u << (job->levels - hit->level), cell[27][3];
+    uint64_t count[27];
+    double m[3], num = 0, den = 0, total = 0, mean[3] = {0, 0, 0}, cov[3][3], facing = 0;
+    int k, i, j;
+    for (i = 0; i < 27; i++) /* wraps outside the grid: counted empty */
+        for (k = 0; k < 3; k++) cell[i][k] = hit->xyz[k] + (uint32_t)neighbour_offset(i, k) * size;
+    voxdag_cell_count_many(job->file->dag, hit->level, cell[0], 27, count, NULL);
+    if (job->lod_opaque) {
+        for (k = 0; k < 3; k++) m[k] = (double)count[13 - (k == 0 ? 1 : k == 1 ? 3 : 9)] - (double)count[13 + (k == 0 ? 1 : k == 1 ? 3 : 9)];
+    } else {
+        for (i = 0; i < 27; i++)
+            for (total += (double)count[i], k = 0; k < 3; k++) mean[k] += (double)count[i] * neighbour_offset(i, k);
+        for (k = 0; k < 3; k++) mean[k] /= total; /* total > 0: the cell is full */
+        for (j = 0; j < 3; j++)
+            for (k = 0; k < 3; k++)
+                for (cov[j][k] = 0, i = 0; i < 27; i++)
+                    cov[j][k] += (double)count[i] * (neighbour_offset(i, j) - mean[j]) * (neighbour_offset(i, k) - mean[k]);
+        least_eigenvector(cov, m);
+        for (k = 0; k < 3; k++) facing += m[k] * dir[k];
+        for (k = 0; k < 3; k++) m[k] = facing > 0 ? -m[k] : m[k];
     }
-    voxdag_cell_count_many(d, hit->level, side[0], 6, count, NULL);
-    for (k = 0; k < 3; k++) m[k] = (double)count[2 * k] - (double)count[2 * k + 1];
     for (k = 0; k < 3; k++) {
         double n = m[k] < 0 ? -1 : 1, seen = fabs(m[k]) * (-dir[k] * n > 0 ? -dir[k] * n : 0);
         num += seen * (l[k] * n > 0 ? l[k] * n : 0);
@@ -311,17 +378,112 @@ static double cell_lit(const render_job *job, const voxdag_hit *hit, const doubl
     return den > 0 ? num / den : face_lit;
 }
 
+/* Coverage of a pixel by the cells along its ray. The pixel's footprint is
+   a square of side FOOTPRINT x the pixel's size at the first hit, across
+   the ray, holding FOOT x FOOT sub-rays parallel to it (at the centres of
+   its sub-squares); *BLOCKED has a bit for each sub-ray some cell before
+   has stopped. Marks the sub-rays that meet a full sub-cell of the cell HIT
+   stopped at (its cells two levels finer: 4^3; 2^3 one level above the
+   voxels; a voxel stops them all) and returns how many it newly stopped. */
+enum { FOOT = 4, FOOT_ALL = (1 << FOOT * FOOT) - 1 };
+#define FOOTPRINT 0.5
+static uint32_t footprint_cover(const render_job *job, const voxdag_hit *hit, const voxdag_ray *ray, double side,
+                                uint32_t *blocked) {
+    uint32_t q = hit->level, down = job->levels - q < 2 ? job->levels - q : 2, n = 1u << down;
+    uint32_t size = 1u << (job->levels - q - down), xyz[64][3], a, c, e, fresh = 0, i;
+    uint64_t count[64];
+    const double *d = ray->dir;
+    double e1[3], e2[3], axis[3] = {0, 0, 0};
+    int k, least = 0;
+    if (!down) {
+        for (i = 0; i < FOOT * FOOT; i++) fresh += !(*blocked >> i & 1);
+        *blocked = FOOT_ALL;
+        return fresh;
+    }
+    for (a = 0; a < n; a++)
+        for (c = 0; c < n; c++)
+            for (e = 0; e < n; e++) {
+                uint32_t *p = xyz[(e * n + c) * n + a];
+                p[0] = hit->xyz[0] + a * size, p[1] = hit->xyz[1] + c * size, p[2] = hit->xyz[2] + e * size;
+            }
+    voxdag_cell_count_many(job->file->dag, q + down, xyz[0], n * n * n, count, NULL);
+    for (k = 1; k < 3; k++) /* e1, e2: across the ray */
+        if (fabs(d[k]) < fabs(d[least])) least = k;
+    axis[least] = 1;
+    cross3(d, axis, e1), normalize3(e1);
+    cross3(d, e1, e2), normalize3(e2);
+    for (i = 0; i < FOOT * FOOT; i++) {
+        double o[3], t0 = -HUGE_VAL, t1 = HUGE_VAL, u = ((i % FOOT + 0.5) / FOOT - 0.5) * side,
+                     v = ((i / FOOT + 0.5) / FOOT - 0.5) * side;
+        int cell[3], step[3], m;
+        if (*blocked >> i & 1) continue;
+        for (m = 0; m < 3; m++) { /* the sub-ray in units of sub-cells, from the cell's corner; its span in the cell */
+            o[m] = (ray->origin[m] + u * e1[m] + v * e2[m] - hit->xyz[m]) / size;
+            if (d[m] != 0) {
+                double ta = -o[m] / d[m], tb = ((double)n - o[m]) / d[m];
+                if (ta > tb) { double x = ta; ta = tb, tb = x; }
+                t0 = ta > t0 ? ta : t0, t1 = tb < t1 ? tb : t1;
+            } else if (o[m] < 0 || o[m] >= n) {
+                t0 = HUGE_VAL;
+            }
+        }
+        if (!(t0 < t1)) continue;
+        for (m = 0; m < 3; m++) {
+            o[m] += t0 * d[m];
+            cell[m] = (int)floor(o[m]);
+            cell[m] = cell[m] < 0 ? 0 : cell[m] >= (int)n ? (int)n - 1 : cell[m];
+            step[m] = d[m] > 0 ? 1 : -1;
+        }
+        for (;;) { /* through the sub-cells, from o */
+            double next_t = HUGE_VAL;
+            int next = 0;
+            if (count[(cell[2] * n + cell[1]) * n + cell[0]]) {
+                *blocked |= 1u << i, fresh++;
+                break;
+            }
+            for (m = 0; m < 3; m++)
+                if (d[m] != 0) {
+                    double tm = ((double)cell[m] + (d[m] > 0) - o[m]) / d[m];
+                    if (tm < next_t) next_t = tm, next = m;
+                }
+            cell[next] += step[next];
+            if (cell[next] < 0 || cell[next] >= (int)n) break;
+        }
+    }
+    return fresh;
+}
+
+/* Where RAY leaves the cell of side 2^(L - level) that HIT stopped at. */
+static double cell_exit(const render_job *job, const voxdag_ray *ray, const voxdag_hit *hit) {
+    double side = (double)(1u << (job->levels - hit->level)), t = HUGE_VAL;
+    int k;
+    for (k = 0; k < 3; k++)
+        if (ray->dir[k] != 0) {
+            double bound = hit->xyz[k] + (ray->dir[k] > 0 ? side : 0), tk = (bound - ray->origin[k]) / ray->dir[k];
+            if (tk < t) t = tk;
+        }
+    return t;
+}
+
 /* The rays of a block of BLOCK x BLOCK pixels and their answers, traced
    together (voxdag_raycast_many, then voxdag_occluded_many for the shadow
    rays of the lit faces), in BLOCK x BLOCK tiles of samples so that
-   neighbouring rays go together. */
+   neighbouring rays go together; then the rays of the samples that a cell
+   covered only in part, past it (a layer), up to LAYERS times. */
 typedef struct ray_block {
     voxdag_ray rays[BLOCK_RAYS], shadows[BLOCK_RAYS];
     voxdag_hit hits[BLOCK_RAYS];
-    uint8_t got[BLOCK_RAYS], occluded[BLOCK_RAYS];
+    uint8_t got[BLOCK_RAYS], occluded[BLOCK_RAYS], front[BLOCK_RAYS];
     uint32_t x[BLOCK_RAYS], y[BLOCK_RAYS]; /* the sample's pixel in the block */
     uint32_t shadow_of[BLOCK_RAYS];       /* the ray whose hit casts shadow ray k */
+    uint32_t sample[BLOCK_RAYS];          /* the sample whose ray is ray k of the layer */
     double factor[BLOCK_RAYS];
+    /* per sample: its colour so far, the footprint's side and stopped
+       sub-rays, the shaded colour of the first cell of the current run of
+       adjacent cells, and where the ray entered and left the last cell */
+    double sum[BLOCK_RAYS][3], side[BLOCK_RAYS], enter[BLOCK_RAYS], leave[BLOCK_RAYS];
+    uint32_t blocked[BLOCK_RAYS];
+    uint8_t color[BLOCK_RAYS][3];
 } ray_block;
 
 /* The ray through pixel (I, J) of a W x H picture of the view. */
@@ -342,7 +504,7 @@ static void sample_ray(const camera *c, uint32_t i, uint32_t j, double w, double
 static void render_block(const render_job *job, uint32_t x0, uint32_t y0, ray_block *b) {
     const camera *c = &job->cam;
     const voxdag *dag = job->file->dag;
-    uint32_t n = job->side, tx, ty, a, k, count = 0, shadows = 0, sum[BLOCK][BLOCK][3];
+    uint32_t n = job->side, tx, ty, a, k, count = 0, shadows = 0, samples, layer, sum[BLOCK][BLOCK][3];
     memset(sum, 0, sizeof sum);
     for (ty = 0; ty < n; ty++) /* samples in tiles of BLOCK x BLOCK */
         for (tx = 0; tx < n; tx++)
@@ -353,42 +515,73 @@ static void render_block(const render_job *job, uint32_t x0, uint32_t y0, ray_bl
                 b->x[count] = i / n - x0, b->y[count] = j / n - y0;
                 count++;
             }
-    voxdag_raycast_many(dag, b->rays, count, &job->opts, b->hits, b->got);
-    for (k = 0; k < count; k++) { /* shading; shadow rays from the lit faces */
-        const voxdag_hit *hit = &b->hits[k];
-        b->factor[k] = 1;
-        if (!b->got[k] || !(hit->normal[0] | hit->normal[1] | hit->normal[2])) continue;
-        {
-            double nv[3] = {hit->normal[0], hit->normal[1], hit->normal[2]}, lit = dot3(nv, c->light);
-            voxdag_ray *shadow = &b->shadows[shadows];
-            if (hit->level < job->levels) lit = cell_lit(job, hit, b->rays[k].dir, lit);
-            b->factor[k] = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
-            if (!job->shadows || !(lit > 0)) continue;
-            if (hit->level < job->levels) { /* past the cell's own staircase (lit above) */
-                voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow);
-                shadow->t_min = (double)(1u << (job->levels - hit->level));
-                b->shadow_of[shadows++] = k;
-            } else if (voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow) > 0) {
-                b->shadow_of[shadows++] = k;
-            }
-        }
-    }
-    voxdag_occluded_many(dag, b->shadows, shadows, NULL, b->occluded);
-    for (k = 0; k < shadows; k++)
-        if (b->occluded[k]) b->factor[b->shadow_of[k]] = AMBIENT;
+    samples = count;
+    samples = count;
     for (k = 0; k < count; k++) {
-        uint8_t rgb[3];
-        if (!b->got[k]) {
-            memcpy(rgb, BACKGROUND, 3);
-        } else {
-            vdag_hit_color(job->file, &b->hits[k], rgb);
-            for (a = 0; a < 3; a++) {
-                double v = rgb[a] * b->factor[k] + 0.5;
-                rgb[a] = (uint8_t)(v > 255 ? 255 : v);
+        b->sample[k] = k, b->blocked[k] = 0;
+        b->sum[k][0] = b->sum[k][1] = b->sum[k][2] = 0;
+    }
+    for (layer = 0; layer < LAYERS && count; layer++) {
+        uint32_t next = 0;
+        shadows = 0;
+        voxdag_raycast_many(dag, b->rays, count, &job->opts, b->hits, b->got);
+        for (k = 0; k < count; k++) { /* shading of the first cell of each run; shadow rays from the lit faces */
+            const voxdag_hit *hit = &b->hits[k];
+            uint32_t s = b->sample[k];
+            b->factor[k] = 1;
+            b->front[k] = !layer || !(hit->t < b->leave[s] + (b->leave[s] - b->enter[s]) * RUN_GAP);
+            if (!b->got[k] || !b->front[k] || !(hit->normal[0] | hit->normal[1] | hit->normal[2])) continue;
+            {
+                double nv[3] = {hit->normal[0], hit->normal[1], hit->normal[2]}, lit = dot3(nv, c->light);
+                voxdag_ray *shadow = &b->shadows[shadows];
+                if (hit->level < job->levels) lit = cell_lit(job, hit, b->rays[k].dir, lit);
+                b->factor[k] = AMBIENT + (1 - AMBIENT) * (lit > 0 ? lit : 0);
+                if (!job->shadows || !(lit > 0)) continue;
+                if (hit->level < job->levels) { /* past the cell's own staircase (lit above) */
+                    voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow);
+                    shadow->t_min = (double)(1u << (job->levels - hit->level));
+                    b->shadow_of[shadows++] = k;
+                } else if (voxdag_ray_from_hit(dag, &b->rays[k], hit, c->light, shadow) > 0) {
+                    b->shadow_of[shadows++] = k;
+                }
             }
         }
-        for (a = 0; a < 3; a++) sum[b->y[k]][b->x[k]][a] += rgb[a];
+        voxdag_occluded_many(dag, b->shadows, shadows, NULL, b->occluded);
+        for (k = 0; k < shadows; k++)
+            if (b->occluded[k]) b->factor[b->shadow_of[k]] = AMBIENT;
+        for (k = 0; k < count; k++) { /* each cell's share of the footprint, in its run's colour */
+            const voxdag_hit *hit = &b->hits[k];
+            uint32_t s = b->sample[k], fresh = 0, left = b->blocked[s];
+            const uint8_t *rgb = BACKGROUND;
+            if (b->got[k]) {
+                if (b->front[k]) {
+                    vdag_hit_color(job->file, hit, b->color[s]);
+                    for (a = 0; a < 3; a++) {
+                        double v = b->color[s][a] * b->factor[k] + 0.5;
+                        b->color[s][a] = (uint8_t)(v > 255 ? 255 : v);
+                    }
+                }
+                rgb = b->color[s];
+                if (!layer) b->side[s] = FOOTPRINT * job->opts.lod_factor * job->opts.lod_pixels * hit->t;
+                if (!job->lod_opaque && layer + 1 < LAYERS) fresh = footprint_cover(job, hit, &b->rays[k], b->side[s], &b->blocked[s]);
+                else b->blocked[s] = FOOT_ALL;
+            } else {
+                b->blocked[s] = FOOT_ALL;
+            }
+            if (b->blocked[s] == FOOT_ALL)
+                for (fresh = 0, a = 0; a < FOOT * FOOT; a++) fresh += !(left >> a & 1);
+            for (a = 0; a < 3; a++) b->sum[s][a] += (double)fresh / (FOOT * FOOT) * rgb[a];
+            if (b->blocked[s] != FOOT_ALL) { /* the rest of the footprint sees past the cell */
+                b->enter[s] = hit->t, b->leave[s] = cell_exit(job, &b->rays[k], hit);
+                b->rays[next] = b->rays[k], b->sample[next] = s;
+                b->rays[next].t_min = b->leave[s] * (1 + 1e-12) + 1e-9; /* past the face, not on it */
+                next++;
+            }
+        }
+        count = next;
     }
+    for (k = 0; k < samples; k++)
+        for (a = 0; a < 3; a++) sum[b->y[k]][b->x[k]][a] += (uint32_t)(b->sum[k][a] + 0.5);
     for (ty = y0; ty < y0 + BLOCK && ty < c->h; ty++)
         for (tx = x0; tx < x0 + BLOCK && tx < c->w; tx++)
             for (a = 0; a < 3; a++)
@@ -509,7 +702,7 @@ static int render_gpu(render_job *job, vdag_gpu_target target, double lod_pixels
 
 int vdag_cmd_render(int argc, char **argv) {
     static const char usage[] = "usage: vdag render FILE OUT.png [--size WxH] [--eye x y z] [--target x y z] "
-                                "[--fov deg] [--threads T] [--shadows] [--light x y z] [--lod PIXELS] [--samples N] [--quiet] "
+                                "[--fov deg] [--threads T] [--shadows] [--light x y z] [--lod PIXELS [--lod-opaque]] [--samples N] [--quiet] "
                                 "[--gpu | --gpu-emulate [--beam]]";
     render_job job;
     vdag_file f;
@@ -543,6 +736,8 @@ int vdag_cmd_render(int argc, char **argv) {
                 return vdag_fail("render: --threads takes 0..64 (0: all processors)");
         } else if (!strcmp(a, "--lod")) {
             if (!parse_numbers(argc, argv, &i, &lod, 1) || lod < 0) return vdag_fail("render: --lod takes pixels >= 0");
+        } else if (!strcmp(a, "--lod-opaque")) {
+            job.lod_opaque = 1;
         } else if (!strcmp(a, "--shadows")) {
             job.shadows = 1;
         } else if (!strcmp(a, "--light")) {

@@ -855,20 +855,22 @@ check "render: --samples takes 1, 4, ..., 64 (CPU only) and --light a nonzero di
         [ ! -e '$T/bad.png' ] || exit 1
     done
     '$VDAG' render '$T/r.vdag' '$T/s.png' --size 4x4 --samples 9 --light 1 -1 2 --shadows --quiet && [ -s '$T/s.png' ]"
-check "render --samples 4: at least 4 dB nearer the 8x8-supersampled picture (--samples 64) than one sample (demo, far view)" sh -c "
+check "render --samples 4 and --lod 1: at least 4 and 2 dB nearer the 8x8-supersampled picture (--samples 64) than one sample (demo, far view)" sh -c "
     '$VDAG' gen demo '$T/aa.xyz' --levels 8 >/dev/null 2>&1 && '$VDAG' build '$T/aa.xyz' '$T/aa.vdag' --quiet &&
-    for n in 64 1 4; do
+    for n in 64 1 4 lod; do
+        o=\"--samples \$n\"; [ \$n = lod ] && o='--lod 1'
         '$VDAG' render '$T/aa.vdag' '$T/aa'\$n.png --size 200x125 --eye 650 -450 375 --target 128 128 50 --fov 30 \\
-            --shadows --samples \$n --quiet || exit 1
+            --shadows \$o --quiet || exit 1
     done
     p1=\$(idiff -a '$T/aa64.png' '$T/aa1.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
     p4=\$(idiff -a '$T/aa64.png' '$T/aa4.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
-    echo \"render --samples: PSNR against --samples 64: 1 sample \$p1 dB, 4 samples \$p4 dB\" >&2
-    awk -v a=\"\$p1\" -v b=\"\$p4\" 'BEGIN { exit !(a > 20 && b >= a + 4) }'"
-check "render --gpu-emulate --lod 2: the CPU's level-of-detail picture in float32 (mean colours, staircase lighting, shadows; PSNR >= 40 dB against it; demo, far view)" sh -c "
+    pl=\$(idiff -a '$T/aa64.png' '$T/aalod.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
+    echo \"render: PSNR against --samples 64: 1 sample \$p1 dB, 4 samples \$p4 dB, --lod 1 \$pl dB\" >&2
+    awk -v a=\"\$p1\" -v b=\"\$p4\" -v l=\"\$pl\" 'BEGIN { exit !(a > 20 && b >= a + 4 && l >= a + 2) }'"
+check "render --gpu-emulate --lod 2: the CPU's level-of-detail picture with --lod-opaque in float32 (mean colours, staircase lighting, shadows; PSNR >= 40 dB against it; demo, far view)" sh -c "
     for k in cpu gpu-emulate; do
         '$VDAG' render '$T/aa.vdag' '$T/lod_'\$k.png --size 200x125 --eye 650 -450 375 --target 128 128 50 --fov 30 \\
-            --shadows --lod 2 \$([ \$k = cpu ] || echo --gpu-emulate) --quiet || exit 1
+            --shadows --lod 2 \$([ \$k = cpu ] && echo --lod-opaque || echo --gpu-emulate) --quiet || exit 1
     done
     p=\$(idiff -a '$T/lod_cpu.png' '$T/lod_gpu-emulate.png' | sed -n 's/.*Peak SNR = \\([0-9.]*\\).*/\\1/p')
     echo \"render --lod 2: the GPU kernel's picture against the CPU renderer's: PSNR \$p dB\" >&2
