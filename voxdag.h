@@ -6747,6 +6747,12 @@ VOXDAG_API int voxdag_lookup(const voxdag *dag, uint32_t x, uint32_t y, uint32_t
     return 1;
 }
 
+/* Morton position inside a 4^3 brick of the voxel with coordinates C. */
+VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
+    return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
+           (c[2] & 2) << 4;
+}
+
 /* The cells of level Q holding points XYZ[0 .. COUNT): for each, its voxel
    count (into COUNT_OUT, or FULL as 0/1 when Q = L, each when not NULL) and
    first voxel index (into FIRST, when not NULL and the cell is not empty).
@@ -6793,7 +6799,10 @@ static uint64_t voxdagi_cells_many(const voxdag *dag, uint32_t q, const uint32_t
             n = voxdagi_node_count(dag, q, at[q]);
         } else {
             unsigned low = 3 * (nlevels - q); /* Morton bits inside the cell: 6 (the brick), 3 or 0 */
-            unsigned p = (unsigned)(voxdag_morton_encode(x & 3, y & 3, z & 3)) >> low << low;
+            uint32_t in_brick[3];
+            unsigned p;
+            in_brick[0] = x, in_brick[1] = y, in_brick[2] = z;
+            p = voxdagi_brick_pos(in_brick) >> low << low;
             uint64_t cell = low == 6 ? ~0ull : ((1ull << (1u << low)) - 1) << p; /* 8 bits or 1 from P */
             if (!have_mask) mask = voxdagi_brick_to_world(voxdagi_brick(dag, at[brick_level]), mi[brick_level]);
             have_mask = 1;
@@ -7077,12 +7086,6 @@ typedef struct voxdagi_frame {
     const uint8_t *rec;
     unsigned header, mi, occ; /* occ: which world octants hold a child */
 } voxdagi_frame;
-
-/* Morton position inside a 4^3 brick of the voxel with coordinates C. */
-VOXDAGI_INLINE unsigned voxdagi_brick_pos(const uint32_t c[3]) {
-    return (c[0] & 1) | (c[1] & 1) << 1 | (c[2] & 1) << 2 | (c[0] & 2) << 2 | (c[1] & 2) << 3 |
-           (c[2] & 2) << 4;
-}
 
 /* The octants of a 2^3 block a ray can still reach from octant W, moving only
    towards the AHEAD halves (bit b set: it has yet to cross mid plane b):

@@ -24,10 +24,10 @@ CG-57|$C|11|1024|2300 -1500 900|512 61 110|30"
 
 echo "## Pictures at a distance"
 echo
-echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. A level-of-detail cell is drawn as the voxels it holds: their mean colour (the file's level-of-detail colour section for cells of more than 64 voxels), lit as a voxel staircase facing the normal of the occupancy around it, over the share of the pixel's 4 x 4 sub-rays its finer cells stop, the ray going on past it for the rest (README, \`vdag render\`); \`--lod-opaque\` (the GPU kernel's model) draws a cell over the whole pixel, lit from the occupancy gradient of its six neighbours. The tree's view puts about two voxels in a pixel (a nearer one, with voxels larger than pixels, has no cell for \`--lod 1\` to stop at). Last two columns: the level-of-detail colour section of the same scene built with \`--color-error 0.02\`, in bytes and as a share of that file's colour section."
+echo "Each scene built by \`vdag build\` (default colours: lossless voxcolor), rendered by \`vdag render --size $size --shadows\` from a far view fixed here. Reference: \`--samples 64\`, which is exactly the full-detail picture 8x as wide and high with its 8x8 blocks averaged. PSNR (dB) of each render against it by OpenImageIO \`idiff\` (RGB, whole picture, background included); higher is closer. A level-of-detail cell is drawn as the voxels it holds: their mean colour (the file's level-of-detail colour section for cells of more than 64 voxels), lit as a voxel staircase facing the normal of the occupancy around it, over the share of the pixel's 4 x 4 sub-rays its finer cells stop, the ray going on past it for the rest (README, \`vdag render\`); \`--lod-opaque\` (the GPU kernel's model) draws a cell over the whole pixel, lit from the occupancy gradient of its six neighbours. The tree's view puts about two voxels in a pixel (a nearer one, with voxels larger than pixels, has no cell for \`--lod 1\` to stop at). CPU-s: the render's CPU seconds on one thread (\`--threads 1\`, as \`vdag render\` reports them: loading excluded). Last two columns: the level-of-detail colour section of the same scene built with \`--color-error 0.02\`, in bytes and as a share of that file's colour section."
 echo
-echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --lod 1 --lod-opaque | --samples 4 gain (dB) | --lod 1 gain (dB) | LOD colours (bytes) | share of colours at e_t 0.02 |"
-echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+echo "| scene | L | 1 sample | --samples 4 | --samples 16 | --lod 1 | --lod 2 | --lod 1 --lod-opaque | --samples 4 gain (dB) | --lod 1 gain (dB) | CPU-s 1 sample | CPU-s --samples 4 | CPU-s --lod 1 | CPU-s --lod 1 --lod-opaque | LOD colours (bytes) | share of colours at e_t 0.02 |"
+echo "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     echo "distance: $name" >&2
     if [ "$in" = demo ]; then
@@ -48,11 +48,11 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     cam=$(echo "$eye $target" | awk -v n="$levels" -v g="$grid" '{ s = 2 ^ n / g; for (i = 1; i <= 6; i++) printf "%g ", $i * s }')
     # shellcheck disable=SC2086
     set -- $cam
-    shot() { # shot OUT OPTIONS...
+    shot() { # shot OUT OPTIONS...; the render's CPU seconds on one thread into $work/OUT.cpu
         out=$1
         shift
         "$vdag" render "$work/s.vdag" "$work/$out.png" --size $size --eye "$c1" "$c2" "$c3" --target "$c4" "$c5" "$c6" \
-            --fov "$fov" --shadows --quiet "$@"
+            --fov "$fov" --shadows --threads 1 "$@" 2>&1 | sed -n 's/.*(\([0-9.]*\) CPU-s).*/\1/p' >"$work/$out.cpu"
     }
     c1=$1 c2=$2 c3=$3 c4=$4 c5=$5 c6=$6
     shot ref --samples 64
@@ -67,6 +67,7 @@ echo "$scenes" | while IFS='|' read -r name in L grid eye target fov; do
     shot l2 --lod 2 && pl2=$(psnr l2)
     shot o1 --lod 1 --lod-opaque && po1=$(psnr o1)
     awk -v n="$name" -v L="$levels" -v a="$p1" -v b="$p4" -v c="$p16" -v d="$pl1" -v e="$pl2" -v o="$po1" -v lb="$lodb" -v cb="$colb" \
-        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f | %d | %.1f %% |\n", n, L, a, b, c, d, e, o, b - a, d - a, lb, 100 * lb / cb }'
+        -v t1="$(cat "$work/one.cpu")" -v t4="$(cat "$work/s4.cpu")" -v tl="$(cat "$work/l1.cpu")" -v to="$(cat "$work/o1.cpu")" \
+        'BEGIN { printf "| %s | %s | %.1f | %.1f | %.1f | %.1f | %.1f | %.1f | %+.1f | %+.1f | %.2f | %.2f | %.2f | %.2f | %d | %.1f %% |\n", n, L, a, b, c, d, e, o, b - a, d - a, t1, t4, tl, to, lb, 100 * lb / cb }'
 done
 echo

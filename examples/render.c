@@ -307,7 +307,7 @@ enum { TILE = 32, BLOCK = 8, BLOCK_RAYS = BLOCK * BLOCK * 64, LAYERS = 8 };
 static void least_eigenvector(double a[3][3], double out[3]) {
     double v[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     int sweep, p, q, k, least = 0;
-    for (sweep = 0; sweep < 12; sweep++)
+    for (sweep = 0; sweep < 12 && !(fabs(a[0][1]) + fabs(a[0][2]) + fabs(a[1][2]) <= 1e-12 * (fabs(a[0][0]) + fabs(a[1][1]) + fabs(a[2][2]))); sweep++)
         for (p = 0; p < 2; p++)
             for (q = p + 1; q < 3; q++) {
                 double theta, t, c, s;
