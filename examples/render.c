@@ -221,7 +221,7 @@ static int write_chunk(FILE *out, const char *type, const uint8_t *data, size_t 
     put_be32(head, (uint32_t)n);
     memcpy(head + 4, type, 4);
     put_be32(tail, crc32_update(crc32_update(0, head + 4, 4), data, n));
-    return fwrite(head, 1, 8, out) == 8 && fwrite(data, 1, n, out) == n && fwrite(tail, 1, 4, out) == 4;
+    return fwrite(head, 1, 8, out) == 8 && (n == 0 || fwrite(data, 1, n, out) == n) && fwrite(tail, 1, 4, out) == 4;
 }
 
 /* Writes W x H RGB8 pixels (rows top to bottom) as a PNG. Returns 1 on success. */
