@@ -24,9 +24,10 @@
    rgb is 0x00BBGGRR (a level-of-detail hit's: its cell's mean colour),
    white for a file without colours.
 
-   The picture model is examples/render.c's in float32, level-of-detail
-   cells included (their mean colour, their staircase's lighting, the
-   shadow ray started past it), with two differences: directions are f +
+   The picture model is examples/render.c's with --lod-opaque in float32,
+   level-of-detail cells included (their mean colour, their staircase's
+   lighting from the occupancy gradient, the shadow ray started past it;
+   each cell covers its whole pixel), with two differences: directions are f +
    sx r + sy u unnormalized (t is then the depth along the view axis), and
    level of detail compares a cell with the pixel size at that depth. */
 #ifndef VDAG_KERNEL_H
@@ -108,7 +109,7 @@ VOXDAG_GPU_FUNC voxdag_gpu_f32 vdag_kernel_lit_by(voxdag_gpu_f32 m, voxdag_gpu_f
 }
 
 /* The lighting of the level-of-detail cell that H stopped at, seen along
-   (DX, DY, DZ): examples/render.c's cell_lit in float32, its voxels'
+   (DX, DY, DZ): examples/render.c's cell_lit with --lod-opaque in float32, its voxels'
    staircase from the occupancy gradient m of the six neighbouring cells,
    faces of axis k weighted by |m_k| max(0, -d . n_k) and lit by
    max(0, n_k . l); FACE_LIT where none is seen. m is scaled by a power of
