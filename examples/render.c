@@ -333,8 +333,10 @@ static void least_eigenvector(double a[3][3], double out[3]) {
     for (k = 0; k < 3; k++) out[k] = v[k][least];
 }
 
-/* Offset -1, 0 or 1 along axis K of neighbour I (0..26, x fastest) of a 3^3 block. */
-static int neighbour_offset(int i, int k) { return (k == 0 ? i : k == 1 ? i / 3 : i / 9) % 3 - 1; }
+/* Neighbour I (0..26) of a 3^3 block of cells, x fastest: the index step
+   along axis K, and its offset -1, 0 or 1 along K (13: the centre). */
+static const int NEIGHBOUR_STRIDE[3] = {1, 3, 9};
+static int neighbour_offset(int i, int k) { return i / NEIGHBOUR_STRIDE[k] % 3 - 1; }
 
 /* Lighting of a level-of-detail cell that HIT stopped at: its voxels'
    faces, not the cell's box, as the supersampled full-detail picture sees
@@ -357,7 +359,7 @@ static double cell_lit(const render_job *job, const voxdag_hit *hit, const doubl
         for (k = 0; k < 3; k++) cell[i][k] = hit->xyz[k] + (uint32_t)neighbour_offset(i, k) * size;
     voxdag_cell_count_many(job->file->dag, hit->level, cell[0], 27, count, NULL);
     if (job->lod_opaque) {
-        for (k = 0; k < 3; k++) m[k] = (double)count[13 - (k == 0 ? 1 : k == 1 ? 3 : 9)] - (double)count[13 + (k == 0 ? 1 : k == 1 ? 3 : 9)];
+        for (k = 0; k < 3; k++) m[k] = (double)count[13 - NEIGHBOUR_STRIDE[k]] - (double)count[13 + NEIGHBOUR_STRIDE[k]];
     } else {
         for (i = 0; i < 27; i++)
             for (total += (double)count[i], k = 0; k < 3; k++) mean[k] += (double)count[i] * neighbour_offset(i, k);
@@ -382,9 +384,9 @@ static double cell_lit(const render_job *job, const voxdag_hit *hit, const doubl
    a square of side FOOTPRINT x the pixel's size at the first hit, across
    the ray, holding FOOT x FOOT sub-rays parallel to it (at the centres of
    its sub-squares); *BLOCKED has a bit for each sub-ray some cell before
-   has stopped. Marks the sub-rays that meet a full sub-cell of the cell HIT
-   stopped at (its cells two levels finer: 4^3; 2^3 one level above the
-   voxels; a voxel stops them all) and returns how many it newly stopped. */
+   has stopped. Marks the sub-rays that meet a full sub-cell of the
+   level-of-detail cell HIT stopped at (its cells two levels finer: 4^3;
+   2^3 one level above the voxels) and returns how many it newly stopped. */
 enum { FOOT = 4, FOOT_ALL = (1 << FOOT * FOOT) - 1 };
 #define FOOTPRINT 0.5
 static uint32_t footprint_cover(const render_job *job, const voxdag_hit *hit, const voxdag_ray *ray, double side,
@@ -395,11 +397,6 @@ static uint32_t footprint_cover(const render_job *job, const voxdag_hit *hit, co
     const double *d = ray->dir;
     double e1[3], e2[3], axis[3] = {0, 0, 0};
     int k, least = 0;
-    if (!down) {
-        for (i = 0; i < FOOT * FOOT; i++) fresh += !(*blocked >> i & 1);
-        *blocked = FOOT_ALL;
-        return fresh;
-    }
     for (a = 0; a < n; a++)
         for (c = 0; c < n; c++)
             for (e = 0; e < n; e++) {
@@ -563,12 +560,13 @@ static void render_block(const render_job *job, uint32_t x0, uint32_t y0, ray_bl
                 }
                 rgb = b->color[s];
                 if (!layer) b->side[s] = FOOTPRINT * job->opts.lod_factor * job->opts.lod_pixels * hit->t;
-                if (!job->lod_opaque && layer + 1 < LAYERS) fresh = footprint_cover(job, hit, &b->rays[k], b->side[s], &b->blocked[s]);
-                else b->blocked[s] = FOOT_ALL;
+                if (!job->lod_opaque && hit->level < job->levels && layer + 1 < LAYERS)
+                    fresh = footprint_cover(job, hit, &b->rays[k], b->side[s], &b->blocked[s]);
+                else b->blocked[s] = FOOT_ALL; /* a voxel (or the last layer) stops the rest */
             } else {
                 b->blocked[s] = FOOT_ALL;
             }
-            if (b->blocked[s] == FOOT_ALL)
+            if (b->blocked[s] == FOOT_ALL) /* the share still open before this cell */
                 for (fresh = 0, a = 0; a < FOOT * FOOT; a++) fresh += !(left >> a & 1);
             for (a = 0; a < 3; a++) b->sum[s][a] += (double)fresh / (FOOT * FOOT) * rgb[a];
             if (b->blocked[s] != FOOT_ALL) { /* the rest of the footprint sees past the cell */
